@@ -142,7 +142,9 @@ def test_each_log_is_mapped_to_the_joint_side_once(logs, tmp_path, monkeypatch):
     """observe mapped every log through the drive five times (the degrees, limits, sign and
     unit checks and the observer each on its own); now once per log, the checks and the
     observer reading the same joint-side log (the check of columns recorded reversed maps
-    its own samples, within the derivative's edges, with chosen columns negated)."""
+    its own samples, within the derivative's edges, with chosen columns negated), and once
+    more for the calibration's judgement of the model, validate's prediction on the same
+    logs, which are not read again."""
     calls = []
     through = Drive.joint_torques
 
@@ -155,4 +157,4 @@ def test_each_log_is_mapped_to_the_joint_side_once(logs, tmp_path, monkeypatch):
     data = [str(logs / "free.csv"), str(logs / "hit.csv")]
     assert main([*p, "--data", *data, "--out", str(tmp_path / "c")]) == 0
     rows = [len((logs / f).read_text().splitlines()) - 3 for f in ("free.csv", "hit.csv")]
-    assert sorted(c for c in calls if c in rows) == sorted(rows), (calls, rows)
+    assert sorted(c for c in calls if c in rows) == sorted(2 * rows), (calls, rows)

@@ -9,6 +9,7 @@ those thresholds on the same log, and the log's own duration.
 
 from __future__ import annotations
 
+import html
 import json
 import re
 
@@ -113,3 +114,45 @@ def test_the_smallest_detectable_torque_grows_with_the_largest_uncertainty():
     np.testing.assert_allclose(detectable(fixed, s), [0.9, 0.3], rtol=1e-12)
     check = CalibrationCheck(30.0, 2, s, detectable(grown, s), np.array([0.3, 0.1]))
     assert check.false_alarms_per_min == pytest.approx(4.0, rel=1e-12)
+
+
+def test_the_calibration_judges_the_model_behind_the_thresholds(free, tmp_path, capsys):
+    """The calibration says how well the model predicts the calibration log's torques,
+    judged as dynid validate judges it: the true Panda (the simulation's own) at the noise
+    floor; the Panda with link 4's parameters 30 % too large not, in other words, with the
+    wider thresholds said to hold the model's error; in thresholds.json, the report's
+    first screen and the printed summary, the verdict the same as validate's."""
+    from dynid.io.robot.toml import save_toml
+
+    path, _ = free
+    panda = dynid.panda()
+    phi = np.array(panda.phi)
+    phi[3] *= 1.3  # link 4: mass, first moments and inertia 30 % off
+    wrong = save_toml(tmp_path / "wrong.toml", panda.with_params(phi))
+    said = {}
+    for name, params in (("true", "panda"), ("wrong", str(wrong))):
+        out = tmp_path / name
+        args = ["observe", "--params", params, "--data", str(path), "--calibrate"]
+        capsys.readouterr()
+        assert main([*args, "--no-figures", "--out", str(out)]) == 0
+        printed = capsys.readouterr().out
+        check = json.loads((out / "thresholds.json").read_text())["calibration"]["model_check"]
+        args = ["validate", "--params", params, "--data", str(path), "--no-figures", "-q"]
+        assert main([*args, "--out", str(tmp_path / f"val_{name}")]) == 0
+        val = json.loads((tmp_path / f"val_{name}" / "validation.json").read_text())
+        assert check["verdict"]["label"] == val["verdict"]["label"], (check, val["verdict"])
+        label = check["verdict"]["label"]
+        err = check["relative_error_percent"]
+        line = f"the model predicts the calibration logs' torques to {err:.3g} %"
+        assert line in printed and f"(validate's verdict: {label})" in printed, printed
+        page = (out / "report.html").read_text()
+        box = page[
+            page.index('id="verdict"') : page.index("</section>", page.index('id="verdict"'))
+        ]
+        box = html.unescape(box)
+        assert line in box and f"(validate's verdict: {label})" in box, box
+        said[name] = (check["verdict"]["level"], label, box)
+    assert said["true"][:2] == ("good", "at the noise floor")
+    assert said["wrong"][0] != "good" and said["wrong"][1] != said["true"][1]
+    assert "a better model narrows them" in said["wrong"][2]
+    assert "a better model" not in said["true"][2]

@@ -40,7 +40,10 @@ Two steps:
   table, kept in thresholds.json's calibration and put first in the report: the false
   alarms the thresholds raise on the calibration logs (the events --thresholds would
   find there, and per minute) and the smallest external torque detected per joint while
-  it moves (the largest contact threshold along the motion; at rest: its column).
+  it moves (the largest contact threshold along the motion; at rest: its column), and
+  how well the model predicts the calibration logs' torques, judged as `dynid validate`
+  judges it (relative error against the noise floor, validate's verdict): a model above
+  the floor makes the thresholds wider, and the line says so.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with

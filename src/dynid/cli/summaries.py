@@ -819,6 +819,8 @@ def _check_lines(check: CalibrationCheck | None) -> list[str]:
         + ", ".join(f"{v:.3g}" for v in check.detectable)
         + " N m (the largest contact threshold along the motion)"
     )
+    if check.model is not None:  # the model behind the thresholds
+        out.append(check.model.words())
     return out
 
 

@@ -16,7 +16,10 @@
                      "detectable": [...], # N m per joint, the smallest torque detected
                                           # while the joint moves
                      "peak": [...],       # N m per joint, the largest |r| read
-                     "sigma_max": [...]}, # N m per joint, the largest sigma (uncertainty)
+                     "sigma_max": [...],  # N m per joint, the largest sigma (uncertainty)
+                     "model_check": {     # the model judged on the logs as validate does
+                         "relative_error_percent": e, "noise_floor_percent": f,
+                         "verdict": {"level", "label", "reason", "ratio"}}},
      "units": {...}}
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
@@ -132,7 +135,11 @@ THRESHOLDS = Format(
                 ),
             ),
             "calibration": Field(
-                "object", record=Record({"samples": Field("integer", low=0)}, open=True)
+                "object",
+                record=Record(
+                    {"samples": Field("integer", low=0), "model_check": Field("object")},
+                    open=True,
+                ),
             ),
             "units": Field("any"),
         }
@@ -528,6 +535,18 @@ def save_observation(
             }
             if check.sigma_max is not None:
                 cal["sigma_max"] = check.sigma_max.tolist()
+            if (m := check.model) is not None:  # the model behind the thresholds
+                v = m.verdict
+                cal["model_check"] = {
+                    "relative_error_percent": m.error_percent,
+                    "noise_floor_percent": m.floor_percent,
+                    "verdict": {
+                        "level": v.level,
+                        "label": v.label,
+                        "reason": v.reason,
+                        "ratio": v.ratio,
+                    },
+                }
         return [
             save_thresholds(
                 out / "thresholds.json", result.thresholds, joints=joints, calibration=cal

@@ -12,7 +12,10 @@ torque detected wherever the joint moves along the calibration motion is the lar
 contact threshold there, ``nu_j + k max_t sigma_j(t)`` (``nu`` the noise floor, ``sigma``
 the model's uncertainty propagated along the motion: :mod:`~dynid.observer.detection`), or
 the fixed threshold without the uncertainty; the standstill margin aside (a joint at rest:
-:func:`~dynid.observer.detection.undetected_at_rest`).
+:func:`~dynid.observer.detection.undetected_at_rest`). *The model behind them*: the
+thresholds hold the model's error on the calibration logs beside the sensors' noise, so
+the model is judged on those logs as ``dynid validate`` judges it
+(:class:`ModelCheck`, :func:`model_words`): a poor model makes wide thresholds.
 """
 
 from __future__ import annotations
@@ -23,10 +26,68 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..identification.verdict import Verdict
 from .events import detect
 from .thresholds import Thresholds
 
-__all__ = ["CalibrationCheck", "calibration_false_alarms", "detectable"]
+__all__ = [
+    "CalibrationCheck",
+    "ModelCheck",
+    "calibration_false_alarms",
+    "detectable",
+    "model_words",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class ModelCheck:
+    """The observer's model judged on the calibration logs as ``dynid validate`` judges a
+    model on a log (:func:`~dynid.workflows.validate.validate_files`: the error against the
+    noise floor of the sensors and of the states through the model, each joint against its
+    noise).
+
+    Attributes
+    ----------
+    verdict : Verdict
+        validate's verdict (:func:`~dynid.identification.verdict.judge_prediction`).
+    error_percent : float
+        The relative error of the model's torques with its friction on the logs [%].
+    floor_percent : float
+        The noise floor of the same torques [%].
+    """
+
+    verdict: Verdict
+    error_percent: float
+    floor_percent: float
+
+    def words(self) -> str:
+        """:func:`model_words` of this judgement."""
+        v = self.verdict
+        return model_words(self.error_percent, self.floor_percent, v.level, v.label, v.ratio)
+
+
+def model_words(
+    error_percent: float, floor_percent: float, level: str, label: str, ratio: float | None
+) -> str:
+    """``"the model predicts the calibration logs' torques to 3.21 %, 1.04 x the noise
+    floor of 3.09 % (validate's verdict: at the noise floor)"``, and for a poor or
+    unusable model that the thresholds are wide because of it: the sentence of a
+    :class:`ModelCheck` (``ratio``: the verdict's, each sample against its own noise)."""
+    said = f"the model predicts the calibration logs' torques to {error_percent:.3g} %"
+    if ratio is not None:
+        said += f", {ratio:.3g} x the noise floor of {floor_percent:.3g} %"
+    said += f" (validate's verdict: {label})"
+    if level in ("poor", "unusable"):
+        said += (
+            ": the thresholds are wide because of the model's error, not the sensors' "
+            "noise; a better model (dynid identify on these logs) narrows them"
+        )
+    elif level == "fair":
+        said += (
+            ": the thresholds hold the model's error beside the sensors' noise; a better "
+            "model narrows them"
+        )
+    return said
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -47,6 +108,8 @@ class CalibrationCheck:
         The smallest external torque detected wherever the joint moves [N m].
     peak : ndarray, shape (n,)
         The largest ``|r|`` of the calibration logs [N m].
+    model : ModelCheck or None
+        The model judged on the calibration logs (None: not judged).
     """
 
     duration_s: float
@@ -54,6 +117,7 @@ class CalibrationCheck:
     sigma_max: NDArray[np.float64] | None
     detectable: NDArray[np.float64]
     peak: NDArray[np.float64]
+    model: ModelCheck | None = None
 
     @property
     def false_alarms_per_min(self) -> float | None:

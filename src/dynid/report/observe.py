@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..identification.verdict import LEVELS
 from .html import esc, figure, href, is_number, number, section, table, verdict
 from .json_tables import json_section
 from .run import Answer, RunFiles
@@ -33,10 +34,31 @@ def _events(doc: Any) -> list | None:
     return None
 
 
+def _model_check(cal: dict) -> tuple[str, str] | None:
+    """The model behind the thresholds (``calibration.model_check``: judged on the
+    calibration logs as ``dynid validate`` judges it) as a fact (HTML) and its level, or
+    None where the file has none."""
+    m = cal.get("model_check")
+    v = m.get("verdict") if isinstance(m, dict) else None
+    if not (isinstance(m, dict) and isinstance(v, dict)):
+        return None
+    err, floor = m.get("relative_error_percent"), m.get("noise_floor_percent")
+    if not (is_number(err) and is_number(floor) and v.get("level") in LEVELS):
+        return None
+    from ..observer.calibration_check import model_words  # here: any run's page loads this
+
+    ratio = v.get("ratio")
+    said = model_words(
+        err, floor, v["level"], str(v.get("label", v["level"])), ratio if is_number(ratio) else None
+    )
+    return f"<b>Model</b>: {esc(said)}", str(v["level"])
+
+
 def _calibration(doc: Any) -> tuple[str, list[str]] | None:
     """Whether a calibrated observer is good enough, from ``thresholds.json``'s
     ``calibration``: the escaped headline (the logs, the false alarms the thresholds raise
-    on them and their rate per minute, the smallest detectable torque's range) and the
+    on them and their rate per minute, the smallest detectable torque's range), how well
+    the model behind them predicts the logs' torques (:func:`_model_check`) and the
     per-joint table (smallest torque detected while moving and at rest, the largest
     ``|r|`` read, the thresholds), or None when the file records no calibration."""
     cal = doc.get("calibration") if isinstance(doc, dict) else None
@@ -62,7 +84,8 @@ def _calibration(doc: Any) -> tuple[str, list[str]] | None:
     rest = cal.get("at_rest")
     if _numbers(rest):
         said += f", above {_span(rest)} N m on a joint at rest"
-    return esc(said + "."), [_joint_table(doc, cal)] if _numbers(moving) else []
+    facts = [m[0]] if (m := _model_check(cal)) is not None else []
+    return esc(said + "."), facts + ([_joint_table(doc, cal)] if _numbers(moving) else [])
 
 
 def _joint_table(doc: dict, cal: dict) -> str:
@@ -215,6 +238,9 @@ def answer(run: RunFiles) -> Answer | None:
     if events is None and calibrated is not None:  # a calibration judges no events
         head, facts = calibrated[0], list(calibrated[1])
         level, label = "info", "thresholds calibrated"
+        model = _model_check(run.docs[found["thresholds.json"] or ""]["calibration"])
+        if model is not None and model[1] in ("poor", "unusable"):  # wide: the model's
+            level, label = model[1], f"thresholds calibrated on a {model[1]} model"
     elif events is None:
         head, level = esc("The run wrote residuals; no events file to judge."), "fair"
     elif events:

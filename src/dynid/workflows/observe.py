@@ -68,10 +68,11 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
+from ..exceptions import DataError, DynidError, DynidWarning, OptionError, ShapeError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
+from ..identification.model import IdentifiedModel
 from ..identification.sanity import SPIKES_BEFORE_OBSERVER
 from ..io.columns import ColumnMap
 from ..io.drive_file import drive_of_robot_file, load_drive
@@ -82,7 +83,12 @@ from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
 from ..model.drive import Drive
 from ..model.robot import Robot
-from ..observer.calibration_check import CalibrationCheck, calibration_false_alarms, detectable
+from ..observer.calibration_check import (
+    CalibrationCheck,
+    ModelCheck,
+    calibration_false_alarms,
+    detectable,
+)
 from ..observer.detection import Thresholds, calibrate
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.gain_noise import GainNoiseTally
@@ -736,8 +742,59 @@ def _calibrated(
         tuple(logs),
         gain_noise=tally.result(),
         unmodelled=None if unmodelled is None else unmodelled.result(),
-        check=_checked(th, logs, sigma_max, r_max, counted),
+        check=dataclasses.replace(
+            _checked(th, logs, sigma_max, r_max, counted), model=_model_check(opts, model, read)
+        ),
     )
+
+
+@contextlib.contextmanager
+def _unsaid() -> Iterator[None]:
+    """Warnings and notes left unsaid: a second reading of the logs this run has read and
+    said its findings on."""
+    before = logging.root.manager.disable
+    logging.disable(NOTE)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynidWarning)
+            yield
+    finally:
+        logging.disable(before)
+
+
+def _model_check(opts: ObserveOptions, model: ObserverModel, read: Recorded) -> ModelCheck | None:
+    """The observer's model judged on the calibration logs ``read`` as ``dynid validate``
+    judges it (:func:`~dynid.workflows.validate.validate_files`, the model and friction
+    read as this run read them, the logs not read again; its warnings, this run's own
+    reading's, not said twice), or None where validate cannot judge it (a log too short
+    to filter)."""
+    from .validate import ValidateOptions, validate_files  # the calibration's alone
+
+    friction = "own" if opts.friction is None else opts.friction
+    options = ValidateOptions(
+        friction=friction,
+        columns=opts.columns,
+        drop_invalid=opts.drop_invalid,
+        max_gap_s=opts.max_gap,
+        drive=model.drive,
+        q_start=opts.q_start,
+    )
+    feasible = None
+    try:
+        with _unsaid():
+            if opts.model is not None:
+                judged: IdentifiedModel | Robot = load_model_json(opts.model)
+            else:
+                spec = str(opts.params)
+                judged = load_robot(
+                    spec, base=opts.base, tip=opts.tip, snap_angles=opts.snap_angles
+                )
+                feasible = spec if spec.lower().endswith(".json") else None
+            got = validate_files(judged, opts.data, options, feasible=feasible, recorded=read)
+    except DynidError:
+        return None
+    error = float(got.validation.errors.relative_error_percent)
+    return ModelCheck(got.verdict, error, float(got.noise_floor_percent))
 
 
 def _checked(

@@ -282,6 +282,7 @@ def validate_files(
     *,
     feasible: str | Path | None = None,
     label: str | None = None,
+    recorded: Recorded | None = None,
 ) -> ValidateResult:
     """Compare ``model``'s torques, without and with friction, with the recordings ``data``.
 
@@ -297,6 +298,9 @@ def validate_files(
         stored in it are the model's own.
     label : str, optional
         What the model is, for the record (default: its robot's name).
+    recorded : Recorded, optional
+        The recordings ``data`` already read and checked for this model (``dynid observe
+        --calibrate`` judging its model on its logs): not read again.
 
     Returns
     -------
@@ -317,7 +321,7 @@ def validate_files(
         held = load_feasible_drive(feasible)
         drive = same_drive(drive, held, Path(feasible).name, f"the one {Path(feasible).name} holds")
     placed = model.drive if drive is None and isinstance(model, IdentifiedModel) else drive
-    rec = read_recordings(
+    rec = recorded or read_recordings(
         data,
         robot,
         recorded=model.info.column_map if isinstance(model, IdentifiedModel) else None,
