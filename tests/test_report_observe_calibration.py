@@ -119,40 +119,46 @@ def test_the_smallest_detectable_torque_grows_with_the_largest_uncertainty():
 def test_the_calibration_judges_the_model_behind_the_thresholds(free, tmp_path, capsys):
     """The calibration says how well the model predicts the calibration log's torques,
     judged as dynid validate judges it: the true Panda (the simulation's own) at the noise
-    floor; the Panda with link 4's parameters 30 % too large not, in other words, with the
-    wider thresholds said to hold the model's error; in thresholds.json, the report's
-    first screen and the printed summary, the verdict the same as validate's."""
+    floor; the Panda with link 4's parameters 30 % too large usable, the thresholds said to
+    hold its error; twice too large poor, the thresholds said to be wide because of it and
+    the report's badge poor. In thresholds.json, the report's first screen and the printed
+    summary; the verdict is validate's on the same log."""
     from dynid.io.robot.toml import save_toml
 
     path, _ = free
     panda = dynid.panda()
-    phi = np.array(panda.phi)
-    phi[3] *= 1.3  # link 4: mass, first moments and inertia 30 % off
-    wrong = save_toml(tmp_path / "wrong.toml", panda.with_params(phi))
     said = {}
-    for name, params in (("true", "panda"), ("wrong", str(wrong))):
-        out = tmp_path / name
+    for name, factor in (("true", 1.0), ("30 %", 1.3), ("twice", 2.0)):
+        phi = np.array(panda.phi)
+        phi[3] *= factor  # link 4: mass, first moments and inertia
+        params = str(save_toml(tmp_path / f"{factor}.toml", panda.with_params(phi)))
+        out = tmp_path / f"cal{factor}"
         args = ["observe", "--params", params, "--data", str(path), "--calibrate"]
         capsys.readouterr()
         assert main([*args, "--no-figures", "--out", str(out)]) == 0
         printed = capsys.readouterr().out
         check = json.loads((out / "thresholds.json").read_text())["calibration"]["model_check"]
-        args = ["validate", "--params", params, "--data", str(path), "--no-figures", "-q"]
-        assert main([*args, "--out", str(tmp_path / f"val_{name}")]) == 0
-        val = json.loads((tmp_path / f"val_{name}" / "validation.json").read_text())
-        assert check["verdict"]["label"] == val["verdict"]["label"], (check, val["verdict"])
+        if factor == 2.0:  # the verdict is validate's
+            args = ["validate", "--params", params, "--data", str(path), "--no-figures", "-q"]
+            assert main([*args, "--out", str(tmp_path / "val")]) == 0
+            val = json.loads((tmp_path / "val" / "validation.json").read_text())
+            assert check["verdict"] == val["verdict"] | {"ratio": check["verdict"]["ratio"]}
         label = check["verdict"]["label"]
         err = check["relative_error_percent"]
         line = f"the model predicts the calibration logs' torques to {err:.3g} %"
         assert line in printed and f"(validate's verdict: {label})" in printed, printed
         page = (out / "report.html").read_text()
+        badge = re.search(r'<section class="verdict (\w+)" id="verdict">', page)[1]
         box = page[
             page.index('id="verdict"') : page.index("</section>", page.index('id="verdict"'))
         ]
         box = html.unescape(box)
         assert line in box and f"(validate's verdict: {label})" in box, box
-        said[name] = (check["verdict"]["level"], label, box)
-    assert said["true"][:2] == ("good", "at the noise floor")
-    assert said["wrong"][0] != "good" and said["wrong"][1] != said["true"][1]
-    assert "a better model narrows them" in said["wrong"][2]
+        said[name] = (check["verdict"]["level"], label, box, badge)
+    assert said["true"][:2] == ("good", "at the noise floor") and said["true"][3] == "info"
     assert "a better model" not in said["true"][2]
+    assert said["30 %"][:2] == ("fair", "usable") and said["30 %"][3] == "info"
+    assert "the thresholds hold the model's error" in said["30 %"][2]
+    assert said["twice"][:2] == ("poor", "poor") and said["twice"][3] == "poor"
+    assert "the thresholds are wide because of the model's error" in said["twice"][2]
+    assert "thresholds calibrated on a poor model" in said["twice"][2]
