@@ -83,10 +83,12 @@ def test_the_summary_marks_the_rotors_and_masses_the_prior_decides(with_rotors):
     prior splits it: marked ``*``. A rotor that is a base parameter of its own (the
     expression ``Ia3``) is not marked. Link 1's mass acts on nothing (it turns about a
     vertical axis through the base): named in the note. The line on the residual says the
-    held-out error decides."""
+    held-out error decides. Without a drive (joint-side torques, the armature term) the
+    line says armature (joint side), not rotor inertia at the motors (regression)."""
     r = with_rotors
     text = format_consistent(r)
-    line = next(x for x in text.splitlines() if x.startswith("rotor inertia at the motors"))
+    assert "rotor inertia at the motors" not in text, text
+    line = next(x for x in text.splitlines() if x.startswith("armature (joint side) [kg m^2]"))
     values = line.split(":")[1].split()
     own = {e.strip() for e in r.identified.base.expressions}
     assert values[0].endswith("*")

@@ -53,7 +53,7 @@ def test_urdf_export_of_smooth_friction_names_everything_it_leaves_out(tmp_path)
     )
     assert len(lines) == 1 and lines[0].startswith("URDF export: robot.urdf holds"), lines
     toml = "not written: a TOML export (--out robot.toml) would hold it exactly"
-    for said in ("tanh(dq / v_s)", "standstill band", "0.006 rad/s at joint 2", "offsets fo",
+    for said in ("tanh(dq / width)", "sign's width", "0.006 rad/s at joint 2", "offsets fo",
                  "-0.44 N m at joint 2", toml):  # fmt: skip
         assert said in lines[0], (said, lines[0])
     assert "feasible.json" not in lines[0]  # none was written or read
@@ -80,7 +80,7 @@ def test_a_narrow_smooth_law_is_said_once_not_as_an_approximation(tmp_path):
     path, lines = _warnings(
         export_urdf, tmp_path / "robot.urdf", _arm(), ExportOptions(friction=smooth)
     )
-    assert len(lines) == 1 and "tanh(dq / v_s)" in lines[0], lines
+    assert len(lines) == 1 and "tanh(dq / width)" in lines[0], lines
     assert "closest to the law over the velocity range" not in lines[0], lines[0]
     np.testing.assert_allclose(
         load_urdf(path).friction.as_array()[:, :2], np.column_stack([FV, FC]), atol=1e-6

@@ -311,3 +311,38 @@ def test_the_whole_torques_confirm_the_sign_of_joints_gravity_does_not_load():
             dataclasses.replace(g, tau=g.tau * np.where(np.arange(7) == j, -1, 1)) for g in logs
         ]
         assert not any(sign_confirmed(robot, [g])[j] for g in flipped), j
+
+
+def test_every_candidate_the_note_says_is_marked_x_is_in_the_table():
+    """Regression: identify's summary said "4 candidate(s) marked x skipped" while no row
+    was marked x: the table showed each smooth law's best width only, and the skipped
+    widths were among those left out. A selection of two widths of one smooth law, the
+    wider not dissipative and worse: its row is shown, marked x, beside the best."""
+    from dynid.cli.structure_table import selection_lines
+
+    def cand(name, heldout, skipped):
+        return {
+            "name": name,
+            "n_params": 57,
+            "train_error_percent": heldout - 0.2,
+            "heldout_error_percent": heldout,
+            "not_dissipative": ["fc1 < 0"] if skipped else None,
+        }
+
+    cands = [
+        cand("links + viscous + smooth:0.3", 2.0, False),
+        cand("links + viscous + smooth:1", 2.1, False),
+        cand("links + viscous + smooth:300", 3.6, True),
+    ]
+    sel = {
+        "candidates": cands,
+        "chosen": cands[0]["name"],
+        "validation": "blocks",
+        "rule": "lowest",
+        "notes": ["1 candidate(s) marked x skipped: their friction is not dissipative"],
+    }
+    lines = selection_lines(sel)
+    rows = {line[4:].split("  ")[0].strip(): line[2] for line in lines[2:] if line[2] in "*x "}
+    assert rows.get("links + viscous + smooth:300") == "x", lines
+    assert rows.get(cands[0]["name"]) == "*" and cands[1]["name"] not in rows, lines
+    assert any("1 more candidate(s)" in line for line in lines), lines

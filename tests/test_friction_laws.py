@@ -391,3 +391,43 @@ def test_a_quiet_joints_friction_counts_in_units_of_its_noise():
     score = {s.name: s for s in sel.scores}
     assert sel.chosen == "classical", sel.table()
     assert score["classical"].scaled_error_percent < 0.5 * score["none"].scaled_error_percent
+
+
+def test_a_smooth_laws_width_is_written_as_width_not_as_the_standstill_band(tmp_path):
+    """Regression: friction.json and feasible.json wrote the smooth law's tanh width
+    (0.00157 rad/s on a Panda's joint 1) as ``standstill_band (the velocity noise
+    band)``, while identify's summary called it the width and the band 0.00523. The
+    smooth laws now write ``width``, the classical law ``standstill_band``; a smooth file
+    of an earlier version (its width under ``standstill_band``) loads the same torques,
+    ``fc tanh(1)`` at ``dq = width``."""
+    from dynid.io.law_friction import law_friction, law_record
+
+    width = np.array([0.00157, 0.0021])
+    for name in ("smooth", "smooth_stribeck"):
+        law = LAWS[name]
+        P = np.array([[0.6, 0.8, 0.0], [0.5, 0.7, 0.1]])  # fv, fc, fo
+        if name == "smooth_stribeck":  # fv, fc, fs, vst, fo
+            P = np.array([[0.6, 0.8, 1.2, 0.1, 0.0], [0.5, 0.7, 0.7, 0.1, 0.1]])
+        model = law.model(P, width)
+        save_friction_json(tmp_path / f"{name}.json", model)
+        doc = json.loads((tmp_path / f"{name}.json").read_text())
+        assert doc["joints"][0]["width"] == width[0] and doc["units"]["width"] == "rad/s"
+        assert "standstill_band" not in doc["joints"][0] and "standstill_band" not in doc["units"]
+        assert "tanh(dq / width)" in doc["convention"], doc["convention"]
+        assert "standstill band of the velocity noise" in doc["convention"]
+        fc = P[0, 1]
+        back = load_friction_json(tmp_path / f"{name}.json")
+        dq = np.array([[width[0], 0.0]])
+        if name == "smooth":
+            np.testing.assert_allclose(back.torques(dq)[0, 0], 0.6 * width[0] + fc * np.tanh(1.0))
+        rec = law_record(model)
+        assert rec["width"] == list(width) and "standstill_band" not in rec
+        for j in doc["joints"]:  # an earlier version's file: the width as standstill_band
+            j["standstill_band"] = j.pop("width")
+        (tmp_path / "old.json").write_text(json.dumps(doc))
+        old = load_friction_json(tmp_path / "old.json")
+        np.testing.assert_array_equal(old.band, width)
+        rec["standstill_band"] = rec.pop("width")
+        np.testing.assert_array_equal(law_friction(rec, None, 2, "f", "k").band, width)
+    classical = LAWS["classical"].model([[0.5, 0.8, 0.0]], [0.005])
+    assert law_record(classical)["standstill_band"] == [0.005]

@@ -275,7 +275,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         v = held.verdict
         text.append(f"held-out verdict on {held.block}, every sample: {v.label}: {v.reason}")
     if result.consistent is not None:
-        files += save_feasible_bundle(args.out, result.consistent, source=str(args.data[0]))
+        sources = [str(p) for p in args.data]  # every recording fitted, not the first alone
+        files += save_feasible_bundle(args.out, result.consistent, sources=sources)
         files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)
         text += ["", format_consistent(result.consistent)]
     console.print(*text)

@@ -34,7 +34,11 @@ def selection_lines(selection: Any) -> list[str]:
     # the choice reads the held-out error with each joint in units of its own noise
     white = any(c.get("heldout_whitened_percent") is not None for c in selection["candidates"])
     cands = selection["candidates"]
-    shown, hidden = _best_of_shapes(cands, selection["chosen"])
+    # skipped (not dissipative within the velocity limits) unless every candidate is
+    skip = not all(c.get("not_dissipative") for c in cands)
+    # every candidate skipped is shown, marked x, as the selection's note says
+    marked = {str(c["name"]) for c in cands if skip and c.get("not_dissipative")}
+    shown, hidden = _best_of_shapes(cands, selection["chosen"], marked)
     # the column of the coefficients left out, when a row shown holds some
     left = any(d for c, (_, _, d) in zip(cands, split, strict=True) if c["name"] in shown)
     out = [
@@ -46,8 +50,6 @@ def selection_lines(selection: Any) -> list[str]:
         + f" {'se vs best':>10}"
         + ("  coefficients left out" if left else ""),
     ]
-    # skipped (not dissipative within the velocity limits) unless every candidate is
-    skip = not all(c.get("not_dissipative") for c in cands)
     for c, (name, _, dropped) in zip(cands, split, strict=True):
         if c["name"] not in shown:
             continue
@@ -61,12 +63,10 @@ def selection_lines(selection: Any) -> list[str]:
             + (f"  {_compact(dropped.split(' - '))}" if dropped and left else "")
         )
     if hidden:
-        x = sum(1 for c in cands if c["name"] not in shown and skip and c.get("not_dissipative"))
         out.append(
             f"  ({hidden} more candidate(s) of a smooth or Stribeck law at other widths or "
-            "Stribeck velocities"
-            + (f", {x} of them skipped as not dissipative" if x else "")
-            + ": the table shows each law's best; metadata.selection.candidates holds every one)"
+            "Stribeck velocities: the table shows each law's best and those skipped; "
+            "metadata.selection.candidates holds every one)"
         )
     per = selection.get("heldout_per_recording") or ()
     if per:
@@ -90,17 +90,20 @@ def _determined_line(kept: Sequence[dict[str, Any]]) -> list[str]:
     return [] if said is None else ["  " + said]
 
 
-def _best_of_shapes(cands: Sequence[dict[str, Any]], chosen: str) -> tuple[set[str], int]:
+def _best_of_shapes(
+    cands: Sequence[dict[str, Any]], chosen: str, marked: set[str]
+) -> tuple[set[str], int]:
     """The names of the candidates the table shows, and how many it leaves out: of the
     candidates that differ only in a shape (``smooth:0.3`` and ``smooth:1``,
     ``stribeck:0.05`` and ``stribeck:0.1``), the one with the lowest held-out error; every
-    other candidate, and the one chosen."""
+    other candidate, the one chosen, and those ``marked`` (skipped: the note that says
+    why names them as marked x)."""
     best: dict[str, dict[str, Any]] = {}
     for c in cands:
         family = re.sub(r"(smooth|stribeck):[0-9.eE+-]+", r"\1:*", str(c["name"]))
         if family not in best or c["heldout_error_percent"] < best[family]["heldout_error_percent"]:
             best[family] = c
-    shown = {str(c["name"]) for c in best.values()} | {chosen}
+    shown = {str(c["name"]) for c in best.values()} | {chosen} | marked
     return shown, sum(1 for c in cands if c["name"] not in shown)
 
 

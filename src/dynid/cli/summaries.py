@@ -677,15 +677,19 @@ def format_consistent(result: ConsistentResult) -> str:
 def _determined_lines(r: FeasibleResult) -> list[str]:
     """What the identified coefficients hold (``N link base parameters + K rotor inertias
     (armatures)``), the rotor inertias retrieved with those the data do not give alone
-    marked ``*`` (taken from the prior), and the link masses the data do not excite."""
+    marked ``*`` (taken from the prior), and the link masses the data do not excite; at the
+    motors with a drive, the armature at the joints without one (joint-side torques)."""
     det = r.determined
     out = [] if det is None else [f"coefficients: {det.counts()}"]
     src = None if det is None else det.rotor_source
     if r.rotor_inertia is not None:
         ia = np.asarray(r.rotor_inertia)
         marked = [s in (SUM, PRIOR) for s in src] if src and len(src) == ia.size else []
+        d = r.drive  # a direct drive (K = 1, joint-side torques): the armature term's
+        bare = d is None or (d.is_identity and np.array_equal(d.transmission, np.eye(d.n)))
+        where = "armature (joint side)" if bare else "rotor inertia at the motors"
         out.append(
-            "rotor inertia at the motors [kg m^2] (>= 0): "
+            f"{where} [kg m^2] (>= 0): "
             + " ".join(f"{x:.4g}" + ("*" if marked and marked[m] else "") for m, x in enumerate(ia))
         )
         if any(marked):

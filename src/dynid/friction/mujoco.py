@@ -352,7 +352,7 @@ def unheld_friction(
     """What per-joint viscous and sharp Coulomb friction (MJCF ``damping`` and
     ``frictionloss``, URDF ``<dynamics damping friction>``) cannot hold of a friction
     model beyond the law's own losses (:func:`joint_coulomb_viscous`'s ``notes``), one
-    line each: the smooth law's ``tanh(dq / v_s)`` rounding, a standstill band, the
+    line each: the smooth law's ``tanh(dq / width)`` rounding, a standstill band, the
     offsets ``fo`` [N m], and that the friction acts at the motors (written reflected to
     the joints). Empty when the coefficients hold the model exactly. ``offset_held`` (n,):
     the joints whose offset the file holds otherwise (a joint spring's reference, MJCF's
@@ -369,9 +369,9 @@ def unheld_friction(
             j = int(np.argmax(band))
             if p.kind in ("smooth", "smooth_stribeck"):
                 notes.append(
-                    f"the {p.kind} law's rounding fc tanh(dq / v_s){where} over its standstill "
-                    f"band (v_s up to {band[j]:.3g} rad/s at {what} {j + 1}; written as plain "
-                    "Coulomb friction)"
+                    f"the {p.kind} law's rounding fc tanh(dq / width){where} (the smooth "
+                    f"sign's width up to {band[j]:.3g} rad/s at {what} {j + 1}; written as "
+                    "plain Coulomb friction)"
                 )
             else:
                 notes.append(

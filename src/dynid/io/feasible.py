@@ -14,7 +14,7 @@ and was not on a torque log; the friction identified with the links in ``linear_
      "links": [{"name": "link1", "mass": 4.97, "com": [...], "inertia": [...]}, ...],
      "friction": null | {"model": "sigmoid", "phi1": [...], "phi2": [...], "phi3": [...]},
      "linear_friction": null | {"model": "classical", "fv": [...], "fc": [...], "fo": [...],
-         "standstill_band": [...]},
+         "standstill_band": [...]} (a smooth law's "width": [...], its tanh's),
      "joint_friction": {"model": "classical", "fv": [...], ...} (with friction at the motors
          and at the joints of a coupled drive: the part at the joints),
      "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},

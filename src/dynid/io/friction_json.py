@@ -14,7 +14,10 @@
 ``smooth``, ``asymmetric``, ``stribeck``, ``sigmoid``) and each joint holds that law's
 parameters (``fv``, ``fc``, ``fo`` for the classical law, ...). ``standstill_band``
 [rad/s] per joint is the velocity band inside which Coulomb friction is off (files
-without it, as those of earlier versions: 0, the plain ``sign(dq)``). ``rms_before``/
+without it, as those of earlier versions: 0, the plain ``sign(dq)``); a smooth law
+(``smooth``, ``smooth_stribeck``) writes ``width`` instead, the width of its
+``tanh(dq / width)`` (a multiple of the standstill band; files of earlier versions wrote
+it as ``standstill_band``, which is read as the width). ``rms_before``/
 ``rms_after`` and ``identified`` (false: the joint never moved beyond its velocity noise
 band, its parameters are zero) are written when a
 :class:`~dynid.friction.fit.FrictionFit` is saved and are optional on reading;
@@ -118,11 +121,11 @@ def _law_doc(model: FrictionModel) -> dict[str, Any]:
     for j in range(model.n):
         d: dict[str, float | bool] = {k: float(P[j, i]) for i, k in enumerate(model.names)}
         if band is not None:
-            d["standstill_band"] = float(band[j])
+            d[law.band_key] = float(band[j])
         joints.append(d)
     units = dict(zip(law.params, law.units, strict=True))
     if band is not None:
-        units["standstill_band"] = "rad/s"
+        units[law.band_key] = "rad/s"
     return {
         "model": model.kind,
         "at": "motor" if model.at_motors else "joint",
@@ -188,8 +191,11 @@ def _law_from(doc: dict[str, Any], kind: str, source: str) -> FrictionModel:
     P = np.zeros((len(joints), len(law.params)))
     for j, d in enumerate(joints):
         P[j] = [d[k] for k in law.params]
-    # no standstill_band: files of earlier versions, the plain sign(dq)
-    band = np.array([d.get("standstill_band", 0.0) for d in joints], dtype=float)
+    # no band: files of earlier versions, the plain sign(dq); a smooth law's width under
+    # standstill_band: files of earlier versions
+    band = np.array(
+        [d.get(law.band_key, d.get("standstill_band", 0.0)) for d in joints], dtype=float
+    )
     try:
         return law.model(P, band)
     except DynidError as exc:
@@ -207,7 +213,8 @@ def _law_fields(kind: str) -> dict[str, Field]:
         p: Field("number", required=True, unit=u)
         for p, u in zip(law.params, law.units, strict=True)
     }
-    return joint | {"standstill_band": Field("number", low=0.0, unit="rad/s")}
+    band = Field("number", low=0.0, unit="rad/s")
+    return joint | {law.band_key: band, "standstill_band": band}  # the latter: earlier files
 
 
 def _part_record(kind: str) -> Record:

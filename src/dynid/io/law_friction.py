@@ -3,8 +3,10 @@
 One record per friction: ``{"model": law, <param>: [one per joint], ...,
 "standstill_band": [one per joint]}`` with the law's parameters by name (units of the law,
 :mod:`dynid.friction.laws`: ``fv`` [N m s/rad], ``fc`` [N m], ``fo`` [N m], ...) and the
-standstill band [rad/s] of a law that has one (the sign's dead zone of Coulomb friction,
-the smooth law's width ``v_s``; written only when not all zero, 0 when absent). Where it
+band [rad/s] of a law that has one: ``standstill_band``, the sign's dead zone of Coulomb
+friction (the standstill band of the velocity noise), or for a smooth law ``width``, its
+``tanh(dq / width)``'s width (a multiple of that band; read under ``standstill_band`` from
+files of earlier versions); written only when not all zero, 0 when absent. Where it
 acts (the joints, or the motors of the drive held beside it) is said by the file holding
 the record, not by the record.
 """
@@ -33,7 +35,7 @@ def law_record(friction: Friction) -> dict[str, Any]:
     cols = {k: [float(x) for x in friction.params[:, j]] for j, k in enumerate(friction.names)}
     rec: dict[str, Any] = {"model": friction.kind} | cols
     if friction.law.standstill and np.any(friction.band > 0):
-        rec["standstill_band"] = [float(x) for x in friction.band]
+        rec[friction.law.band_key] = [float(x) for x in friction.band]
     return rec
 
 
@@ -53,8 +55,9 @@ def law_friction(
     if law is None:
         raise fault(source, f"{key}.model", f"expected one of {', '.join(LAWS)}")
     cols = []
-    for name in (*law.params, "standstill_band"):
-        v = rec.get(name, [0.0] * n if name == "standstill_band" else None)
+    band = law.band_key if law.band_key in rec else "standstill_band"  # earlier files
+    for name in (*law.params, band):
+        v = rec.get(name, [0.0] * n if name == band else None)
         if not isinstance(v, list) or len(v) != n or not all(_finite(x) for x in v):
             want = f"{n} numbers (one per joint) for the {law.name} law's {name}"
             raise fault(source, f"{key}.{name}", f"expected {want}; got {_checks.short(v)}")

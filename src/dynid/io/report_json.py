@@ -72,7 +72,10 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
         ``seed``, ``notes``, ``total_mass`` [kg], ``bounds`` (a bounds file's content) and
         ``units``; then the method's own
         (:meth:`~dynid.feasibility.result.FeasibleResult.report_fields`), their numbers that
-        may have no value written None."""
+        may have no value written None. A convex fit's ``weight_search`` is the search
+        that chose its weight, and ``weight_search_on`` says on what: ``"heldout"``
+        (``[w, held-out error %]``, as ``heldout.weight_search``; the convex search on the
+        training data is then not run) or ``"training"`` (``[w, residual_ratio]``)."""
     rep = result.report
     fr = result.friction
     d: dict[str, Any] = {
@@ -99,6 +102,11 @@ def report_to_dict(result: FeasibleResult) -> dict[str, Any]:
     nullable = result.nullable_fields
     d |= {k: finite_or_none(v) if k in nullable else v for k, v in result.report_fields().items()}
     d["units"] = _UNITS | dict(result.field_units)
+    if "weight_search" in d:  # the convex method's: the search that chose the weight
+        held = d["heldout"]["weight_search"] if d["heldout"] is not None else []
+        on = "heldout" if held and not d["weight_search"] else "training"
+        d["weight_search"] = held if on == "heldout" else d["weight_search"]
+        d["weight_search_on"] = on
     return d
 
 

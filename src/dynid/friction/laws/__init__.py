@@ -5,15 +5,16 @@ name                 law                                                        
 ===================  ==========================================================  ===============
 ``none``             ``0`` (no extra friction)                                   none
 ``classical``        ``fv dq + fc s(dq) + fo`` (Gaz et al. 2019, eq. 24)         bounded linear
-``smooth``           ``fv dq + fc tanh(dq / v_s) + fo``, ``v_s`` the noise band  bounded linear
+``smooth``           ``fv dq + fc tanh(dq / w) + fo``, ``w`` the sign's width    bounded linear
 ``quadratic``        ``fv dq + fq dq |dq| + fc s(dq) + fo``                      bounded linear
 ``asymmetric``       ``fv+ dq+ + fv- dq- + fc+ [s > 0] - fc- [s < 0]``           bounded linear
 ``stribeck``         ``fv dq + (fc + (fs - fc) exp(-(dq/vst)^2)) s(dq) + fo``    var. projection
-``smooth_stribeck``  the same with ``tanh(dq / v_s)`` for ``s(dq)``              var. projection
+``smooth_stribeck``  the same with ``tanh(dq / w)`` for ``s(dq)``                var. projection
 ``sigmoid``          Gaz et al. 2019, eq. 25                                     Nelder-Mead
 ===================  ==========================================================  ===============
 
-``s(dq)`` is the sign outside the standstill band (:mod:`dynid.friction.laws.base`). The
+``s(dq)`` is the sign outside the standstill band (:mod:`dynid.friction.laws.base`); ``w``
+the smooth sign's width, a multiple of that band (``width`` in files). The
 registry gives ``--friction-model``'s choices, ``friction.json``'s ``model`` values, the
 candidates of the selection (:mod:`dynid.friction.select`) and the MuJoCo mapping. Adding
 a law: a module here defining ``LAW`` (a :class:`~dynid.friction.laws.base.FrictionLaw`,

@@ -128,6 +128,12 @@ class FrictionLaw:
     standstill : bool
         Whether the law has a standstill band (the sigmoid, smooth and zero at rest, has
         none: its band is always zero and ``friction.json`` writes none).
+    band_key : str
+        The name of the law's band in files (``friction.json``, ``feasible.json``, the robot
+        TOML): ``standstill_band`` where the sign is off inside the band (the standstill
+        band of the velocity noise), ``width`` where the sign is ``tanh(dq / width)`` (the
+        smooth sign's width, a multiple of that standstill band: ``identify``'s summary
+        gives both, ``band`` and ``width``).
     compared : bool
         Whether ``dynid friction`` compares it by default
         (:func:`~dynid.friction.select.select_friction`); a law it fits at a width it
@@ -146,6 +152,7 @@ class FrictionLaw:
     canonical: Canonical | None = field(repr=False, default=None)
     standstill: bool = True
     compared: bool = True
+    band_key: str = "standstill_band"
 
     def model(
         self, params: ArrayLike, band: ArrayLike | None = None, drive: Drive | None = None

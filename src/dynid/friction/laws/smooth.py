@@ -15,6 +15,8 @@ the noise. Linear in ``fv`` [N m s/rad] ``>= 0``,
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -44,14 +46,18 @@ def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.
     )  # fmt: skip
 
 
-LAW = linear_law(
-    "smooth",
-    ("fv", "fc", "fo"),
-    ("N m s/rad", "N m", "N m"),
-    "tau_f = fv dq + fc tanh(dq / v_s) + fo, v_s = standstill_band (the velocity noise band)",
-    columns,
-    (0.0, 0.0, -np.inf),
-    (np.inf, np.inf, np.inf),
-    _mjcf,
-    _canonical,
+LAW = replace(
+    linear_law(
+        "smooth",
+        ("fv", "fc", "fo"),
+        ("N m s/rad", "N m", "N m"),
+        "tau_f = fv dq + fc tanh(dq / width) + fo, width: the smooth sign's width (a multiple of "
+        "the standstill band of the velocity noise)",
+        columns,
+        (0.0, 0.0, -np.inf),
+        (np.inf, np.inf, np.inf),
+        _mjcf,
+        _canonical,
+    ),
+    band_key="width",
 )

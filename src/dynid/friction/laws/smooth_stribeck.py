@@ -18,6 +18,8 @@ merely reshapes a ``tanh`` wider than the noise).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -43,7 +45,9 @@ def _canonical(P: NDArray[np.float64], band: NDArray[np.float64]) -> NDArray[np.
 LAW = stribeck_law(
     "smooth_stribeck",
     smooth_sign,
-    "s(dq) = tanh(dq / v_s), v_s = standstill_band (the velocity noise band)",
+    "s(dq) = tanh(dq / width), width: the smooth sign's width (a multiple of the standstill "
+    "band of the velocity noise)",
     _canonical,
     compared=False,
 )
+LAW = replace(LAW, band_key="width")

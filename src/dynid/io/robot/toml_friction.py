@@ -11,7 +11,7 @@ joint (:mod:`dynid.io.law_friction`)::
     fv = [0.5, ...]         # N m s/rad
     fc = [0.8, ...]         # N m
     fo = [0.0, ...]         # N m
-    standstill_band = [...] # rad/s, optional
+    standstill_band = [...] # rad/s, optional (width = [...] for a smooth law's tanh)
 
 The place written is the one every command uses, whatever drive the torques are read
 through (the description's ``[drive]`` or another one given with the robot): the friction
@@ -64,7 +64,7 @@ def friction_tables(friction: Friction | FrictionSum | None) -> str:
         rec = law_record(part)
         lines = [f"[{key}]", f'model = "{rec.pop("model")}"', f'at = "{at}"']
         units = dict(zip(part.law.params, part.law.units, strict=True))
-        units["standstill_band"] = "rad/s"
+        units[part.law.band_key] = "rad/s"
         lines += [
             f"{k} = [{', '.join(repr(float(x)) for x in v)}]  # {units[k]}" for k, v in rec.items()
         ]
