@@ -474,7 +474,7 @@ def prepare_recordings(
     if len(names) != len(logs):
         raise ShapeError(f"{len(names)} names for {len(logs)} recordings")
     _check_cutoff(names, logs, cutoff_hz)
-    # a motor-side log: its motors turn (a joint-side one: joints whose limits span a turn)
+    # a motor-side log: its motors turn (a joint-side one: its revolute joints)
     turns = wrappable(robot, drive)
     pieces: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
@@ -496,7 +496,8 @@ def prepare_recordings(
         turned.update(joints)
         if joints:
             motors = drive is not None and drive.side == "motor"
-            wrapped.setdefault(wrapped_finding(joints, motors), []).append(name)
+            said = wrapped_finding(joints, motors, robot=robot, log=log)
+            wrapped.setdefault(said, []).append(name)
         cuts.append(max(0, len(mine) - 1))
         gaps.append(gaps_between(mine))
         pieces += [(r, p) for p in mine]
