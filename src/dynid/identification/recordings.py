@@ -475,7 +475,7 @@ def prepare_recordings(
         raise ShapeError(f"{len(names)} names for {len(logs)} recordings")
     _check_cutoff(names, logs, cutoff_hz)
     # a motor-side log: its motors turn (a joint-side one: its revolute joints)
-    turns = wrappable(robot, drive)
+    turns, motors = wrappable(robot, drive), drive is not None and drive.side == "motor"
     pieces: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
     cuts: list[int] = []
@@ -494,8 +494,7 @@ def prepare_recordings(
             name, log, turns, max_gap_s, robot=robot, drive=drive, say_wrapped=False
         )
         turned.update(joints)
-        if joints:
-            motors = drive is not None and drive.side == "motor"
+        if joints:  # the joints named with their limits (a motor-side log: the motors)
             said = wrapped_finding(joints, motors, robot=robot, log=log)
             wrapped.setdefault(said, []).append(name)
         cuts.append(max(0, len(mine) - 1))

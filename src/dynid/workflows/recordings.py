@@ -12,7 +12,11 @@ line naming the file, never a recording dropped silently:
   an error naming the file and ``--units t=ms``;
 * a recording in other units than the others (its torques, or its velocities against the
   derivative of its positions on the joints that move, a power of ten away from the other
-  recordings'): an error naming it (a recording at rest has no velocity ratio to compare);
+  recordings'): an error naming it (a recording at rest, or without velocity columns, has
+  no velocity ratio to compare);
+
+Every check reads the recordings with their joints recorded wrapped into ``[-pi, pi]``
+unwrapped by the preparation's rule (:func:`unwrapped_recorded`), not a whole turn's jump.
 * a recording in degrees among recordings in radians (positions and velocities both in
   degrees pass the check above): an error naming it and the columns to convert
   (:mod:`~dynid.identification.unit_mix`);
