@@ -20,6 +20,7 @@ import dynid
 from dynid.exceptions import DataError, DynidWarning, OptionError
 from dynid.friction.recordings import prepare_pieces
 from dynid.identification.log import TorqueLog
+from dynid.identification.pieces import turn_limited
 from dynid.identification.recordings import (
     prepare_recordings,
     recording_pieces,
@@ -61,13 +62,14 @@ def _wrap(log, joints):
     return TorqueLog(log.t, q, log.dq, log.tau)
 
 
-def test_only_joints_whose_limits_span_a_turn_can_wrap(panda):
-    """The Panda's joints span less than a turn: none can wrap; continuous joints can;
-    a motor-side log's motor of a 50:1 gear turns over joint limits of 0.2 rad (10 rad),
-    a 20:1 one does not (4 rad); an identity drive is the joint side."""
-    assert not np.any(wrappable(panda))
+def test_every_revolute_joint_can_be_recorded_wrapped(panda):
+    """Joint side, every revolute joint's log can hold a wrap (the Panda's limits span less
+    than a turn: those are turn_limited, named when wrapped); a motor-side log's motor of
+    a 50:1 gear turns over joint limits of 0.2 rad (10 rad), a 20:1 one does not (4 rad);
+    an identity drive is the joint side."""
+    assert np.all(wrappable(panda)) and np.all(turn_limited(panda))
     arm = _continuous(panda, [0, 6])
-    np.testing.assert_array_equal(wrappable(arm), np.arange(7) % 6 == 0)
+    np.testing.assert_array_equal(turn_limited(arm), np.arange(7) % 6 != 0)
     np.testing.assert_array_equal(wrappable(arm, Drive.identity(7)), wrappable(arm))
     narrow = dataclasses.replace(
         panda, q_min=np.full(7, -0.1), q_max=np.full(7, 0.1), q_neutral=np.zeros(7)

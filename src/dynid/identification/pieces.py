@@ -2,8 +2,10 @@
 
 * :func:`split_at_gaps`: the pieces between the gaps longer than ``max_gap_s``;
 * :func:`wrappable`: the recorded position columns that can hold a wrap into
-  ``[-pi, pi]`` (joints whose limits span a turn; a motor-side log's motors);
-* :func:`unwrapped`: the wraps of a piece taken out;
+  ``[-pi, pi]`` (revolute joints; a motor-side log's motors that turn a whole turn);
+  :func:`turn_limited`: the joints whose limits do not allow the whole turn a wrap needs;
+* :func:`unwrapped`: the wraps of a piece taken out; :func:`unwrapped_log`: a whole
+  recording's, piece by piece, for the checks across recordings;
 * :func:`start_turns`: the whole turns a motor recorded wrapped had at a piece's start,
   from the joints' limits (refused when they leave several), or, at the log's first
   sample, the turns that put the joints nearest the positions given there (``--q-start``);
@@ -30,7 +32,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .log import TorqueLog, default_max_gap
+from .log import DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap, with_derived_velocities
 from .sanity import time_unit_finding, too_few_samples
 
 __all__ = [
@@ -48,6 +50,8 @@ __all__ = [
     "start_turns",
     "unwrapped",
     "with_start_turns",
+    "turn_limited",
+    "unwrapped_log",
     "wrappable",
 ]
 
@@ -118,19 +122,29 @@ def wrappable(robot: Robot, drive: Drive | None = None) -> NDArray[np.bool_]:
     """The recorded position columns that can hold a wrap into ``[-pi, pi]``.
 
     Without a drive, or with one whose log is joint side (an identity drive, the armature
-    of ``rotor_inertia = "identify"`` included): the revolute joints whose limits span at
-    least a whole turn (unbounded ones included); a joint whose limits span less cannot
-    wrap. On a motor-side log: the motors whose angle spans at least a turn over the
-    joints' limits (``|K| (q_max - q_min)``, ``K`` the transmission; any unbounded joint
-    they drive included), prismatic joints' motors too (a ball screw turns).
+    of ``rotor_inertia = "identify"`` included): every revolute joint. A joint whose
+    limits span less than a turn (:func:`turn_limited`) cannot wrap as described, but a
+    log of it can (its description's limits narrower than the arm's, or an encoder read
+    modulo a turn): its jumps of a whole turn are a wrap, not degrees, and
+    :func:`wrapped_finding` says the limits do not allow them. On a motor-side log: the
+    motors whose angle spans at least a turn over the joints' limits (``|K| (q_max -
+    q_min)``, ``K`` the transmission; any unbounded joint they drive included), prismatic
+    joints' motors too (a ball screw turns).
     """
     span = np.asarray(robot.q_max, dtype=np.float64) - np.asarray(robot.q_min, dtype=np.float64)
     turn = 2 * np.pi * (1.0 - 1e-9)
     if drive is None or drive.side == "joint":
-        return ~np.asarray(robot.prismatic, dtype=bool) & (span >= turn)
+        return ~np.asarray(robot.prismatic, dtype=bool)
     K = np.abs(np.asarray(drive.transmission, dtype=np.float64))
     motor = np.array([float(np.sum(span[row > 0] * row[row > 0])) for row in K])
     return np.asarray(motor >= turn, dtype=bool)
+
+
+def turn_limited(robot: Robot) -> NDArray[np.bool_]:
+    """The revolute joints whose limits span less than a whole turn (n,): recorded
+    wrapped, they moved where their description does not let them."""
+    span = np.asarray(robot.q_max, dtype=np.float64) - np.asarray(robot.q_min, dtype=np.float64)
+    return ~np.asarray(robot.prismatic, dtype=bool) & (span < 2 * np.pi * (1.0 - 1e-9))
 
 
 def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, tuple[int, ...]]:
@@ -233,12 +247,7 @@ def recording_pieces(
         ``max_gap_s`` below the sample step.
     """
     check_samples_and_time(name, log)
-    pieces: list[TorqueLog] = []
-    turned: set[int] = set()
-    for piece in split_at_gaps(log, max_gap_s, name):
-        piece, joints = unwrapped(piece, turns)
-        turned.update(joints)
-        pieces.append(piece)
+    pieces, turned = _unwrapped_pieces(name, log, turns, max_gap_s)
     motors = drive is not None and drive.side == "motor"
     if turned and motors and robot is not None:
         assert drive is not None
@@ -255,19 +264,108 @@ def recording_pieces(
         )
     joints = tuple(sorted(turned))
     if joints and say_wrapped:
-        warnings.warn(f"{name}: {wrapped_finding(joints, motors)}", DynidWarning, stacklevel)
+        said = wrapped_finding(joints, motors, robot=None if motors else robot, log=log)
+        warnings.warn(f"{name}: {said}", DynidWarning, stacklevel)
     return pieces, joints
 
 
-def wrapped_finding(joints: Sequence[int], motors: bool = False) -> str:
+def _unwrapped_pieces(
+    name: str, log: TorqueLog, turns: NDArray[np.bool_], max_gap_s: float | None
+) -> tuple[list[TorqueLog], set[int]]:
+    """The pieces of ``log`` (:func:`split_at_gaps`), each unwrapped on its own
+    (:func:`unwrapped`), and the columns unwrapped in some piece.
+
+    Velocities the reader derived from the positions (``dq_derived``) were derived over
+    the wrapped ones: a whole turn's jump spread by the filter over many samples. When
+    some column was unwrapped they are derived again as the reader did, over the whole
+    log at its cut-off, from the unwrapped positions (each piece after a gap shifted by
+    the whole turns nearest the sample before it, as a log unwrapped by hand): every step
+    reads the motion, not the jump, and the same velocities as from that log."""
+    pieces: list[TorqueLog] = []
+    turned: set[int] = set()
+    for piece in split_at_gaps(log, max_gap_s, name):
+        piece, joints = unwrapped(piece, turns)
+        turned.update(joints)
+        pieces.append(piece)
+    if not turned or not log.dq_derived:
+        return pieces, turned
+    cols = sorted(turned)
+    q = np.array(log.q)
+    at = np.searchsorted(log.t, [p.t[0] for p in pieces])
+    for start, piece in zip(at, pieces, strict=True):
+        q[start : start + piece.n_samples, cols] = piece.q[:, cols]
+    step = np.diff(q[:, cols], axis=0)  # the turns left at the gaps (and isolated samples)
+    q[1:, cols] -= 2 * np.pi * np.cumsum(np.round(step / (2 * np.pi)), axis=0)
+    dq = with_derived_velocities(TorqueLog(log.t, q, log.dq, log.tau), DEFAULT_CUTOFF_HZ).dq
+    return [
+        TorqueLog(p.t, p.q, dq[k : k + p.n_samples], p.tau, p.ddq, p.cleaning, p.dq_derived)
+        for k, p in zip(at, pieces, strict=True)
+    ], turned
+
+
+def unwrapped_log(
+    name: str, log: TorqueLog, turns: NDArray[np.bool_], max_gap_s: float | None = None
+) -> tuple[TorqueLog, tuple[int, ...]]:
+    """``log`` with its columns ``turns`` (:func:`wrappable`) recorded wrapped unwrapped
+    piece by piece, by the rule :func:`recording_pieces` applies (the pieces joined
+    again, samples isolated between gaps left out), for the checks that read a whole
+    recording before it is prepared, and the columns unwrapped (0-based); velocities
+    derived from the positions derived again from the unwrapped ones, as there. ``log``
+    itself when nothing was wrapped. Warns of nothing: the preparation says it.
+
+    Raises
+    ------
+    OptionError
+        ``max_gap_s`` below the sample step.
+    """
+    if log.n_samples < 3:
+        return log, ()
+    pieces, turned = _unwrapped_pieces(name, log, turns, max_gap_s)
+    if not turned:
+        return log, ()
+    out = TorqueLog(
+        np.concatenate([p.t for p in pieces]),
+        np.concatenate([p.q for p in pieces]),
+        np.concatenate([p.dq for p in pieces]),
+        np.concatenate([p.tau for p in pieces]),
+        None if log.ddq is None else np.concatenate([p.ddq for p in pieces if p.ddq is not None]),
+        log.cleaning,
+        log.dq_derived,
+    )
+    return out, tuple(sorted(turned))
+
+
+def wrapped_finding(
+    joints: Sequence[int],
+    motors: bool = False,
+    *,
+    robot: Robot | None = None,
+    log: TorqueLog | None = None,
+) -> str:
     """The finding of the joints (0-based; ``motors``: the motors) recorded wrapped into
     ``[-pi, pi]`` and unwrapped, without the file's name (:func:`recording_pieces` says it
-    per recording; several recordings say it once, naming them)."""
+    per recording; several recordings say it once, naming them). Given the ``robot`` and
+    the joint-side ``log`` as recorded, a joint whose limits span less than a turn
+    (:func:`turn_limited`) is named with the times [s] of its jumps and its limits, which
+    do not allow that motion: the log or the description is wrong (not degrees)."""
     what = "motor(s)" if motors else "joint(s)"
-    return (
+    said = (
         f"{what} {', '.join(str(j + 1) for j in joints)} recorded wrapped into [-pi, pi] "
         "(jumps of a whole turn): unwrapped"
     )
+    if robot is None or log is None or motors:
+        return said
+    limited = turn_limited(robot)
+    for j in (j for j in joints if limited[j]):
+        at = log.t[1:][np.abs(np.diff(log.q[:, j])) > np.pi]
+        times = ", ".join(f"{x:.4g}" for x in at[:5]) + (", ..." if at.size > 5 else "")
+        said += (
+            f"; {robot.joint_names[j]} jumps a whole turn at t = {times} s, but its limits "
+            f"[{robot.q_min[j]:.4g}, {robot.q_max[j]:.4g}] do not allow a whole turn: "
+            "unwrapped as a continuous joint; the log or the robot description is wrong "
+            "(not degrees: those would be 57 times the radians)"
+        )
+    return said
 
 
 def start_turns(

@@ -474,8 +474,8 @@ def prepare_recordings(
     if len(names) != len(logs):
         raise ShapeError(f"{len(names)} names for {len(logs)} recordings")
     _check_cutoff(names, logs, cutoff_hz)
-    # a motor-side log: its motors turn (a joint-side one: joints whose limits span a turn)
-    turns = wrappable(robot, drive)
+    # a motor-side log: its motors turn (a joint-side one: its revolute joints)
+    turns, motors = wrappable(robot, drive), drive is not None and drive.side == "motor"
     pieces: list[tuple[int, TorqueLog]] = []
     turned: set[int] = set()
     cuts: list[int] = []
@@ -494,9 +494,9 @@ def prepare_recordings(
             name, log, turns, max_gap_s, robot=robot, drive=drive, say_wrapped=False
         )
         turned.update(joints)
-        if joints:
-            motors = drive is not None and drive.side == "motor"
-            wrapped.setdefault(wrapped_finding(joints, motors), []).append(name)
+        if joints:  # the joints named with their limits (a motor-side log: the motors)
+            said = wrapped_finding(joints, motors, robot=robot, log=log)
+            wrapped.setdefault(said, []).append(name)
         cuts.append(max(0, len(mine) - 1))
         gaps.append(gaps_between(mine))
         pieces += [(r, p) for p in mine]

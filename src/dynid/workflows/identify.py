@@ -81,6 +81,7 @@ from .recordings import (
     check_torque_unit,
     check_units,
     given_start,
+    unwrapped_recorded,
 )
 
 __all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
@@ -481,9 +482,10 @@ def _read_logs(
     if heldout is not None and opt.validate_on is not None:
         held.append((heldout, Path(opt.validate_on)))
     rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
+    check_derived_velocities(rec, cmap)
+    rec = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
     check_limits(rec, robot)
     check_units(rec)
-    check_derived_velocities(rec, cmap)
     check_signs(rec.select(slice(len(logs), None)), robot)  # the held-out log's
     check_torque_unit(rec, robot, cmap)
     return logs

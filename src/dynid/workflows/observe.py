@@ -126,6 +126,7 @@ from .recordings import (
     check_units,
     despiked_recordings,
     given_start,
+    unwrapped_recorded,
 )
 
 __all__ = [
@@ -627,12 +628,15 @@ def _read_logs(
     names = [Path(p).name for p in paths]
     logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
     read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
-    check_limits(read, model.robot)
-    check_units(read)
+    checked = unwrapped_recorded(read, model.robot, opts.max_gap)  # as prepared_log reads
+    check_limits(checked, model.robot)
+    check_units(checked)
     check_derived_velocities(read, cmap)
     # detection logs hold contacts; a model's recorded sign map judged first
-    check_signs(read, model.robot, among=opts.calibrate, recorded=recorded, units=opts.columns[1])
-    check_torque_unit(read, model.robot, cmap)
+    check_signs(
+        checked, model.robot, among=opts.calibrate, recorded=recorded, units=opts.columns[1]
+    )
+    check_torque_unit(checked, model.robot, cmap)
     return read
 
 

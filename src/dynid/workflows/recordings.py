@@ -12,7 +12,11 @@ line naming the file, never a recording dropped silently:
   an error naming the file and ``--units t=ms``;
 * a recording in other units than the others (its torques, or its velocities against the
   derivative of its positions on the joints that move, a power of ten away from the other
-  recordings'): an error naming it (a recording at rest has no velocity ratio to compare);
+  recordings'): an error naming it (a recording at rest, or without velocity columns, has
+  no velocity ratio to compare);
+
+Every check reads the recordings with their joints recorded wrapped into ``[-pi, pi]``
+unwrapped by the preparation's rule (:func:`unwrapped_recorded`), not a whole turn's jump.
 * a recording in degrees among recordings in radians (positions and velocities both in
   degrees pass the check above): an error naming it and the columns to convert
   (:mod:`~dynid.identification.unit_mix`);
@@ -48,7 +52,7 @@ import numpy as np
 
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, velocity_note
-from ..identification.pieces import with_start_turns
+from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
 from ..identification.sanity import (
     SignFinding,
     despiked,
@@ -92,6 +96,7 @@ __all__ = [
     "despiked_recordings",
     "given_start",
     "read_recordings",
+    "unwrapped_recorded",
 ]
 
 _log = logging.getLogger(__name__)
@@ -118,12 +123,16 @@ class Recorded:
         (:func:`~dynid.identification.log.joint_side_log`; the logs themselves without
         it or through a drive of another joint count), mapped once when made (default)
         for every check and for the observer.
+    wrapped : tuple of tuple of int, optional
+        Per recording, the joints (0-based) recorded wrapped and unwrapped for the checks
+        (:func:`unwrapped_recorded`); None when nothing was unwrapped.
     """
 
     logs: tuple[TorqueLog, ...]
     paths: tuple[Path, ...]
     drive: Drive | None = None
     sides: tuple[TorqueLog, ...] | None = None
+    wrapped: tuple[tuple[int, ...], ...] | None = None
 
     def __post_init__(self) -> None:
         if self.sides is None:
@@ -142,7 +151,10 @@ class Recorded:
 
     def select(self, rows: slice) -> Recorded:
         """The recordings ``rows`` (a slice), their joint-side logs not mapped again."""
-        return Recorded(self.logs[rows], self.paths[rows], self.drive, self.joint_side[rows])
+        wrapped = None if self.wrapped is None else self.wrapped[rows]
+        return Recorded(
+            self.logs[rows], self.paths[rows], self.drive, self.joint_side[rows], wrapped
+        )
 
 
 def read_recordings(
@@ -218,15 +230,16 @@ def read_recordings(
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths), drive)
-    check_limits(out, robot)
     for name, log in zip(out.names, out.logs, strict=True):  # the time unit named first
         if (unit := time_unit_finding(name, log)) is not None:  # it names the file
             raise DataError(unit.removeprefix(f"{name}: "), file=name)
-    check_units(out)
+    checked = unwrapped_recorded(out, robot, max_gap_s)  # as the preparation reads them
+    check_limits(checked, robot)
+    check_units(checked)
     check_derived_velocities(out, cmap)
     if signs:  # said, naming the joints: the verdict judges the log as it is
-        warn_signs(out, robot if reference is None else reference)
-    check_torque_unit(out, robot if reference is None else reference, cmap)
+        warn_signs(checked, robot if reference is None else reference)
+    check_torque_unit(checked, robot if reference is None else reference, cmap)
     return out
 
 
@@ -302,17 +315,36 @@ def given_start(
     return (with_start_turns(names[0], logs[0], robot, drive, np.asarray(q_start), max_gap_s),)
 
 
+def unwrapped_recorded(rec: Recorded, robot: Robot, max_gap_s: float | None = None) -> Recorded:
+    """The recordings with their joints recorded wrapped into ``[-pi, pi]`` unwrapped by
+    the rule the preparation applies (:func:`~dynid.identification.pieces.unwrapped_log`,
+    cut at the gaps longer than ``max_gap_s`` [s]), for the checks across recordings:
+    they read the positions every later step reads, not a whole turn's jump. A motor-side
+    log is as it is (its motors' turns are the preparation's, or ``--q-start``'s);
+    ``rec`` itself when nothing was wrapped."""
+    if rec.drive is not None and rec.drive.side == "motor":
+        return rec
+    turns = wrappable(robot)
+    pairs = zip(rec.names, rec.logs, strict=True)
+    done = [unwrapped_log(name, log, turns, max_gap_s) for name, log in pairs]
+    if not any(joints for _, joints in done):
+        return rec
+    logs, wrapped = zip(*done, strict=True)
+    return Recorded(tuple(logs), rec.paths, rec.drive, wrapped=tuple(wrapped))
+
+
 def _scales(log: TorqueLog) -> tuple[float, float]:
     """The RMS torque [N m] and ``k`` of ``d q / dt ~ k dq`` (1 when ``t``, ``q`` and
     ``dq`` share their units) of a log, on at most 20 000 samples. The positions'
     differences of half a turn or more (a continuous joint recorded wrapped into
     [-pi, pi), a jump) are left out: they are not motion; so are the joints whose
     velocities are their noise (a joint at rest: ``k`` of noise against noise, any
-    number); ``k`` is NaN when no joint moves."""
+    number); ``k`` is NaN when no joint moves, and for velocities derived from the
+    positions (they are that derivative: nothing to compare)."""
     step = max(1, log.n_samples // 20_000)
     t, q, dq, tau = log.t[::step], log.q[::step], log.dq[::step], log.tau[::step]
     rms = float(np.sqrt(np.mean(tau**2)))
-    if t.size < 5:
+    if t.size < 5 or log.dq_derived:
         return rms, float("nan")
     dqdt = np.diff(q, axis=0) / np.diff(t)[:, None]
     mid = 0.5 * (dq[1:] + dq[:-1])
@@ -325,7 +357,9 @@ def _scales(log: TorqueLog) -> tuple[float, float]:
 def check_units(rec: Recorded) -> None:
     """Refuse a recording whose torque scale or velocity unit is a power of ten away from
     the median of the other recordings' (several recordings only; of two, the second is
-    named).
+    named). The velocity unit is compared among the recordings with velocity columns
+    only: velocities derived from the positions are their derivative by construction.
+    ``rec`` as the preparation reads it (:func:`unwrapped_recorded`).
 
     Raises
     ------
@@ -586,7 +620,8 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
     and a recording with joints in degrees
     (:func:`~dynid.identification.unit_mix.joints_in_degrees`); warn about a recording
     whose (joint-side) positions lie far outside the joint limits (:data:`LIMIT_MARGIN`
-    beyond them), naming it.
+    beyond them), naming it; a joint recorded wrapped (:attr:`Recorded.wrapped`) is left
+    to the preparation's warning, which names its jumps and its limits.
 
     Raises
     ------
@@ -601,10 +636,11 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
             raise DataError(found[1], file=name)
     lo = np.asarray(robot.q_min) - LIMIT_MARGIN
     hi = np.asarray(robot.q_max) + LIMIT_MARGIN
-    for name, log in zip(rec.names, sides, strict=True):
+    wrapped = rec.wrapped or ((),) * len(sides)
+    for name, log, turned in zip(rec.names, sides, wrapped, strict=True):
         q = log.q
         qmin, qmax = np.min(q, axis=0), np.max(q, axis=0)
-        bad = np.flatnonzero((qmin < lo) | (qmax > hi))
+        bad = np.setdiff1d(np.flatnonzero((qmin < lo) | (qmax > hi)), turned)  # said: wrapped
         if bad.size:
             j = int(bad[0])
             warnings.warn(

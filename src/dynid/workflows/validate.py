@@ -84,6 +84,7 @@ from .recordings import (
     despiked_recordings,
     read_recordings,
     recorded_sign_map_findings,
+    unwrapped_recorded,
     warn_signs,
 )
 
@@ -334,7 +335,8 @@ def validate_files(
         max_gap_s=opt.max_gap_s,
         reference=_reference(model),
     )
-    sign_map, opposite = _said_signs(rec, model, opt)  # before the verdict, naming the joints
+    checked = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
+    sign_map, opposite = _said_signs(checked, model, opt)  # before the verdict, naming joints
     _say_training_data(model, rec.names)
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
     friction, source = _friction(model, opt.friction, feasible, placed)
