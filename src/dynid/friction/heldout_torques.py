@@ -19,7 +19,7 @@ prepared states put into the prediction (:mod:`~dynid.identification.input_noise
 sample against its own noise. The true structure of an SO-101 with quantized currents and
 positions-only logs was "usable, 2.47 x the noise floor of 0.554 %" on the sensors' noise
 alone (now 1.01 x a floor of 0.872 %). The held-out torques are judged as the fit used
-them: their one-sample spikes replaced (:func:`~dynid.identification.sanity.despiked`, as
+them: their one-sample spikes replaced (:func:`~dynid.identification.spikes.despiked`, as
 identification replaces them before filtering), the verdict saying how many.
 """
 
@@ -56,7 +56,7 @@ from ..identification.residual_dependence import (
     with_dependence_hint,
 )
 from ..identification.residual_spring import ResidualSpring, residual_spring
-from ..identification.sanity import despiked
+from ..identification.spikes import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -96,7 +96,7 @@ class HeldOutTorques:
     spikes : int
         Torque samples of the held-out data replaced as one-sample spikes before they were
         judged, as the fit replaced them
-        (:func:`~dynid.identification.sanity.despiked`).
+        (:func:`~dynid.identification.spikes.despiked`).
     inputs : tuple of (int, ndarray) or None
         The variance [N^2 m^2] the held-out states' noise puts into the prediction at every
         k-th sample (:func:`~dynid.identification.floor_verdict.prediction_input_noise`);
@@ -536,7 +536,7 @@ def _input_noise(
 def _despiked_from(log: TorqueLog, first: int = 0) -> tuple[TorqueLog, int]:
     """Rows ``first:`` of ``log`` with its torque spikes replaced as the identification
     replaced them before fitting (found on the whole log,
-    :func:`~dynid.identification.sanity.despiked`), and how many of those rows' torque
+    :func:`~dynid.identification.spikes.despiked`), and how many of those rows' torque
     samples were replaced."""
     clean, _ = despiked(log)
     if clean is log:

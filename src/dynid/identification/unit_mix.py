@@ -41,8 +41,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
+from .angle_time_units import _RATE_AGREES, _rate_verdict, joint_rate_factor
 from .log import TorqueLog
-from .sanity import _RATE_AGREES, _rate_verdict, joint_rate_factor
 
 __all__ = ["DEGREE_TOLERANCE", "FREE_SPEED_FACTOR", "degrees_among_radians", "joints_in_degrees"]
 

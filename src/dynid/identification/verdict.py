@@ -402,7 +402,7 @@ def with_hint(verdict: Verdict, hint: str | None, joiner: str = "; ") -> Verdict
 
 def with_replaced_spikes(verdict: Verdict, count: int, detail: str = "") -> Verdict:
     """``verdict`` with its reason saying that it was judged with ``count`` one-sample torque
-    spikes replaced (:func:`~dynid.identification.sanity.despiked`), ``detail`` appended
+    spikes replaced (:func:`~dynid.identification.spikes.despiked`), ``detail`` appended
     (``", as the fit replaced them"``, the files); ``verdict`` itself when ``count`` is 0."""
     if count <= 0:
         return verdict
