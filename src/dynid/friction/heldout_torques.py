@@ -53,6 +53,7 @@ from ..identification.residual_dependence import (
     Dependence,
     held_terms,
     residual_dependence,
+    round_off,
     with_dependence_hint,
 )
 from ..identification.residual_spring import ResidualSpring, residual_spring
@@ -180,6 +181,7 @@ class HeldOutTorques:
             self.tilt,
             fl.joint_ratios,
             self.springs,
+            [v.log.tau],
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -189,11 +191,21 @@ class HeldOutTorques:
     @property
     def systematic(self) -> tuple[Dependence, ...]:
         """The joints whose held-out residual is above their noise and what it follows
-        (:func:`~dynid.identification.residual_dependence.residual_dependence`)."""
+        (:func:`~dynid.identification.residual_dependence.residual_dependence`); none when
+        the residual is exact to round-off (:attr:`round_off`)."""
         v = self.validation
+        if self.round_off is not None:
+            return ()
         fl = self._judged()[1]
         error = [v.log.tau - v.tau_hat]
         return residual_dependence([v.log.q], [v.log.dq], error, fl.total_rms, fl.joint_ratios)
+
+    @property
+    def round_off(self) -> float | None:
+        """The held-out residual's RMS over the torques' when the prediction is exact to
+        round-off (:func:`~dynid.identification.residual_dependence.round_off`), else None."""
+        v = self.validation
+        return round_off([v.log.tau - v.tau_hat], [v.log.tau])
 
     @property
     def low_speed(self) -> str | None:

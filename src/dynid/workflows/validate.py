@@ -426,8 +426,9 @@ def _with_hints(
         whole = joined_validation(val.parts) if verdict.level != "good" else None
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
+        tau = [v.log.tau for v in val.parts]
         verdict = with_dependence_hint(
-            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs
+            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau
         )
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
