@@ -21,6 +21,10 @@ from ..model.robot import Robot
 from .log import TorqueLog
 
 __all__ = [
+    "RATE_AGREES",
+    "degrees_findings",
+    "milliseconds_findings",
+    "rate_verdict",
     "joint_rate_factor",
     "time_unit_finding",
     "velocity_rate_factor",
@@ -29,12 +33,12 @@ __all__ = [
 
 #: Relative tolerance of "``dq`` agrees with the derivative of ``q``" (filtered velocities
 #: lag and smooth: 25 % is far from the factor 57.3 of degrees either way).
-_RATE_AGREES = 0.25
+RATE_AGREES = 0.25
 #: Speed [rad/s] above which velocities are too fast for radians on a joint without dq_max.
 _FAST_RAD_S = 2 * np.pi
 
 
-def _degrees(robot: Robot, log: TorqueLog) -> list[str]:
+def degrees_findings(robot: Robot, log: TorqueLog) -> list[str]:
     """The degrees finding (module docstring), or nothing."""
     q = log.q
     rev = ~np.asarray(robot.prismatic)
@@ -46,7 +50,7 @@ def _degrees(robot: Robot, log: TorqueLog) -> list[str]:
     suspect = rev & (span > 2 * np.pi) & (lo * r >= lim_lo - 0.1) & (hi * r <= lim_hi + 0.1)
     why: dict[int, tuple[str, str]] = {}
     for j in map(int, np.flatnonzero(suspect)):
-        verdict = _rate_verdict(robot, log, j)
+        verdict = rate_verdict(robot, log, j)
         if verdict is None:
             suspect[j] = False
         else:
@@ -72,7 +76,7 @@ def joint_rate_factor(log: TorqueLog, j: int) -> float:
     return float(signals.derivative(t, q) @ v) / den  # in blocks: a long log's column
 
 
-def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | None:
+def rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | None:
     """What the velocities of joint ``j`` say of positions that may be degrees: None (they
     are radians), or the reason and the hint of the warning.
 
@@ -84,13 +88,13 @@ def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | Non
         return "", "--units q=deg"
     v = log.dq[:, j]
     deg = 180.0 / np.pi
-    if abs(k / deg - 1.0) < _RATE_AGREES:
+    if abs(k / deg - 1.0) < RATE_AGREES:
         return (
             f", and its velocities are {k:.3g} times slower than the derivative of its "
             "positions (degrees against radians per second)",
             "--units q=deg",
         )
-    if abs(k - 1.0) < _RATE_AGREES:
+    if abs(k - 1.0) < RATE_AGREES:
         fast = float(robot.dq_max[j]) if np.isfinite(robot.dq_max[j]) else _FAST_RAD_S
         peak = float(np.quantile(np.abs(v), 0.99))
         if peak <= 1.5 * fast:
@@ -104,7 +108,9 @@ def _rate_verdict(robot: Robot, log: TorqueLog, j: int) -> tuple[str, str] | Non
     return "", "--units q=deg"
 
 
-def _milliseconds(log: TorqueLog) -> list[str]:
+def milliseconds_findings(log: TorqueLog) -> list[str]:
+    """The milliseconds finding of ``log`` (its velocities about ``1e3`` times the
+    derivative of its positions: ``--units t=ms``), or nothing."""
     t, q, dq = log.t, log.q, log.dq
     if t.size < 5:
         return []
@@ -160,7 +166,7 @@ def time_unit_finding(name: str, log: TorqueLog) -> str | None:
     if not np.isfinite(k) or k <= 0:
         return None
     for unit, size in _TIME_UNITS:
-        if abs(k / size - 1.0) < _RATE_AGREES:
+        if abs(k / size - 1.0) < RATE_AGREES:
             return (
                 f"{name}: its recorded velocities are {1 / k:.4g} times the rate of change of "
                 f"its positions per unit of its time column: the time column looks like "

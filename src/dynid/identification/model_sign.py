@@ -43,6 +43,10 @@ from .log import TorqueLog
 from .velocity_noise import MIN_MOTION, noise_band, velocity_noise_std
 
 __all__ = [
+    "CHECKED_SAMPLES",
+    "flip_entries",
+    "gravity_spread",
+    "motion_accelerations",
     "CONFIRMED_CORRELATION",
     "CONFIRMED_SLOPE",
     "MOTION_HALF_SPAN_S",
@@ -56,7 +60,8 @@ __all__ = [
     "sign_confirmed",
 ]
 
-_MAX_SAMPLES = 4000  # samples used by the checks (evenly spaced): they are statistics
+#: Samples the checks of a log use, evenly spaced: they are statistics.
+CHECKED_SAMPLES = 4000
 #: The sign and scale checks judge a joint only where its gravity torques span at least
 #: this share of the log's largest gravity torque (a UR5's shoulder: 0.9 over 20 s of
 #: Fourier motion, 0.14 over 0.5 s, 0.008 over 0.05 s, where the correlation was -0.95
@@ -107,14 +112,14 @@ def anticorrelated(
 
 
 def _loaded(g: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """The joints the gravity torques ``g`` (N, n) load (:func:`_gravity_spread`)."""
+    """The joints the gravity torques ``g`` (N, n) load (:func:`gravity_spread`)."""
     spread = np.std(g, axis=0)
     varied = np.ptp(g, axis=0) >= GRAVITY_RANGE_SHARE * float(np.max(np.abs(g)))
     out: NDArray[np.bool_] = (spread > 0.05 * max(float(spread.max()), 1e-300)) & varied
     return out & bool(np.any(spread > 0))
 
 
-def _gravity_spread(
+def gravity_spread(
     robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]] | None:
     """The robot's gravity torques and ``tau`` with their means removed, and the joints
@@ -136,7 +141,7 @@ def gravity_loaded(robot: Robot, q: ArrayLike) -> NDArray[np.bool_]:
     qq = _checks.as_array("q", q)
     if qq.ndim != 2 or qq.shape[0] < 2 or not np.any(robot.phi):
         return np.zeros(robot.n, dtype=bool)
-    return _loaded(_static_torques(robot, qq[:: max(1, qq.shape[0] // _MAX_SAMPLES)]))
+    return _loaded(_static_torques(robot, qq[:: max(1, qq.shape[0] // CHECKED_SAMPLES)]))
 
 
 def _static_torques(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -147,7 +152,7 @@ def _static_torques(robot: Robot, q: NDArray[np.float64]) -> NDArray[np.float64]
     return g if robot.spring is None else g + robot.spring.torques(q)
 
 
-def _flips(joints: Iterable[int], file: str | None = None) -> str:
+def flip_entries(joints: Iterable[int], file: str | None = None) -> str:
     """The ``--units`` entries that flip the torques of ``joints`` (from 0): ``tau2=-1``,
     or a file's own, ``rec2.csv:tau2=-1``."""
     at = "" if file is None else f"{file}:"
@@ -165,9 +170,9 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
     masses, and friction that pushes the arm."""
     if not np.any(robot.phi):
         return None
-    step = max(1, log.n_samples // _MAX_SAMPLES)
+    step = max(1, log.n_samples // CHECKED_SAMPLES)
     at = np.arange(0, log.n_samples, step)
-    centred = _gravity_spread(robot, log.q[at], log.tau[at])
+    centred = gravity_spread(robot, log.q[at], log.tau[at])
     if centred is None:  # gravity barely varies: its means and the motion's torques tell
         loaded, corr = np.zeros(robot.n, dtype=bool), np.zeros(robot.n)
     else:
@@ -207,7 +212,7 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
     )
     unjudged = np.flatnonzero(~(loaded | strong))
     if unjudged.size == 0:
-        every_joint = "tau=-1" if file is None else _flips(range(robot.n), file)
+        every_joint = "tau=-1" if file is None else flip_entries(range(robot.n), file)
         return (
             f"{said}: the torque sign is probably opposite to the model's; hint: --units "
             f"{every_joint} reads them flipped"
@@ -219,8 +224,8 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
         f"{', '.join(names[k] for k in unjudged)}, whose torques the model's do not explain "
         "(gravity barely loads them, and friction or a drive's rotor inertia outweighs their "
         "links'), is not told by this check; hint: --units "
-        f"{'tau=-1' if file is None else _flips(range(robot.n), file)} if every joint's is "
-        f"opposite, --units {_flips(seen, file)} if these only"
+        f"{'tau=-1' if file is None else flip_entries(range(robot.n), file)} if every joint's is "
+        f"opposite, --units {flip_entries(seen, file)} if these only"
     )
 
 
@@ -386,7 +391,7 @@ def _centred(x: NDArray[np.float64]) -> NDArray[np.float64]:
     return out
 
 
-def _motion_accelerations(
+def motion_accelerations(
     log: TorqueLog, at: NDArray[np.intp]
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]] | None:
     """The accelerations (at.size, n) at the samples ``at`` of ``log`` that the checks
@@ -425,8 +430,8 @@ def _motion_torques(
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]] | None:
     """The robot's rigid-body torques ``M ddq + c + g`` (no friction, its spring
     included) at the samples ``at`` of ``log``, at the accelerations
-    :func:`_motion_accelerations` gives, and where they are known (None: too few)."""
-    found = _motion_accelerations(log, at)
+    :func:`motion_accelerations` gives, and where they are known (None: too few)."""
+    found = motion_accelerations(log, at)
     if found is None:
         return None
     ddq, ok = found
@@ -449,7 +454,7 @@ def sign_confirmed(robot: Robot, logs: Sequence[TorqueLog]) -> NDArray[np.bool_]
     last joint: -0.92 on a log of the right sign), the slope then far from 1."""
     if not np.any(robot.phi) or not logs:
         return np.zeros(robot.n, dtype=bool)
-    step = max(1, sum(g.n_samples for g in logs) // _MAX_SAMPLES)
+    step = max(1, sum(g.n_samples for g in logs) // CHECKED_SAMPLES)
     model, tau = [], []
     for g in logs:
         at = np.arange(0, g.n_samples, step)
@@ -523,10 +528,10 @@ def _opposite(
         )
         + (
             f"; hint: --units "
-            f"{'tau=-1' if file is None else _flips(range(len(names)), file)} if every "
-            f"joint's is opposite, --units {_flips(bad, file)} if these only"
+            f"{'tau=-1' if file is None else flip_entries(range(len(names)), file)} if every "
+            f"joint's is opposite, --units {flip_entries(bad, file)} if these only"
             if rest.size == 0 and bad.size > 1
-            else f"; hint: --units {_flips(bad, file)} reads "
+            else f"; hint: --units {flip_entries(bad, file)} reads "
             + ("it" if bad.size == 1 else "them")
             + " flipped (beside the torques' unit, if one is given)"
         )

@@ -28,11 +28,11 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .log import TorqueLog, joint_side_log
 from .model_sign import (
-    _MAX_SAMPLES,
+    CHECKED_SAMPLES,
     NEGATED_DISTANCE_SHARE,
     NEGATED_MODEL_SHARE,
-    _flips,
-    _motion_accelerations,
+    flip_entries,
+    motion_accelerations,
     opposite_sign_among,
 )
 
@@ -63,7 +63,7 @@ REVERSED_STEP_SHARE = 0.75
 @dataclass(frozen=True, slots=True)
 class _Recorded:
     """A log's samples as recorded, for :func:`reversed_joint`: positions, velocities,
-    accelerations (one derivation, :func:`_motion_accelerations`) and efforts (N, n) in
+    accelerations (one derivation, :func:`motion_accelerations`) and efforts (N, n) in
     the log's own columns, and the drive that reads them (None: joint-side torques)."""
 
     q: NDArray[np.float64]
@@ -100,9 +100,9 @@ class _Recorded:
 
 def _recorded(log: TorqueLog, drive: Drive | None) -> _Recorded | None:
     """:class:`_Recorded` of ``log`` at every k-th of its samples whose accelerations are
-    known (:func:`_motion_accelerations`), or None when too few are."""
-    at = np.arange(0, log.n_samples, max(1, log.n_samples // _MAX_SAMPLES))
-    found = _motion_accelerations(log, at)
+    known (:func:`motion_accelerations`), or None when too few are."""
+    at = np.arange(0, log.n_samples, max(1, log.n_samples // CHECKED_SAMPLES))
+    found = motion_accelerations(log, at)
     if found is None:
         return None
     ddq, ok = found
@@ -121,7 +121,7 @@ def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> 
     log's columns (``q6=-1,tau6=-1``).
 
     Judged on the robot's whole rigid-body torques over every joint, at the accelerations
-    :func:`_motion_accelerations` derives (one derivation for the torques and the rotor
+    :func:`motion_accelerations` derives (one derivation for the torques and the rotor
     columns, of the sign check's whole torques too), each joint's residual freed of its
     own viscous, Coulomb, offset and armature torques (least squares on ``dq``,
     ``sign(dq)``, 1, ``ddq``; through a drive, each motor's, where its friction acts, and
@@ -456,7 +456,7 @@ def opposite_friction_among(
         f"{what}, where {where} of the right sign (a file logged with another sign "
         "convention; the check "
         "against the model's torques does not tell a joint the links barely load); hint: "
-        f"--units {_flips(motors, names[r] if len(names) > 1 else None)} reads it flipped"
+        f"--units {flip_entries(motors, names[r] if len(names) > 1 else None)} reads it flipped"
     )
 
 

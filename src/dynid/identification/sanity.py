@@ -35,9 +35,9 @@ from numpy.typing import NDArray
 
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .angle_time_units import _degrees, _milliseconds
+from .angle_time_units import degrees_findings, milliseconds_findings
 from .log import TorqueLog
-from .model_sign import _MAX_SAMPLES, _gravity_spread, opposite_sign
+from .model_sign import CHECKED_SAMPLES, gravity_spread, opposite_sign
 from .velocity_noise import moving_joints
 
 __all__ = [
@@ -82,7 +82,7 @@ def check_torque_log(robot: Robot, log: TorqueLog, drive: Drive | None = None) -
         out.append(seen.opposite)
     elif a is not None and (abs(a) > 30 or 0 < abs(a) < 1 / 30):
         out.append(_scale_line(a, drive=drive))
-    out += _milliseconds(log)
+    out += milliseconds_findings(log)
     frozen, names = seen.frozen, robot.joint_names
     if np.any(frozen) and not np.all(frozen):
         which = ", ".join(names[j] for j in np.flatnonzero(frozen))
@@ -107,7 +107,7 @@ class _GravitySaid:
     frozen : ndarray of bool, shape (n,)
         The joints that never leave their velocity noise band.
     opposite : str or None
-        The sign finding (:func:`_opposite`).
+        The sign finding (:func:`~dynid.identification.model_sign.opposite_sign`).
     scale : float or None
         ``a`` of ``tau ~ a g(q)`` (:func:`_torque_scale`); None where not compared: a
         robot without inertial parameters, every joint frozen (at rest the variations are
@@ -124,20 +124,20 @@ class _GravitySaid:
 def _against_gravity(robot: Robot, log: TorqueLog) -> _GravitySaid:
     """The degrees, frozen joints, sign and scale of ``log`` against ``robot``'s gravity
     torques (:class:`_GravitySaid`), each judged only where the ones before allow."""
-    degrees = tuple(_degrees(robot, log))
+    degrees = tuple(degrees_findings(robot, log))
     frozen = ~moving_joints(log.dq)
     if not np.any(robot.phi) or degrees or np.all(frozen):
         return _GravitySaid(degrees, frozen)
     if (opposite := opposite_sign(robot, log)) is not None:
         return _GravitySaid(degrees, frozen, opposite)
-    step = max(1, log.n_samples // _MAX_SAMPLES)
+    step = max(1, log.n_samples // CHECKED_SAMPLES)
     return _GravitySaid(degrees, frozen, None, _torque_scale(robot, log.q[::step], log.tau[::step]))
 
 
 def _torque_scale(robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]) -> float | None:
     """The least-squares factor ``a`` of ``tau ~ a g(q)`` over the joints gravity loads,
     their means removed (None when gravity loads none)."""
-    centred = _gravity_spread(robot, q, tau)
+    centred = gravity_spread(robot, q, tau)
     if centred is None:
         return None
     gc, tc, loaded = centred
