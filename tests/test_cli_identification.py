@@ -158,7 +158,7 @@ def test_bad_inputs_exit_non_zero_with_one_stderr_line(tmp_path, identified, cap
     npz = tmp_path / "log.npz"
     np.savez(npz, t=np.arange(3.0), tau=np.zeros((3, 7)))
     assert main(["identify", "--data", str(npz), "--out", str(tmp_path)]) == 2
-    assert "missing array(s) ['q']" in _one_error_line(capsys)
+    assert "missing array(s) q;" in _one_error_line(capsys)
     assert main(["predict", "--model", model, "--q=0,0,0"]) == 2
     assert "--q must have 7 values; got 3" in _one_error_line(capsys)
     assert main(["predict", "--model", model, "--q=0,0,0,-1,0,1,0", "--ddq=0,0,0,0,0,0,0"]) == 2

@@ -411,12 +411,12 @@ def test_trajectory_csv_records_its_rows_and_is_read_strictly(tmp_path):
     word[9] = ",".join(cells[:3] + ["abc"] + cells[4:])
     cases = [
         (variant("dup.csv", lines[2] + ",q1", [r + ",0" for r in lines[3:]]),
-         r"dup.csv, line 3: duplicated column\(s\) \['q1'\]"),
+         r"dup.csv, line 3: duplicated column\(s\) q1;"),
         (variant("unknown.csv", lines[2] + ",temp", [r + ",20" for r in lines[3:]]),
-         r"unknown.csv, line 3: unknown column\(s\) \['temp'\]"),
+         r"unknown.csv, line 3: unknown column\(s\) temp;"),
         (variant("missing.csv", lines[2].rsplit(",", 1)[0],
                  [r.rsplit(",", 1)[0] for r in lines[3:]]),
-         r"missing column\(s\) \['ddq7'\] for 7 joints"),
+         r"missing column\(s\) ddq7 for 7 joints"),
         (variant("cut.csv", rows=lines[3:502]), "records 1001 rows but holds 499"),
         (variant("word.csv", rows=word), "word.csv, line 13, column 'q3': not a number: 'abc'"),
     ]  # fmt: skip

@@ -21,8 +21,8 @@ import dynid
 from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DynidWarning
 from dynid.identification.dissipation import GRID, friction_violations, reversed_sign_finding
+from dynid.identification.model_sign import opposite_sign
 from dynid.identification.recordings import prepare_recordings
-from dynid.identification.sanity import opposite_sign
 from dynid.identification.selection import reversed_friction, select_structure
 from dynid.identification.structure import Structure
 from dynid.model.drive import Drive
@@ -296,7 +296,7 @@ def test_the_whole_torques_confirm_the_sign_of_joints_gravity_does_not_load():
     whose torques were negated is confirmed, whichever joint; most joints of the right
     sign are, the wrist's included (gravity judges joints 2-4 only); the last joint,
     whose friction outweighs its rigid body, is not (its correlation can be -0.9)."""
-    from dynid.identification.sanity import sign_confirmed
+    from dynid.identification.model_sign import sign_confirmed
 
     from conftest import recordings
 

@@ -33,7 +33,7 @@ from dynid.identification.input_noise import (
 )
 from dynid.identification.log import TorqueLog, with_derived_velocities
 from dynid.identification.prepare import Preprocessing, prepare_log
-from dynid.identification.sanity import velocity_noise_std
+from dynid.identification.velocity_noise import velocity_noise_std
 from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier

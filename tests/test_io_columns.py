@@ -193,7 +193,7 @@ def test_mapped_csv_is_read_strictly_and_frugally(tmp_path, monkeypatch):
     head = lines[0].split(",")
     dup = tmp_path / "dup.csv"
     dup.write_text(",".join(head[:-1] + ["seq"]) + "\n" + "\n".join(lines[1:4]) + "\n")
-    with pytest.raises(DataError, match=r"line 1: duplicate column\(s\) \['seq'\]"):
+    with pytest.raises(DataError, match=r"line 1: duplicate column\(s\) seq$"):
         load_mapped_torque_log(dup, cmap)
     short = tmp_path / "short.csv"
     short.write_text("# rows: 5\n" + "\n".join(lines[:4]) + "\n")

@@ -93,7 +93,7 @@ def test_csv_missing_column_is_named(tmp_path, panda_data):
     comments, header, rows = _csv_table(path)
     k = header.index("M3_2")
     _write_csv(path, comments, header[:k] + header[k + 1 :], [r[:k] + r[k + 1 :] for r in rows])
-    with pytest.raises(DataError, match=r"missing columns \['M3_2'\]"):
+    with pytest.raises(DataError, match=r"missing columns M3_2;"):
         load_static_csv(path, robot)
 
 
@@ -103,10 +103,10 @@ def test_csv_extra_and_duplicated_columns_are_named(tmp_path, panda_data):
     path = save_static_data(tmp_path / "static.csv", data)
     comments, header, rows = _csv_table(path)
     _write_csv(path, comments, header + ["temperature"], [r + ["21.5"] for r in rows])
-    with pytest.raises(DataError, match=r"unexpected columns \['temperature'\]"):
+    with pytest.raises(DataError, match=r"unexpected columns temperature;"):
         load_static_csv(path, robot)
     _write_csv(path, comments, header + ["g2"], [r + ["0.0"] for r in rows])
-    with pytest.raises(DataError, match=r"duplicated columns \['g2'\]"):
+    with pytest.raises(DataError, match=r"duplicated columns g2$"):
         load_static_csv(path, robot)
 
 
@@ -164,10 +164,10 @@ def test_npz_missing_extra_and_misshaped_arrays_are_named(tmp_path, panda_data):
     robot, data = panda_data
     path = tmp_path / "static.npz"
     np.savez(path, q=data.q, M=data.M)
-    with pytest.raises(DataError, match=r"missing arrays \['g'\]"):
+    with pytest.raises(DataError, match=r"missing arrays g;"):
         load_static_npz(path, robot)
     np.savez(path, q=data.q, M=data.M, g=data.g, t=np.arange(200.0))
-    with pytest.raises(DataError, match=r"unexpected arrays \['t'\]"):
+    with pytest.raises(DataError, match=r"unexpected arrays t;"):
         load_static_npz(path, robot)
     np.savez(path, q=data.q, M=data.M[:, :6, :6], g=data.g)
     with pytest.raises(

@@ -78,7 +78,7 @@ def test_a_single_missing_torque_column_is_named_without_a_map(tmp_path):
     """tau7 alone missing: named as before, and no map is offered."""
     path = tmp_path / "six.csv"
     _write(path, {"q": _cols("q"), "tau": _cols("tau")[:6] + ["note"]})
-    with pytest.raises(DataError, match=r"missing column\(s\) \['tau7'\]") as err:
+    with pytest.raises(DataError, match=r"missing column\(s\) tau7 ") as err:
         load_torque_log(path)
     assert "present but unused: note" in str(err.value) and "--columns '" not in str(err.value)
 
@@ -102,3 +102,51 @@ def test_a_time_column_of_another_name_is_mapped_with_its_unit(tmp_path):
     log = load_mapped_torque_log(path, parse_column_map(spec, "t=ms")).log
     np.testing.assert_allclose(log.t, t / 1000.0)
     np.testing.assert_array_equal(log.tau, tau)
+
+
+def test_a_renamed_torque_column_is_named_in_plain_text_by_the_command(tmp_path, capsys):
+    """Regression: tau6 written torque6 was reported as "missing column(s) ['tau6']", a
+    Python list; the command's error names tau6 and torque6 as plain text."""
+    from dynid.cli.__main__ import main
+
+    path = tmp_path / "log.csv"
+    taus = _cols("tau")
+    _write(path, {"q": _cols("q"), "dq": _cols("dq"), "tau": taus[:5] + ["torque6", "tau7"]})
+    rc = main(["validate", "--robot", "panda", "--data", str(path), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and err[-1].startswith(
+        "dynid validate: error: log.csv: missing column(s) tau6 (n = 7 from q1..q7); "
+        "present but unused: torque6"
+    ), err
+    assert "[" not in err[-1] and "'tau6'" not in err[-1]
+
+
+def test_only_the_time_column_renamed_is_mapped_alone(tmp_path):
+    """Regression: a header time, q1.., dq1.., tau1.. gave "hint: ; present but unused:
+    q1..q7, ..." (columns it does use); the hint maps the time column alone, and that map
+    reads the values written."""
+    rng = np.random.default_rng(5)
+    t = np.arange(50) / 100.0
+    q, dq, tau = (rng.uniform(-1, 1, (50, N)) for _ in range(3))
+    header = ["time", *_cols("q"), *_cols("dq"), *_cols("tau")]
+    path = tmp_path / "log.csv"
+    np.savetxt(path, np.column_stack([t, q, dq, tau]), delimiter=",", header=",".join(header),
+               comments="", fmt="%.17g")  # fmt: skip
+    with pytest.raises(DataError) as err:
+        load_torque_log(path)
+    said = str(err.value)
+    assert said.endswith("got time, q1, q2, q3, q4, q5, q6, q7 and 14 more; hint: --columns "
+                         "'t=time' reads time as the time, or name it t"), said  # fmt: skip
+    log = load_mapped_torque_log(path, parse_column_map("t=time")).log
+    np.testing.assert_array_equal(log.t, t)
+    np.testing.assert_array_equal(log.tau, tau)
+
+
+def test_names_in_messages_are_plain_unless_plain_text_would_garble_them():
+    """Column names are joined as text; one with a comma, a space or a line break is quoted,
+    and past eight names the rest are counted."""
+    from dynid._checks import names
+
+    assert names(["tau6", "tau7"]) == "tau6, tau7"
+    assert names(["a,b", "tau 6", "x\ny"]) == "'a,b', 'tau 6', 'x\\ny'"
+    assert names([f"c{k}" for k in range(10)]) == "c0, c1, c2, c3, c4, c5, c6, c7 and 2 more"

@@ -18,8 +18,8 @@ import pytest
 import dynid
 from dynid.exceptions import DataError
 from dynid.friction.model import ClassicalFriction
+from dynid.identification.recorded_signs import opposite_friction_among
 from dynid.identification.recordings import prepare_recordings
-from dynid.identification.sanity import opposite_friction_among
 
 from conftest import GEARED_NOISE, geared_recordings, recordings
 

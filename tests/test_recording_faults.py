@@ -21,7 +21,8 @@ from dynid.cli.__main__ import main
 from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DataError
 from dynid.identification.log import TorqueLog
-from dynid.identification.sanity import check_torque_log, opposite_sign
+from dynid.identification.model_sign import opposite_sign
+from dynid.identification.sanity import check_torque_log
 from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
@@ -432,7 +433,7 @@ def test_a_joint_recorded_reversed_is_found_and_read_back(panda, tmp_path, torqu
     the joint and the entries that read it back; with them, the fit is that of the log as
     recorded the right way, bit for bit; the log itself is not called reversed."""
     from dynid.friction.model import ClassicalFriction
-    from dynid.identification.sanity import reversed_joint
+    from dynid.identification.recorded_signs import reversed_joint
     from dynid.simulation.measurement import SensorNoise
     from dynid.workflows.identify import IdentifyOptions, identify_files
 

@@ -316,7 +316,7 @@ def test_extra_columns_are_noted_once_per_read(panda, logs, tmp_path, caplog):
         warnings.simplefilter("ignore", DynidWarning)
         assert main([*argv, str(tmp_path / "extra.csv")]) == 0
     notes = [r.getMessage() for r in caplog.records if "not torque-log signals" in r.getMessage()]
-    assert notes == ["extra.csv: column(s) ['temp'] are not torque-log signals: ignored as data"]
+    assert notes == ["extra.csv: column(s) temp are not torque-log signals: ignored as data"]
 
 
 def test_a_folder_names_the_files_it_leaves_out(logs, tmp_path, caplog):

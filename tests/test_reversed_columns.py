@@ -15,8 +15,9 @@ import dynid
 from dynid.exceptions import DataError
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.log import TorqueLog
+from dynid.identification.model_sign import opposite_sign
+from dynid.identification.recorded_signs import reversed_joint
 from dynid.identification.recordings import prepare_recordings
-from dynid.identification.sanity import opposite_sign, reversed_joint
 from dynid.io.columns import load_mapped_torque_log, parse_column_map
 from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive

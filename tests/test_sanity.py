@@ -15,8 +15,9 @@ from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DataError, DynidWarning
 from dynid.identification.classical import identify_from_log
 from dynid.identification.log import TorqueLog, joint_side_log, recorded_side_log
+from dynid.identification.model_sign import opposite_sign
 from dynid.identification.recordings import prepare_recordings
-from dynid.identification.sanity import check_torque_log, opposite_sign, torque_unit_finding
+from dynid.identification.sanity import check_torque_log, torque_unit_finding
 from dynid.identification.selection import identify_recordings
 from dynid.model.drive import Drive
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
@@ -205,7 +206,7 @@ def test_torque_spikes_are_found_where_they_were_put_and_named_with_the_file(pan
     there and counted, and preparing the recording warns with the file, the joints and the
     counts (issue 28: spikes were fitted silently); the clean log has none."""
     from dynid.identification.recordings import prepare_recordings
-    from dynid.identification.sanity import torque_spikes
+    from dynid.identification.spikes import torque_spikes
 
     robot = dynid.panda()
     assert torque_spikes(panda_log.tau) == []

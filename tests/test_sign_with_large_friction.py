@@ -16,7 +16,7 @@ from scipy.ndimage import gaussian_filter1d
 
 import dynid
 from dynid.friction.model import ClassicalFriction
-from dynid.identification.sanity import opposite_sign
+from dynid.identification.model_sign import opposite_sign
 from dynid.io.robot.urdf_parse import load_urdf
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import Trajectory, random_fourier

@@ -16,8 +16,8 @@ import pytest
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import own_friction
-from dynid.identification.sanity import despiked
 from dynid.identification.selection import identify_recordings
+from dynid.identification.spikes import despiked
 from dynid.simulation.measurement import SensorNoise, sample_times
 from dynid.simulation.trajectories import random_fourier
 

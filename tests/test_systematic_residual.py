@@ -17,13 +17,13 @@ import pytest
 
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
+from dynid.identification.model_sign import opposite_sign
 from dynid.identification.residual_dependence import (
     dependence_hint,
     held_terms,
     outside_model_note,
     residual_dependence,
 )
-from dynid.identification.sanity import opposite_sign
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.io.torque_log import save_torque_log

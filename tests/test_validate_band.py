@@ -16,7 +16,7 @@ import pytest
 
 from dynid.cli.__main__ import main
 from dynid.identification.input_noise import derived_noise_gains
-from dynid.identification.sanity import NOISE_BAND_STD
+from dynid.identification.velocity_noise import NOISE_BAND_STD
 
 #: Velocity noise std of the simulated log [rad/s].
 DQ_NOISE = 0.003

@@ -174,7 +174,7 @@ def test_the_noise_of_unevenly_timed_samples_is_read_at_their_times():
     """White noise of std 0.05 on a fast motion sampled at jittered instants: read at the
     samples' times, its std; read as if even, the motion too (0.056-0.069). On even times
     the two readings are one."""
-    from dynid.identification.sanity import velocity_noise_std
+    from dynid.identification.velocity_noise import velocity_noise_std
 
     rng = np.random.default_rng(5)
     t = np.arange(5000) * 0.01

@@ -10,6 +10,7 @@ import json
 import math
 import re
 import unicodedata
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
@@ -114,6 +115,27 @@ def short(value: Any, limit: int = ECHO_LIMIT) -> str:
     unit = "characters" if isinstance(value, str) else "bytes" if big else "items"
     size = f" ({len(value)} {unit})" if hasattr(value, "__len__") else ""
     return text[: limit - 3] + "..." + size
+
+
+#: How many names :func:`names` lists before ``and k more``.
+NAMES_SHOWN = 8
+#: Longest name :func:`names` writes as it is [characters].
+_NAME_LIMIT = 60
+
+
+def names(items: Iterable[str], shown: int = NAMES_SHOWN) -> str:
+    """Names (columns, arrays) for a message in plain text, as dynid's messages name them:
+    ``tau6, tau7``, the first ``shown`` and then ``and k more``. A name plain text would
+    garble (empty, holding white space, a comma, a quote or a control character, or longer
+    than 60 characters) is quoted and cut as :func:`short` echoes it."""
+    listed = [str(s) for s in items]
+
+    def one(s: str) -> str:
+        plain = 0 < len(s) <= _NAME_LIMIT and re.search(r"[\s,'\"]", s) is None
+        return s if plain and control_character(s) is None else short(s, _NAME_LIMIT)
+
+    text = ", ".join(one(s) for s in listed[:shown])
+    return text + (f" and {len(listed) - shown} more" if len(listed) > shown else "")
 
 
 def one_line(text: str, limit: int = 2 * ECHO_LIMIT + 200) -> str:

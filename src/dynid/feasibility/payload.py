@@ -24,7 +24,7 @@ or a robot's links with its drive's known rotor inertias and its own friction.
   friction ``fv, fc, fo`` per joint estimated alongside (what the arm's own friction
   leaves); the Coulomb columns and the arm's own friction low-passed as the torques were
   (parallel filtering, as identification's rows); a joint whose measured velocity never
-  leaves its noise band (:func:`~dynid.identification.sanity.moving_joints`) does not
+  leaves its noise band (:func:`~dynid.identification.velocity_noise.moving_joints`) does not
   move: its velocity and acceleration are zero in the regressor and its ``fv, fc`` are
   not fitted (zero);
 * **difference method** (``unloaded=`` data of the same kind recorded without the load):

@@ -35,7 +35,7 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.log_rows import stepped_columns
 from ..identification.model import IdentifiedModel
 from ..identification.recordings import Recordings
-from ..identification.sanity import moving_joints
+from ..identification.velocity_noise import moving_joints
 from ..model.drive import Drive
 from ..regressors.static import static_regressor_columns, static_rows, static_vector
 from ..regressors.terms import LinearFriction
@@ -115,7 +115,7 @@ def log_preparation(
 
 def still_joints(logs: Sequence[TorqueLog], drive: Drive | None) -> NDArray[np.bool_]:
     """Joints whose measured velocity (joint side) never leaves its noise band in any
-    recording (:func:`~dynid.identification.sanity.moving_joints`)."""
+    recording (:func:`~dynid.identification.velocity_noise.moving_joints`)."""
     return ~moving_joints(np.concatenate([joint_side_log(log, drive).dq for log in logs]))
 
 

@@ -48,8 +48,13 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.model import IdentifiedModel
 from ..identification.prepare import MEASURED, Preprocessing, prepare_log
 from ..identification.recordings import standstill_band
-from ..identification.sanity import NOISE_BAND_STD, moving_joints, noise_band, velocity_noise_std
 from ..identification.structure import smooth_width
+from ..identification.velocity_noise import (
+    NOISE_BAND_STD,
+    moving_joints,
+    noise_band,
+    velocity_noise_std,
+)
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .laws import FrictionLaw, law_named
@@ -164,7 +169,7 @@ class FrictionResidual:
         White-noise std of the prepared (low-passed) velocities [rad/s], read from the log
         before preparation as identification reads it: its standstill band
         (:func:`~dynid.identification.recordings.standstill_band`) over
-        :data:`~dynid.identification.sanity.NOISE_BAND_STD`; None when unknown.
+        :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD`; None when unknown.
     recording : ndarray of int, shape (N,), optional
         The recording of each sample when the residual holds several
         (:func:`~dynid.friction.recordings.pieces_residual`); None: one recording.
@@ -356,10 +361,10 @@ def fit_law(
     dq_noise_std : array_like, shape (n,), optional
         White-noise std of the measured velocities [rad/s]
         (:attr:`FrictionResidual.dq_noise_std`). It sets each joint's standstill band
-        (:func:`~dynid.identification.sanity.noise_band`): Coulomb terms are off inside it,
+        (:func:`~dynid.identification.velocity_noise.noise_band`): Coulomb terms are off inside it,
         in the fit and in the fitted model. Joints whose ``dq`` does not leave the band
         (:func:`moving_joints`) get zero friction; None: no noise (no band; only
-        :data:`~dynid.identification.sanity.MIN_MOTION` tells still joints).
+        :data:`~dynid.identification.velocity_noise.MIN_MOTION` tells still joints).
     warn : bool
         Warn about joints that do not move (False: silently zero, as in cross-validation).
     width : float, optional

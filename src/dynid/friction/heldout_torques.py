@@ -19,7 +19,7 @@ prepared states put into the prediction (:mod:`~dynid.identification.input_noise
 sample against its own noise. The true structure of an SO-101 with quantized currents and
 positions-only logs was "usable, 2.47 x the noise floor of 0.554 %" on the sensors' noise
 alone (now 1.01 x a floor of 0.872 %). The held-out torques are judged as the fit used
-them: their one-sample spikes replaced (:func:`~dynid.identification.sanity.despiked`, as
+them: their one-sample spikes replaced (:func:`~dynid.identification.spikes.despiked`, as
 identification replaces them before filtering), the verdict saying how many.
 """
 
@@ -54,10 +54,11 @@ from ..identification.residual_dependence import (
     held_terms,
     judged_springs,
     residual_dependence,
+    round_off,
     with_dependence_hint,
 )
 from ..identification.residual_spring import ResidualSpring, residual_spring
-from ..identification.sanity import despiked
+from ..identification.spikes import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -97,7 +98,7 @@ class HeldOutTorques:
     spikes : int
         Torque samples of the held-out data replaced as one-sample spikes before they were
         judged, as the fit replaced them
-        (:func:`~dynid.identification.sanity.despiked`).
+        (:func:`~dynid.identification.spikes.despiked`).
     inputs : tuple of (int, ndarray) or None
         The variance [N^2 m^2] the held-out states' noise puts into the prediction at every
         k-th sample (:func:`~dynid.identification.floor_verdict.prediction_input_noise`);
@@ -181,6 +182,7 @@ class HeldOutTorques:
             self.tilt,
             fl.joint_ratios,
             self.springs,
+            [v.log.tau],
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -190,11 +192,21 @@ class HeldOutTorques:
     @property
     def systematic(self) -> tuple[Dependence, ...]:
         """The joints whose held-out residual is above their noise and what it follows
-        (:func:`~dynid.identification.residual_dependence.residual_dependence`)."""
+        (:func:`~dynid.identification.residual_dependence.residual_dependence`); none when
+        the residual is exact to round-off (:attr:`round_off`)."""
         v = self.validation
+        if self.round_off is not None:
+            return ()
         fl = self._judged()[1]
         error = [v.log.tau - v.tau_hat]
         return residual_dependence([v.log.q], [v.log.dq], error, fl.total_rms, fl.joint_ratios)
+
+    @property
+    def round_off(self) -> float | None:
+        """The held-out residual's RMS over the torques' when the prediction is exact to
+        round-off (:func:`~dynid.identification.residual_dependence.round_off`), else None."""
+        v = self.validation
+        return round_off([v.log.tau - v.tau_hat], [v.log.tau])
 
     @property
     def low_speed(self) -> str | None:
@@ -543,7 +555,7 @@ def _input_noise(
 def _despiked_from(log: TorqueLog, first: int = 0) -> tuple[TorqueLog, int]:
     """Rows ``first:`` of ``log`` with its torque spikes replaced as the identification
     replaced them before fitting (found on the whole log,
-    :func:`~dynid.identification.sanity.despiked`), and how many of those rows' torque
+    :func:`~dynid.identification.spikes.despiked`), and how many of those rows' torque
     samples were replaced."""
     clean, _ = despiked(log)
     if clean is log:

@@ -46,8 +46,8 @@ from ..identification.model import IdentifiedModel
 from ..identification.pieces import check_below_nyquist, recording_pieces, skipped_piece, wrappable
 from ..identification.prepare import Preprocessing, at_measured_samples, prepare_log, resamples
 from ..identification.recordings import standstill_band
-from ..identification.sanity import NOISE_BAND_STD
 from ..identification.trim import common_cutoff, edge_seconds
+from ..identification.velocity_noise import NOISE_BAND_STD
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .fit import FrictionResidual, TorqueModel, model_drive, torques_through
@@ -91,7 +91,7 @@ class Pieces:
         White-noise std of the prepared (low-passed) joint velocities [rad/s], read as
         identification reads it from the raw pieces: its standstill band
         (:func:`~dynid.identification.recordings.standstill_band`) over
-        :data:`~dynid.identification.sanity.NOISE_BAND_STD`, so that the friction laws
+        :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD`, so that the friction laws
         switch Coulomb friction off within the band identification gave the model's (the
         raw velocities' noise band, 25 times wider on a UR5 log at 5 Hz of 500 Hz, left
         the classical law 0.75 N m RMS where the model's reached 0.43 N m).
@@ -430,7 +430,7 @@ def _prepared_noise_std(pieces: list[TorqueLog], cutoff_hz: float | None) -> NDA
     """The white-noise std [rad/s] (n,) of the prepared joint velocities: identification's
     standstill band of the raw pieces at ``cutoff_hz``
     (:func:`~dynid.identification.recordings.standstill_band`) over
-    :data:`~dynid.identification.sanity.NOISE_BAND_STD`; zeros when no piece has 8
+    :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD`; zeros when no piece has 8
     samples."""
     if not any(p.n_samples >= 8 for p in pieces):
         return _checks.frozen(np.zeros(pieces[0].n))

@@ -33,6 +33,7 @@ from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
+from ..identification.model_sign import anticorrelated
 from ..identification.prepare import (
     Preprocessing,
     at_measured_samples,
@@ -41,7 +42,6 @@ from ..identification.prepare import (
     resamples,
 )
 from ..identification.recordings import common_cutoff
-from ..identification.sanity import anticorrelated
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import report

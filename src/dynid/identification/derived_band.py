@@ -1,7 +1,7 @@
 """The standstill band of velocities derived from positions (a log without velocity columns).
 
-The band of measured velocities is :data:`~dynid.identification.sanity.NOISE_BAND_STD`
-times their white-noise std (:func:`~dynid.identification.sanity.velocity_noise_std`).
+The band of measured velocities is :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD`
+times their white-noise std (:func:`~dynid.identification.velocity_noise.velocity_noise_std`).
 Velocities derived from positions are smooth: that estimate finds next to nothing on them
 (1e-7 rad/s on a 200 Hz log whose positions carry 1e-5 rad of noise), while they depart
 from the true velocity by the positions' noise passed through the derivative filter. Their
@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..signals import derivative_noise_gain
-from .sanity import noise_band, velocity_noise_std
+from .velocity_noise import noise_band, velocity_noise_std
 
 __all__ = ["WINDOW", "derived_velocity_band", "position_noise_std"]
 

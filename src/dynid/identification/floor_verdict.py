@@ -35,7 +35,7 @@ from .input_noise import (
 )
 from .log import TorqueLog
 from .metrics import TorqueErrors
-from .sanity import anticorrelated
+from .model_sign import anticorrelated
 from .verdict import Verdict, judge_prediction
 
 __all__ = [
@@ -87,7 +87,7 @@ def opposite_sign(tau: Sequence[NDArray[np.float64]], model: Sequence[NDArray[np
     """Whether the measured torques ``tau`` are anti-correlated with the model's ``model``
     (each a sequence of (N_p, n) [N m]) on the joints the model loads (its spread above 5 %
     of the largest), on at most 20 000 samples
-    (:func:`~dynid.identification.sanity.anticorrelated`)."""
+    (:func:`~dynid.identification.model_sign.anticorrelated`)."""
     N = sum(t.shape[0] for t in tau)
     step = max(1, N // 20_000)
     t = np.concatenate([x[::step] for x in tau])

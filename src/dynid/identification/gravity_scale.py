@@ -7,7 +7,7 @@ right one: every identified inertial parameter is scaled by ``1/c`` and the mode
 the log to its noise. Only something outside the log tells: the robot description's
 masses. Its gravity torques at the logged configurations ``g_d(q)`` against the identified
 model's ``g_m(q)``, per joint that gravity loads
-(:func:`~dynid.identification.sanity.gravity_loaded`): the least-squares factor ``r_j`` of
+(:func:`~dynid.identification.model_sign.gravity_loaded`): the least-squares factor ``r_j`` of
 ``g_m ~ r_j g_d``. A description's masses are off
 joint by joint (a cable, a motor left out of the CAD); a factor that is the same on every
 loaded joint (within :data:`UNIFORM`) and at least :data:`OFF` away from 1, with the
@@ -26,7 +26,7 @@ from ..dynamics.terms import gravity_torques
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .model import IdentifiedModel
-from .sanity import gravity_loaded
+from .model_sign import gravity_loaded
 
 __all__ = ["OFF", "SHAPE", "UNIFORM", "gravity_scale_finding", "gravity_ratios"]
 

@@ -38,7 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks, signals
 from ..exceptions import ShapeError
 from .log import TorqueLog
-from .sanity import velocity_noise_std
+from .velocity_noise import velocity_noise_std
 from .verdict import NOISE_FLOOR_SHARE, joint_ratios
 
 __all__ = [
@@ -99,7 +99,7 @@ def quantization_step(x: ArrayLike) -> NDArray[np.float64]:
 
 def quantized_noise_std(x: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.float64]:
     """The white-noise std (n,) of the samples ``x`` (N, n) at times ``t`` (N,): the
-    differences' estimate (:func:`~dynid.identification.sanity.velocity_noise_std`), at
+    differences' estimate (:func:`~dynid.identification.velocity_noise.velocity_noise_std`), at
     least ``step / sqrt(12)`` of a quantized column (:func:`quantization_step`).
 
     A quantized signal that moves less than a step between samples changes at a few samples

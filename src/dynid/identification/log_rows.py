@@ -23,8 +23,8 @@ from ..regressors.terms import LinearFriction, ModelTerm, base_term_columns
 from ..regressors.torque import torque_regressor_prepared
 from .dataset import ModelColumns, RegressorBlock
 from .log import TorqueLog
-from .sanity import moving_joints
 from .streaming import BLOCK_ROWS, streams
+from .velocity_noise import moving_joints
 
 #: Cycles of the cut-off frequency after which the zero-phase Butterworth low-pass has
 #: forgotten a block's edge (its slowest pole decays as ``exp(-0.38 * 2 pi f_c t)``; 14

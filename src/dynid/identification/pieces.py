@@ -12,7 +12,7 @@
 * :func:`with_start_turns`: a motor-side log with its wrapped motors unwrapped and given
   their whole turns, the first piece's from the joint positions given at its start;
 * :func:`recording_pieces`: all four for one recording, its time column checked first
-  (:func:`~dynid.identification.sanity.time_unit_finding`);
+  (:func:`~dynid.identification.angle_time_units.time_unit_finding`);
 * :func:`joined`: the pieces of one recording as one log for its checks;
 * :func:`skipped_piece`: the line of a piece left out, for the record.
 
@@ -32,8 +32,9 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from .angle_time_units import time_unit_finding
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap, with_derived_velocities
-from .sanity import time_unit_finding, too_few_samples
+from .sanity import too_few_samples
 
 __all__ = [
     "wrapped_finding",
@@ -194,7 +195,7 @@ def check_samples_and_time(name: str, log: TorqueLog) -> None:
     """Refuse a recording of too few samples
     (:func:`~dynid.identification.sanity.too_few_samples`, before any statistic of it) or
     whose time column looks like ms, us or ns
-    (:func:`~dynid.identification.sanity.time_unit_finding`).
+    (:func:`~dynid.identification.angle_time_units.time_unit_finding`).
 
     Raises
     ------
@@ -221,7 +222,7 @@ def recording_pieces(
     """One recording checked, cut at its gaps and unwrapped piece by piece.
 
     The time column is checked against the recorded velocities first
-    (:func:`~dynid.identification.sanity.time_unit_finding`); the log is cut at its gaps
+    (:func:`~dynid.identification.angle_time_units.time_unit_finding`); the log is cut at its gaps
     longer than ``max_gap_s`` (:func:`split_at_gaps`) and each piece's columns ``turns``
     (:func:`wrappable`) are unwrapped on their own (:func:`unwrapped`): a jump across a
     cut-out stretch is no wrap and does not keep the other wraps in. On a motor-side log

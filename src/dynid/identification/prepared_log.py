@@ -27,6 +27,7 @@ from .dataset import ModelColumns, RegressorBlock, TorqueRoute
 from .info import IdentificationInfo, LogInfo
 from .log import LogCleaning, TorqueLog, joint_side_log
 from .log_rows import log_blocks, still_columns, still_friction
+from .model_sign import opposite_sign
 from .prepare import (
     Preprocessing,
     fine_states,
@@ -37,14 +38,9 @@ from .prepare import (
     trimmed_margins,
 )
 from .rate import cutoff_from_motion, decimation, motion_frequency
-from .sanity import (
-    check_torque_log,
-    moving_joints,
-    opposite_sign,
-    too_few_samples,
-    velocity_noise_std,
-)
+from .sanity import check_torque_log, too_few_samples
 from .serial import Serial, hac_lag
+from .velocity_noise import moving_joints, velocity_noise_std
 
 __all__ = ["MAX_FINE_BYTES", "PreparedLog", "prepare_torque_log"]
 
@@ -84,7 +80,7 @@ class PreparedLog(TorqueRoute):
         The raw log's counts (``n_samples``, ``duration``, ``cleaning``).
     torque_noise_std : ndarray, shape (n,), or None
         White-noise std [N m] per joint of the raw log's joint-side torques
-        (:func:`~dynid.identification.sanity.velocity_noise_std`, which reads any signal's).
+        (:func:`~dynid.identification.velocity_noise.velocity_noise_std`, which reads any signal's).
     tau_raw : ndarray, shape like ``log.tau``, or None
         The joint-side torques at the prepared samples as measured, not low-passed (None
         when the log was not filtered): the held-out judgement predicts them, as

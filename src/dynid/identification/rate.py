@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .log import DEFAULT_CUTOFF_HZ
-from .sanity import moving_joints
+from .velocity_noise import moving_joints
 
 __all__ = [
     "BRIDGE_GROWTH",

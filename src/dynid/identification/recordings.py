@@ -9,7 +9,7 @@ Here:
 
 1. every log's time column is checked against its recorded velocities (a time column in
    ms, us or ns is refused with the remedy,
-   :func:`~dynid.identification.sanity.time_unit_finding`), then cut at each gap longer
+   :func:`~dynid.identification.angle_time_units.time_unit_finding`), then cut at each gap longer
    than ``max_gap_s`` (default :func:`~dynid.identification.log.default_max_gap`: one or
    two lost samples are bridged, longer gaps cut) into **pieces**;
 2. in each piece, the joints that can wrap (a continuous joint, a motor of a motor-side
@@ -79,17 +79,13 @@ from .prepare import (
 )
 from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
-from .sanity import (
-    check_torque_log,
-    despiked,
-    noise_band,
-    recording_sign_findings,
-    spike_finding,
-    velocity_noise_std,
-)
+from .recorded_signs import recording_sign_findings
+from .sanity import check_torque_log
 from .serial import Serial, serial_of_pieces
+from .spikes import despiked, spike_finding
 from .streaming import streams
 from .trim import common_cutoff, edge_seconds, within_edges
+from .velocity_noise import noise_band, velocity_noise_std
 
 __all__ = [
     "WRAP_SPAN",
@@ -179,7 +175,7 @@ class Recordings(TorqueRoute):
     band : ndarray, shape (n,)
         Standstill band [rad/s] per joint (motor, where the drive's friction acts there):
         the velocity noise band of the raw logs
-        (:func:`~dynid.identification.sanity.noise_band`); for velocities derived from the
+        (:func:`~dynid.identification.velocity_noise.noise_band`); for velocities derived from the
         positions, the noise they carry divided by ``band_gain``
         (:mod:`~dynid.identification.derived_band`).
     skipped : tuple of str
@@ -464,7 +460,7 @@ def prepare_recordings(
         No recording, or no piece long enough to filter (the files are named); a
         recording with columns recorded reversed or torques of the opposite sign to the
         robot's or to the other recordings' (the first finding of
-        :func:`~dynid.identification.sanity.recording_sign_findings`, named).
+        :func:`~dynid.identification.recorded_signs.recording_sign_findings`, named).
     ShapeError
         A recording with another number of joints than the robot (named).
     """
@@ -730,7 +726,7 @@ def standstill_band(
     -------
     ndarray, shape (n,)
         ``lowpass_noise_gain`` at the pieces' median rate times the raw velocities' noise
-        band (:func:`~dynid.identification.sanity.noise_band`; for derived velocities the
+        band (:func:`~dynid.identification.velocity_noise.noise_band`; for derived velocities the
         band of :mod:`~dynid.identification.derived_band`, divided by that gain): the
         noise band of the prepared velocities (a UR5 at 500 Hz, 0.002 rad/s of velocity
         noise, 5 Hz: 0.0004 rad/s, against 0.01 rad/s for the raw velocities).

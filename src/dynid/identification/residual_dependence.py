@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 from ..model.robot import Robot
 from .gravity_tilt import GravityTilt
 from .residual_spring import ResidualSpring
-from .verdict import SYSTEMATIC_RATIO, Verdict, with_hint
+from .verdict import ROUND_OFF_PERCENT, SYSTEMATIC_RATIO, Verdict, with_hint
 
 if TYPE_CHECKING:
     from .model import IdentifiedModel
@@ -50,8 +50,11 @@ __all__ = [
     "held_terms",
     "judged_springs",
     "outside_model_note",
+    "ROUND_OFF",
     "position_led",
     "residual_dependence",
+    "round_off",
+    "round_off_note",
     "with_dependence_hint",
 ]
 
@@ -64,6 +67,10 @@ MIN_PER_BIN = 10
 #: A coordinate names the residual when it explains at least this share of its part above
 #: the noise (RMS).
 FOLLOWS = 0.5
+#: The whole residual's RMS over the torques' RMS below which a prediction is exact to
+#: round-off (:data:`~dynid.identification.verdict.ROUND_OFF_PERCENT`): its error over a
+#: noise floor itself at the file's rounding says nothing of the model.
+ROUND_OFF = ROUND_OFF_PERCENT / 100.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -341,6 +348,33 @@ def dependence_hint(
     return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
 
 
+def round_off(
+    error: Sequence[NDArray[np.float64]], torques: Sequence[NDArray[np.float64]] | None
+) -> float | None:
+    """The RMS of the residuals ``error`` over that of the measured ``torques`` (pieces of
+    (N_k, n) [N m], every joint pooled) when below :data:`ROUND_OFF`: a prediction exact to
+    round-off, whose residual is no systematic one; None above it or without torques."""
+    if torques is None or not len(error):
+        return None
+    e = np.concatenate([np.asarray(x, dtype=np.float64).ravel() for x in error])
+    t = np.concatenate([np.asarray(x, dtype=np.float64).ravel() for x in torques])
+    scale = float(np.sqrt(np.mean(t**2))) if t.size else 0.0
+    if not e.size or not scale > 0 or not np.all(np.isfinite(e)):
+        return None
+    relative = float(np.sqrt(np.mean(e**2))) / scale
+    return relative if relative < ROUND_OFF else None
+
+
+def round_off_note(relative: float, what: str = "the prediction") -> str:
+    """``what`` is exact to round-off: its residual ``relative`` of the torques' RMS
+    (:func:`round_off`) said in words, not called systematic."""
+    return (
+        f"{what} is exact to round-off (residual {relative:.2g} of the torques' RMS): what "
+        "is above a noise floor itself at round-off is no systematic residual, no effect "
+        "outside the model"
+    )
+
+
 def with_dependence_hint(
     verdict: Verdict,
     q: Sequence[NDArray[np.float64]],
@@ -352,15 +386,20 @@ def with_dependence_hint(
     tilt: GravityTilt | None = None,
     ratios: NDArray[np.float64] | None = None,
     springs: ResidualSpring | None = None,
+    torques: Sequence[NDArray[np.float64]] | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
-    (not ``"good"``) and a joint is above its noise; else ``verdict`` itself. ``terms``: the
+    (not ``"good"``) and a joint is above its noise; else ``verdict`` itself; with the
+    measured ``torques`` (pieces as ``error``), a residual exact to round-off
+    (:func:`round_off`) is said so instead of diagnosed. ``terms``: the
     model's (:func:`held_terms`); ``tilt``: the tilt of the gravity vector the residual
     points to, said first when it explains it; ``ratios``: the verdict's per joint, which
     say which joints are above their noise; ``springs``: the stiffness per joint fitted
     with the model, said for a spring's joint."""
     if verdict.level == "good":
         return verdict
+    if (exact := round_off(error, torques)) is not None:
+        return with_hint(verdict, round_off_note(exact))
     said = dependence_hint(q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs)
     return with_hint(verdict, said)
 

@@ -89,8 +89,8 @@ from .least_squares import StdMethod, within_motion_caveat
 from .log import TorqueLog
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
+from .model_sign import gravity_loaded, sign_confirmed
 from .recordings import Recordings, prepare_recordings
-from .sanity import gravity_loaded, sign_confirmed
 from .structural import absorbed_by
 from .structure import (
     ERROR_FLOOR_PERCENT,
@@ -892,8 +892,8 @@ def _fitted_structure(
     Refused (:class:`~dynid.exceptions.DataError`), as a flipped joint gravity loads is
     before any fit: friction the held-out data need to put energy in at every speed
     (:func:`reversed_friction`) on a joint whose sign the check against gravity does not
-    judge (:func:`~.sanity.gravity_loaded`) nor the whole rigid-body torques confirm
-    (:func:`~.sanity.sign_confirmed`), a torque of the opposite sign there. On a joint
+    judge (:func:`~.model_sign.gravity_loaded`) nor the whole rigid-body torques confirm
+    (:func:`~.model_sign.sign_confirmed`), a torque of the opposite sign there. On a joint
     they judge the sign is right (a controller's compensation, ``-0.05 dq2``; a short
     log's loose viscous coefficient), and that friction is left out instead."""
     if selection is not None and (pushing := reversed_friction(selection)):

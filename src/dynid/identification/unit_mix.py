@@ -41,8 +41,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
+from .angle_time_units import RATE_AGREES, joint_rate_factor, rate_verdict
 from .log import TorqueLog
-from .sanity import _RATE_AGREES, _rate_verdict, joint_rate_factor
 
 __all__ = ["DEGREE_TOLERANCE", "FREE_SPEED_FACTOR", "degrees_among_radians", "joints_in_degrees"]
 
@@ -135,7 +135,7 @@ def _free_in_degrees(robot: Robot, log: TorqueLog, j: int) -> tuple[str, bool] |
     if not np.isfinite(k):
         return None
     name = robot.joint_names[j]
-    if abs(k / _DEG - 1.0) < _RATE_AGREES:
+    if abs(k / _DEG - 1.0) < RATE_AGREES:
         return (
             f"{name} (no position limits) has velocities {k:.3g} times slower than the "
             "derivative of its positions",
@@ -143,7 +143,7 @@ def _free_in_degrees(robot: Robot, log: TorqueLog, j: int) -> tuple[str, bool] |
         )
     fast = float(robot.dq_max[j]) if np.isfinite(robot.dq_max[j]) else 2 * np.pi
     peak = float(np.quantile(np.abs(log.dq[:, j]), 0.99))
-    if abs(k - 1.0) < _RATE_AGREES and FREE_SPEED_FACTOR * fast < peak <= 1.5 * fast * _DEG:
+    if abs(k - 1.0) < RATE_AGREES and FREE_SPEED_FACTOR * fast < peak <= 1.5 * fast * _DEG:
         return (
             f"{name} (no position limits) moves at up to {peak:.4g} per second, "
             f"{peak / fast:.3g} times its speed limit {fast:.3g} rad/s",
@@ -180,7 +180,7 @@ def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list
         & (hi / _DEG <= q_max + margin)
     )
     thin = TorqueLog(log.t[::step], q, log.dq[::step], log.tau[::step])
-    verdicts = {j: _rate_verdict(robot, thin, j) for j in map(int, np.flatnonzero(suspect))}
+    verdicts = {j: rate_verdict(robot, thin, j) for j in map(int, np.flatnonzero(suspect))}
     hints = {j: v[1] for j, v in verdicts.items() if v is not None}
     found = list(hints)
     unbounded = map(int, np.flatnonzero(moving & ~np.isfinite(width)))

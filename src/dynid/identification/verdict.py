@@ -62,6 +62,7 @@ __all__ = [
     "JOINT_GOOD",
     "LEVELS",
     "NEGLIGIBLE_PERCENT",
+    "ROUND_OFF_PERCENT",
     "NOISE_FLOOR_SHARE",
     "SYSTEMATIC_RATIO",
     "UNUSABLE_PERCENT",
@@ -97,6 +98,11 @@ JOINT_GOOD, JOINT_FAIR = 10.0, 25.0
 SYSTEMATIC_RATIO = 1.25
 #: Relative error [%] below which a prediction is good whatever its noise floor.
 NEGLIGIBLE_PERCENT = 0.01
+#: Relative error [%] of a joint below which its residual is round-off, never systematic
+#: whatever its ratio to a noise floor itself at round-off: noise-free logs of the geared
+#: Panda with its coupled wrist, written to CSV and filtered, left 2e-5 to 4e-4 % per joint
+#: at 5 to 40 x their floor; a noisy log leaves its noise, 0.1 % and more.
+ROUND_OFF_PERCENT = 1e-3
 #: A joint's torque noise counts at least this share of the largest joint's: a joint whose
 #: noise estimate is next to nothing (a quantised or filtered sensor) must not outweigh
 #: every other (the whitened judgement of the structure choice and the verdict).
@@ -161,7 +167,8 @@ def joint_levels(
     percent: ArrayLike | None, ratios: ArrayLike | None, rough: ArrayLike | None = None
 ) -> tuple[Level, ...]:
     """Each joint's level: good within :data:`SYSTEMATIC_RATIO` x its noise (where the
-    ratio is unknown, below :data:`JOINT_GOOD` % relative error), fair below
+    ratio is unknown, below :data:`JOINT_GOOD` % relative error; below
+    :data:`ROUND_OFF_PERCENT` %, round-off, whatever the ratio), fair below
     :data:`JOINT_FAIR` % or within :data:`FLOOR_FAIR` x, else poor. A joint whose error
     is a few percent of large torques is not good when that is twice its noise: the
     residual is systematic. A ``rough`` joint, whose noise is mostly the states' noise
@@ -202,6 +209,7 @@ def joint_levels(
         raise ShapeError(f"rough has {est.size} joints, ratios {n}")
     unknown = np.isnan(p) & np.isnan(r)
     relative = (np.isnan(r) | est) & (p < JOINT_GOOD)  # judged in relative terms too
+    relative |= p < ROUND_OFF_PERCENT  # round-off over a floor at round-off: no residual
     limit = np.where(est, FLOOR_GOOD, SYSTEMATIC_RATIO)
     p, r = np.where(np.isnan(p), np.inf, p), np.where(np.isnan(r), np.inf, r)
     levels: list[Level] = []
@@ -402,7 +410,7 @@ def with_hint(verdict: Verdict, hint: str | None, joiner: str = "; ") -> Verdict
 
 def with_replaced_spikes(verdict: Verdict, count: int, detail: str = "") -> Verdict:
     """``verdict`` with its reason saying that it was judged with ``count`` one-sample torque
-    spikes replaced (:func:`~dynid.identification.sanity.despiked`), ``detail`` appended
+    spikes replaced (:func:`~dynid.identification.spikes.despiked`), ``detail`` appended
     (``", as the fit replaced them"``, the files); ``verdict`` itself when ``count`` is 0."""
     if count <= 0:
         return verdict

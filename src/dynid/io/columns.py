@@ -399,7 +399,9 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
     def layout(names: list[str], line: int) -> dict[str, list[int]]:
         dup = sorted({c for c in names if names.count(c) > 1})
         if dup:
-            raise DataError(f"duplicate column(s) {dup}", file=path.name, at=f"line {line}")
+            raise DataError(
+                f"duplicate column(s) {_checks.names(dup)}", file=path.name, at=f"line {line}"
+            )
         wanted = _referenced(names, cmap, quantities)
         if not wanted:
             raise DataError(
@@ -499,7 +501,10 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
     if len(missing) == n:
         return None
     if missing:
-        raise DataError(f"missing column(s) {missing} for {quantity!r} ({tpl!r})", file=table.name)
+        raise DataError(
+            f"missing column(s) {_checks.names(missing)} for {quantity!r} ({tpl!r})",
+            file=table.name,
+        )
     group = table.groups.get(quantity)
     # the columns of a group scaled as read are in SI (the first n of the group: names)
     f = 1.0 if quantity in table.scaled else cmap.factor(quantity)

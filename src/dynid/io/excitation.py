@@ -385,7 +385,7 @@ def _trajectory_csv(path: Path, n: int) -> Trajectory:
         dup = sorted({c for c in names if names.count(c) > 1})
         if dup:
             raise DataError(
-                f"duplicated column(s) {_checks.short(dup)}; each column must appear once",
+                f"duplicated column(s) {_checks.names(dup)}; each column must appear once",
                 file=path.name,
                 at=at,
             )
@@ -397,12 +397,12 @@ def _trajectory_csv(path: Path, n: int) -> Trajectory:
         missing = [c for c in want if c not in names]
         if missing:
             raise DataError(
-                f"missing column(s) {_checks.short(missing)} for {n} joints", file=path.name, at=at
+                f"missing column(s) {_checks.names(missing)} for {n} joints", file=path.name, at=at
             )
         unknown = [c for c in names if c not in want]
         if unknown:
             raise DataError(
-                f"unknown column(s) {_checks.short(unknown)}; a trajectory of {n} "
+                f"unknown column(s) {_checks.names(unknown)}; a trajectory of {n} "
                 f"joints has t, q1..q{n}, dq1..dq{n}, ddq1..ddq{n}",
                 file=path.name,
                 at=at,

@@ -72,7 +72,7 @@ def check_npz(path: str | Path) -> None:
             dup = sorted({n for n in names if names.count(n) > 1})
             if dup:  # numpy reads the last one of a name silently
                 raise DataError(
-                    f"duplicated array(s) {_checks.short(dup)}; an array may appear once",
+                    f"duplicated array(s) {_checks.names(dup)}; an array may appear once",
                     file=path.name,
                 )
             total = sum(i.file_size for i in infos)

@@ -255,7 +255,9 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
     """Validate the header; return the joint count."""
     dup = sorted({c for c in header if header.count(c) > 1})
     if dup:
-        raise DataError(f"duplicated columns {dup}", file=path.name, at=f"line {line}")
+        raise DataError(
+            f"duplicated columns {_checks.names(dup)}", file=path.name, at=f"line {line}"
+        )
     qcols = [c for c in header if re.fullmatch(r"q[1-9]\d*", c)]
     if not qcols:
         raise DataError(
@@ -277,13 +279,15 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
     extra = [c for c in header if c not in expected]
     if missing:
         raise DataError(
-            f"missing columns {missing}; expected q1..q{n}, M<i>_<j> (i >= j) and g1..g{n}",
+            f"missing columns {_checks.names(missing)}; expected q1..q{n}, M<i>_<j> (i >= j) "
+            f"and g1..g{n}",
             file=path.name,
             at=f"line {line}",
         )
     if extra:
         raise DataError(
-            f"unexpected columns {extra}; expected q1..q{n}, M<i>_<j> (i >= j) and g1..g{n} only",
+            f"unexpected columns {_checks.names(extra)}; expected q1..q{n}, M<i>_<j> (i >= j) "
+            f"and g1..g{n} only",
             file=path.name,
             at=f"line {line}",
         )
@@ -362,10 +366,13 @@ def load_static_npz(
             missing = [k for k in _NPZ_KEYS if k not in keys]
             extra = sorted(keys - set(_NPZ_KEYS) - {"metadata", "n_rows"})
             if missing:
-                raise DataError(f"missing arrays {missing}; expected q, M, g", file=path.name)
+                raise DataError(
+                    f"missing arrays {_checks.names(missing)}; expected q, M, g", file=path.name
+                )
             if extra:
                 raise DataError(
-                    f"unexpected arrays {extra}; expected q, M, g (and metadata)", file=path.name
+                    f"unexpected arrays {_checks.names(extra)}; expected q, M, g (and metadata)",
+                    file=path.name,
                 )
             arrays = {k: np.asarray(z[k]) for k in _NPZ_KEYS}
             meta_text = str(z["metadata"]) if "metadata" in keys else "{}"

@@ -386,8 +386,9 @@ def _read_npz(path: Path) -> dict[str, NDArray[np.float64]]:
             missing = [k for k in ("t", "q", "tau") if k not in npz.files]
             if missing:
                 raise DataError(
-                    f"missing array(s) {missing}; expected t, q, tau (optional "
-                    f"dq, derived from q when absent, and ddq); found {sorted(npz.files)}",
+                    f"missing array(s) {_checks.names(missing)}; expected t, q, tau (optional "
+                    f"dq, derived from q when absent, and ddq); found "
+                    f"{_checks.names(sorted(npz.files))}",
                     file=path.name,
                 )
             extra = sorted(set(npz.files) - {"t", "n_rows", *_SIGNALS})
@@ -457,7 +458,9 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     dup = sorted({c for c in names if names.count(c) > 1})
     if dup:
         raise DataError(
-            f"duplicated column(s) {dup}; each column must appear once", file=path.name, at=at
+            f"duplicated column(s) {_checks.names(dup)}; each column must appear once",
+            file=path.name,
+            at=at,
         )
     qs = sorted(int(c[1:]) for c in names if re.fullmatch(r"q[1-9]\d*", c))
     n = len(qs)
@@ -467,9 +470,15 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
         if not hint and time is not None and (k := position_count(names)):
             signals = [s for s in ("q", "tau") if f"{s}1" not in names]
             optional = ["dq"] if "dq1" not in names else []
+            unit = re.search(r"(ms|us|ns)$", time.lower())
             hint = column_hint(names, k, signals, {time}, optional).split("; hint: ", 1)[-1]
-            if time != "t" and "--columns '" in hint:  # the time column mapped too
-                unit = re.search(r"(ms|us|ns)$", time.lower())
+            if not signals and time != "t":  # the joints' columns named right, not the time
+                hint = (
+                    f"--columns 't={time}'"
+                    + (f" --units t={unit[1]}" if unit else "")
+                    + f" reads {time} as the time, or name it t"
+                )
+            elif time != "t" and "--columns '" in hint:  # the time column mapped too
                 hint = hint.replace("--columns '", f"--columns 't={time},", 1)
                 hint = hint.replace(
                     "' reads them",
@@ -479,7 +488,7 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
             hint = f"; hint: {hint}"
         raise DataError(
             f"header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
-            f"got {names[:8]}{' ...' if len(names) > 8 else ''}{hint}",
+            f"got {_checks.names(names)}{hint}",
             file=path.name,
             at=at,
         )
@@ -504,7 +513,7 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     have = [c for c in ddq if c in names]
     if have and len(have) != n:
         raise DataError(
-            f"accelerations must be all of ddq1..ddq{n} or none; got only {have}",
+            f"accelerations must be all of ddq1..ddq{n} or none; got only {_checks.names(have)}",
             file=path.name,
             at=at,
         )
@@ -512,7 +521,7 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     signals = [c for c in unknown if re.fullmatch(r"(q|dq|tau|ddq)\d+", c)]
     if signals:
         raise DataError(
-            f"unknown column(s) {signals}; a torque log has t, q1..q{n}, "
+            f"unknown column(s) {_checks.names(signals)}; a torque log has t, q1..q{n}, "
             f"dq1..dq{n} (optional: derived from q when absent), tau1..tau{n} and optionally "
             f"ddq1..ddq{n}",
             file=path.name,
@@ -529,13 +538,13 @@ LABEL_COLUMNS = ("collision", "contact", "label")
 
 
 def _span(columns: list[str]) -> str:
-    """Columns for a message: ``tau1..tau7`` for a run of one signal, else the list."""
+    """Columns for a message: ``tau1..tau7`` for a run of one signal, else their names."""
     m = [re.fullmatch(r"([a-z]+)(\d+)", c) for c in columns]
     if len(columns) > 2 and all(m) and len({x.group(1) for x in m if x}) == 1:
         idx = [int(x.group(2)) for x in m if x]
         if idx == list(range(idx[0], idx[0] + len(idx))):
             return f"{columns[0]}..{columns[-1]}"
-    return _checks.short(columns)
+    return _checks.names(columns)
 
 
 def _say_unread(name: str, kind: str, extra: list[str]) -> None:
@@ -554,7 +563,7 @@ def _say_unread(name: str, kind: str, extra: list[str]) -> None:
             "events against them)",
             name,
             kind,
-            _checks.short(labels),
+            _checks.names(labels),
         )
     if truth:
         span = truth[0] if len(truth) == 1 else f"{truth[0]}..{truth[-1]}"
@@ -567,7 +576,7 @@ def _say_unread(name: str, kind: str, extra: list[str]) -> None:
         )
     if rest:
         _log.warning(
-            "%s: %s %s are not torque-log signals: ignored as data", name, kind, _checks.short(rest)
+            "%s: %s %s are not torque-log signals: ignored as data", name, kind, _checks.names(rest)
         )
 
 

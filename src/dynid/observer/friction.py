@@ -134,7 +134,7 @@ def velocity_bands(
     :data:`~dynid.identification.sanity.NOISE_BAND_STD`, the median of its estimates over
     windows of :data:`_NOISE_WINDOW` samples); zeros for fewer than 4 samples.
     """
-    from ..identification.sanity import noise_band, velocity_noise_std
+    from ..identification.velocity_noise import noise_band, velocity_noise_std
 
     v = np.asarray(dq, dtype=np.float64)
     parts = friction_parts(friction)
@@ -164,7 +164,7 @@ def noise_bands(
     independent per joint: :data:`~dynid.identification.sanity.NOISE_BAND_STD` times
     ``sqrt(K^2 dq_std^2)`` through the part's transmission ``K`` (the noise a validation's
     prepared velocities carry, :func:`~dynid.identification.input_noise.state_noise`)."""
-    from ..identification.sanity import noise_band
+    from ..identification.velocity_noise import noise_band
 
     var = np.asarray(dq_std, dtype=np.float64) ** 2
     return tuple(
@@ -186,7 +186,7 @@ def derived_velocity_bands(
     position noise of each motor (:func:`~dynid.identification.sanity.velocity_noise_std`
     of its positions, the median over windows) times the filter's noise gain; zeros for
     fewer than 4 samples."""
-    from ..identification.sanity import noise_band, velocity_noise_std
+    from ..identification.velocity_noise import noise_band, velocity_noise_std
     from ..signals import derivative_noise_gain
 
     parts = friction_parts(friction)

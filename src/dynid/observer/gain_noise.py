@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..identification.sanity import velocity_noise_std
+from ..identification.velocity_noise import velocity_noise_std
 from .model import ObserverModel
 
 __all__ = ["DOMINANT", "GainNoise", "GainNoiseTally"]

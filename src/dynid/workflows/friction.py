@@ -46,7 +46,7 @@ from ..friction.select import (
 )
 from ..friction.validation import RECORDED, own_friction
 from ..identification.model import IdentifiedModel
-from ..identification.sanity import SPIKES_BEFORE_FIT
+from ..identification.spikes import SPIKES_BEFORE_FIT
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, in_file

@@ -44,7 +44,7 @@ from ..identification.gravity_scale import gravity_scale_finding
 from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
-from ..identification.residual_dependence import outside_model_note
+from ..identification.residual_dependence import outside_model_note, round_off_note
 from ..identification.selection import identify_recordings
 from ..identification.static import identify_static
 from ..identification.structure import Structure
@@ -513,10 +513,18 @@ def _with_outside_model_note(
 ) -> ConsistentResult:
     """``result`` with the note that least squares' own held-out residual is systematic
     (:func:`~dynid.identification.residual_dependence.outside_model_note`) first, when its
-    held-out judgement rejected it; else ``result`` itself."""
+    held-out judgement rejected it, or that it is exact to round-off, no systematic one
+    (:func:`~dynid.identification.residual_dependence.round_off_note`); else ``result``
+    itself."""
     if held is None or result.heldout is None or result.heldout.accepted:
         return result
-    said = outside_model_note(held.systematic, names, held.terms)
+    said: str | None
+    if (exact := held.round_off) is not None:
+        said = round_off_note(exact, "least squares' held-out prediction") + (
+            ": the consistent fit's larger error is its constraints' and its prior's"
+        )
+    else:
+        said = outside_model_note(held.systematic, names, held.terms)
     return result if said is None else dataclasses.replace(result, notes=(said, *result.notes))
 
 

@@ -73,7 +73,7 @@ from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..identification.model import IdentifiedModel
-from ..identification.sanity import SPIKES_BEFORE_OBSERVER
+from ..identification.spikes import SPIKES_BEFORE_OBSERVER
 from ..io.columns import ColumnMap
 from ..io.drive_file import drive_of_robot_file, load_drive
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction

@@ -33,7 +33,7 @@ from ..feasibility.payload import (
 )
 from ..feasibility.payload_arm import ArmFriction
 from ..identification.model import IdentifiedModel
-from ..identification.sanity import SPIKES_BEFORE_FIT
+from ..identification.spikes import SPIKES_BEFORE_FIT
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..model.drive import Drive
 from ..model.robot import Robot

@@ -8,7 +8,7 @@ line naming the file, never a recording dropped silently:
 
 * an empty file, NaN/inf or a repeated timestamp (without ``drop_invalid``), another
   joint count than the model's: the reader's error, naming the file;
-* a time column in ms, us or ns (:func:`~dynid.identification.sanity.time_unit_finding`):
+* a time column in ms, us or ns (:func:`~dynid.identification.angle_time_units.time_unit_finding`):
   an error naming the file and ``--units t=ms``;
 * a recording in other units than the others (its torques, or its velocities against the
   derivative of its positions on the joints that move, a power of ten away from the other
@@ -30,7 +30,7 @@ unwrapped by the preparation's rule (:func:`unwrapped_recorded`), not a whole tu
   (:func:`check_torque_unit`; ``identify`` and ``observe`` alike);
 * a recording whose positions lie far outside the model's joint limits (of another robot):
   a warning naming it;
-* one-sample torque spikes (:func:`~dynid.identification.sanity.despiked`, the rule
+* one-sample torque spikes (:func:`~dynid.identification.spikes.despiked`, the rule
   ``identify`` applies before fitting): replaced by :func:`despiked_recordings`
   (``validate`` before judging, ``observe`` before the observer runs), with a warning per
   file naming the joints, the counts and the times.
@@ -51,20 +51,15 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError, DynidWarning, OptionError
+from ..identification.angle_time_units import time_unit_finding
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, velocity_note
+from ..identification.model_sign import sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
-from ..identification.sanity import (
-    SignFinding,
-    despiked,
-    moving_joints,
-    recording_sign_findings,
-    sign_confirmed,
-    spike_finding,
-    time_unit_finding,
-    too_few_samples,
-    torque_unit_finding,
-)
+from ..identification.recorded_signs import SignFinding, recording_sign_findings
+from ..identification.sanity import too_few_samples, torque_unit_finding
+from ..identification.spikes import despiked, spike_finding
 from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
+from ..identification.velocity_noise import moving_joints
 from ..io.columns import CURRENT_UNITS, ColumnMap, parse_column_map
 from ..io.torque_log import declared_tau_unit
 from ..model.drive import Drive
@@ -247,10 +242,10 @@ def despiked_recordings(
     rec: Recorded, joint_names: Sequence[str], before: str, min_rate_hz: float = 0.0
 ) -> tuple[Recorded, tuple[int, ...]]:
     """The recordings with their one-sample torque spikes replaced by the line between their
-    neighbours (:func:`~dynid.identification.sanity.despiked`, the rule ``identify``
+    neighbours (:func:`~dynid.identification.spikes.despiked`, the rule ``identify``
     applies before fitting), a warning per recording with spikes naming it, the joints,
     the counts, the times and ``before`` what they were replaced
-    (:func:`~dynid.identification.sanity.spike_finding`); and the torque samples replaced
+    (:func:`~dynid.identification.spikes.spike_finding`); and the torque samples replaced
     per recording. A recording sampled below ``min_rate_hz`` [Hz] keeps its spikes, said
     in its warning (``observe``: at 100 Hz a short impact can be one sample)."""
     logs, counts = [], []
@@ -425,7 +420,7 @@ def sign_findings(
     rec: Recorded, robot: Robot, skip: Sequence[str] = (), reference: Any = None
 ) -> dict[str, str]:
     """Per recording (by name), its sign finding, by the one rule ``identify`` refuses by
-    (:func:`~dynid.identification.sanity.recording_sign_findings`): columns recorded
+    (:func:`~dynid.identification.recorded_signs.recording_sign_findings`): columns recorded
     reversed (a motor mounted the other way: its position and effort negated), its
     (joint-side) torques of the opposite sign to the robot's on every joint gravity loads
     or on some, or a motor (joint) the links barely load of the opposite sign to the other
@@ -488,7 +483,7 @@ def recorded_sign_map_findings(
     """Per recording (by name), the finding that the sign flips of the model's recorded
     ``--units`` (``tau3=-1``, applied because no ``units`` were given) look wrong for it:
     a flipped joint whose torques the robot's rigid-body torques confirm as the file holds
-    them and not as read (:func:`~dynid.identification.sanity.sign_confirmed`). Said
+    them and not as read (:func:`~dynid.identification.model_sign.sign_confirmed`). Said
     first, naming the joints and the ``--units`` that reads the file without the flips;
     the verdict judges the torques as read. Empty without such a recording.
 

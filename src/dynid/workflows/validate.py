@@ -67,9 +67,10 @@ from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
 from ..identification.pieces import check_below_nyquist
+from ..identification.recorded_signs import SignFinding
 from ..identification.residual_dependence import held_terms, with_dependence_hint
 from ..identification.residual_spring import ResidualSpring
-from ..identification.sanity import SPIKES_BEFORE_JUDGING, SignFinding
+from ..identification.spikes import SPIKES_BEFORE_JUDGING
 from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -431,8 +432,9 @@ def _with_hints(
         whole = joined_validation(val.parts) if verdict.level != "good" else None
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
+        tau = [v.log.tau for v in val.parts]
         verdict = with_dependence_hint(
-            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs
+            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau
         )
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
@@ -561,7 +563,7 @@ def _model_friction(
 ) -> NDArray[np.float64] | None:
     """An identified model's own ``fv, fc, Ia`` (n, 3) per motor (joint) where ``drive``
     puts the friction, the reference a recording's own friction and rotor are compared
-    with (:func:`~dynid.identification.sanity.opposite_friction_among`): its one friction
+    with (:func:`~dynid.identification.recorded_signs.opposite_friction_among`): its one friction
     term's viscous and Coulomb coefficients, its rotor inertias (zeros without them);
     None for a robot, a model of several friction terms, or friction placed elsewhere."""
     if not isinstance(model, IdentifiedModel) or len(model.frictions) != 1:

@@ -12,7 +12,7 @@ stands still the measured velocity is encoder noise: ``sign(dq)`` of noise would
 full Coulomb torque on at rest. Every law here uses :func:`coulomb_sign`, which is
 ``sign(dq)`` where ``|dq|`` exceeds the joint's standstill band ``b`` and 0 inside it, in
 fitting and in evaluation alike. The band is the velocity noise band of
-:func:`~dynid.identification.sanity.noise_band` (``5 sigma``, ``sigma`` the white-noise std
+:func:`~dynid.identification.velocity_noise.noise_band` (``5 sigma``, ``sigma`` the white-noise std
 of the measured velocity, the band inside which a joint counts as still); a model with
 ``b = 0`` (a noise-free log, or a file without a band) uses the plain ``sign(dq)``
 (``sign(0) = 0``).

@@ -1,0 +1,573 @@
+"""Signs as recorded: columns of a log recorded reversed, and one recording of the opposite
+sign to the others.
+
+* **Reversed columns**: a motor or encoder mounted the other way, its position and velocity
+  (with its effort or without) of the opposite sign; several at once, named in the log's own
+  columns (a motor-side log's motors) with one ``--units`` hint, judged through the drive
+  before the sign (:func:`reversed_joint`).
+* **Opposite sign between recordings**: of several recordings, one motor (joint) the links
+  barely load of the opposite sign to the others' is told by its own friction and rotor
+  (:func:`opposite_friction_among`).
+
+:func:`recording_sign_findings` runs these sign checks, with the sign against the model's
+torques (:func:`~dynid.identification.model_sign.opposite_sign_among`), in the one order
+``identify``, ``validate`` and ``observe`` share.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..dynamics.rnea import rnea
+from ..model.drive import Drive
+from ..model.robot import Robot
+from .log import TorqueLog, joint_side_log
+from .model_sign import (
+    CHECKED_SAMPLES,
+    NEGATED_DISTANCE_SHARE,
+    NEGATED_MODEL_SHARE,
+    flip_entries,
+    motion_accelerations,
+    opposite_sign_among,
+)
+
+__all__ = [
+    "opposite_friction_among",
+    "reversed_joint",
+    "recording_sign_findings",
+    "SignFinding",
+    "REVERSED_MODEL_SHARE",
+    "REVERSED_STEP_SHARE",
+]
+
+
+#: :func:`reversed_joint` questions a log whose residual, each motor's own friction and
+#: rotor taken out, is at least this share of the RMS of what they leave of the torques
+#: (the links' share; clean simulated Panda logs left 0.04, and 0.05 geared with rotors
+#: that outweigh the links; a geared Panda's motor 3 logged reversed 0.37, 0.053 once
+#: reversed).
+REVERSED_MODEL_SHARE = 0.1
+#: :func:`reversed_joint` changes one more column's signs while that leaves at most this
+#: share of the sum of squares left before (a Panda's joints 2 and 5 reversed: joint 2
+#: alone left 0.004 of it as read, joint 5 alone 0.99, both 1.3e-4; a geared Panda's
+#: motors 3 and 6: motor 1 alone left 0.15 against motor 3's 0.18, joints 1 and 3 being
+#: parallel near q2 = 0, and the move from motor 1 to motor 3 then 0.011 for 0.072).
+REVERSED_STEP_SHARE = 0.75
+
+
+@dataclass(frozen=True, slots=True)
+class _Recorded:
+    """A log's samples as recorded, for :func:`reversed_joint`: positions, velocities,
+    accelerations (one derivation, :func:`motion_accelerations`) and efforts (N, n) in
+    the log's own columns, and the drive that reads them (None: joint-side torques)."""
+
+    q: NDArray[np.float64]
+    dq: NDArray[np.float64]
+    ddq: NDArray[np.float64]
+    tau: NDArray[np.float64]
+    drive: Drive | None
+
+    @property
+    def joint_torques(self) -> NDArray[np.float64]:
+        """The efforts as joint torques [N m] (N, n)."""
+        return self.tau if self.drive is None else self.drive.joint_torques(self.tau)
+
+    def carried(self) -> float:
+        """The sum of squares [N^2 m^2] of what each motor's friction and rotor leave of the
+        joint torques (:func:`_left_over`): the links' share, which a reversal disturbs (a
+        geared arm's rotors outweigh it)."""
+        states = (self.q, self.dq, self.ddq)
+        _, dq, ddq = states if self.drive is None else self.drive.joint_states(*states)
+        return _left_over(self.joint_torques, dq, ddq, self.drive)
+
+    def left(self, robot: Robot, motion: NDArray[np.float64], torque: NDArray[np.float64]) -> float:
+        """What the model and each motor's friction and rotor leave [N^2 m^2] (sum of
+        squares over the joints) with the columns' signs ``motion`` and ``torque`` (n,)."""
+        q, dq, ddq, tau = self.q * motion, self.dq * motion, self.ddq * motion, self.tau * torque
+        if self.drive is not None:
+            q, dq, ddq = self.drive.joint_states(q, dq, ddq)
+            tau = self.drive.joint_torques(tau)
+        model = rnea(robot, q, dq, ddq)
+        if robot.spring is not None:
+            model = model + robot.spring.torques(q)
+        return _left_over(tau - model, dq, ddq, self.drive)
+
+
+def _recorded(log: TorqueLog, drive: Drive | None) -> _Recorded | None:
+    """:class:`_Recorded` of ``log`` at every k-th of its samples whose accelerations are
+    known (:func:`motion_accelerations`), or None when too few are."""
+    at = np.arange(0, log.n_samples, max(1, log.n_samples // CHECKED_SAMPLES))
+    found = motion_accelerations(log, at)
+    if found is None:
+        return None
+    ddq, ok = found
+    return _Recorded(log.q[at][ok], log.dq[at][ok], ddq[ok], log.tau[at][ok], drive)
+
+
+def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> str | None:
+    """The finding that columns of a log were recorded reversed, each position (and
+    velocity) of the opposite sign, with or without its effort (a motor mounted or wired
+    the other way: its encoder and current both negated; or the encoder alone), or None;
+    None too for a robot without inertial parameters.
+
+    ``log`` is as recorded, read through ``drive`` (motor-side positions and efforts,
+    currents): a reversed column is the log's own, a motor's of a motor-side log (a
+    coupled wrist's motor turns two joints), named so with the ``--units`` entries in the
+    log's columns (``q6=-1,tau6=-1``).
+
+    Judged on the robot's whole rigid-body torques over every joint, at the accelerations
+    :func:`motion_accelerations` derives (one derivation for the torques and the rotor
+    columns, of the sign check's whole torques too), each joint's residual freed of its
+    own viscous, Coulomb, offset and armature torques (least squares on ``dq``,
+    ``sign(dq)``, 1, ``ddq``; through a drive, each motor's, where its friction acts, and
+    its rotor's ``K^T (K ddq)``: a geared arm's rotors and motor friction, which the
+    description lacks), against the torques those columns leave (the links' share: a
+    geared arm's rotors outweigh it). The columns' signs change one step at a time
+    (:func:`_changes`: a column's position and effort, position or effort reversed, or
+    back, or a reversal moved to another column), the step that leaves least first, while
+    it leaves at most :data:`REVERSED_STEP_SHARE` of what was left; the reversed columns
+    are named when what they leave is within :data:`NEGATED_DISTANCE_SHARE` of the RMS as
+    read, where that is at least :data:`REVERSED_MODEL_SHARE` of the links' share (a model
+    that explains the log is not questioned), and below :data:`NEGATED_MODEL_SHARE` of it,
+    a position among them, and better than every torque negated (then None: that is
+    :func:`opposite_sign`'s finding, which a log of every torque negated, joint 2
+    reversed, explained to 0.41 of its residual as read; where friction outweighs gravity
+    on a joint, an encoder reversed and a torque negated look alike, and the reversal must
+    explain it better). Efforts alone negated are named beside a reversal, and left to
+    :func:`opposite_sign` without one. Judged before :func:`opposite_sign`, which read an
+    encoder reversed as a torque of the opposite sign and asked for ``tau3=-1``. Before, a
+    geared arm's motor 3 logged reversed was fitted to 34 % error with a spring suggested
+    on joint 3; a coupled wrist's motor, which turns two joints, could not be named.
+
+    Parameters
+    ----------
+    robot : Robot
+    log : TorqueLog
+        As recorded (its columns the drive's side and effort).
+    drive : Drive, optional
+        What reads ``log`` (:func:`~dynid.identification.log.joint_side_log`).
+
+    Returns
+    -------
+    str or None
+        The finding, one line with the ``--units`` entries.
+    """
+    if not np.any(robot.phi):
+        return None
+    rec = _recorded(log, drive)
+    if rec is None:
+        return None
+    one = np.ones(log.n)
+    total = rec.carried()
+    read = rec.left(robot, one, one)
+    if read < REVERSED_MODEL_SHARE**2 * total:
+        return None
+    motion, torque, left = one.copy(), one.copy(), read
+    while True:  # the change of one column (or a move to another) that leaves least
+        best = min(
+            ((rec.left(robot, m, t), m, t) for m, t in _changes(motion, torque)),
+            key=lambda x: x[0],
+        )
+        if not best[0] <= REVERSED_STEP_SHARE * left:
+            break
+        left, motion, torque = best
+    if not left < NEGATED_DISTANCE_SHARE**2 * read or not left < NEGATED_MODEL_SHARE**2 * total:
+        return None  # none explains it
+    if np.all(motion > 0):
+        return None  # torques alone negated explain it best: opposite_sign's
+    if rec.left(robot, one, -one) <= left:  # every torque of the opposite sign
+        return None
+    return _reversed_line(robot, rec.drive, motion < 0, torque < 0, (left, read, total))
+
+
+def _changes(
+    motion: NDArray[np.float64], torque: NDArray[np.float64]
+) -> Iterator[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """Every sign of the columns (``motion``, ``torque``: +-1, n) one step from these: a
+    column set to another of its signs (position and effort reversed, position alone,
+    effort alone, neither), or a reversed column's signs moved to one not reversed (a
+    Panda's joints 1 and 3, parallel when joint 2 is near zero, look alike)."""
+    states = ((-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0))
+    for j in range(motion.size):
+        for m, t in states:
+            if (m, t) != (motion[j], torque[j]):
+                ms, ts = motion.copy(), torque.copy()
+                ms[j], ts[j] = m, t
+                yield ms, ts
+    flipped = (motion < 0) | (torque < 0)
+    for i in np.flatnonzero(flipped):
+        for k in np.flatnonzero(~flipped):
+            pair = np.array([i, k])
+            ms, ts = motion.copy(), torque.copy()
+            ms[pair], ts[pair] = ms[pair[::-1]], ts[pair[::-1]]
+            yield ms, ts
+
+
+def _reversed_line(
+    robot: Robot,
+    drive: Drive | None,
+    motion: NDArray[np.bool_],
+    torque: NDArray[np.bool_],
+    sums: tuple[float, float, float],
+) -> str:
+    """:func:`reversed_joint`'s finding: the columns reversed (``motion``, n) and the
+    efforts negated (``torque``, n) named in the log's own columns (a motor-side log's
+    motors), what is left reversed and as read (``sums``: those and the torques' sums of
+    squares), the ``--units`` entries."""
+    left, read, total = sums
+    motors = drive is not None and drive.side == "motor"
+    names = [f"motor {k + 1}" if motors else robot.joint_names[k] for k in range(robot.n)]
+    rev = np.flatnonzero(motion)
+    alone = np.flatnonzero(torque & ~motion)
+    one = rev.size == 1
+    what = [
+        ("its " if one else f"{names[k]}'s ") + ("position and torque" if torque[k] else "position")
+        for k in rev
+    ] + [f"{names[k]}'s torque" for k in alone]
+    cols = ",".join(
+        [f"q{k + 1}=-1" + (f",tau{k + 1}=-1" if torque[k] else "") for k in rev]
+        + [f"tau{k + 1}=-1" for k in alone]
+    )
+    rates = ", ".join(f"dq{k + 1}=-1, ddq{k + 1}=-1" for k in rev)
+    gears = drive is not None and not drive.is_coupled and bool(np.all(torque[rev]))
+    return (
+        f"{', '.join(names[k] for k in rev)} {'looks' if one else 'look'} recorded reversed: "
+        f"{', '.join(what)} of the opposite sign to the model's convention (with "
+        f"{'it' if one else 'them'} reversed, what the model and each "
+        + ("motor's friction and rotor" if drive is not None else "joint's friction and armature")
+        + f" leave is {np.sqrt(left / total):.2g} of the RMS of the torques the links carry "
+        f"(what that friction leaves of them), {np.sqrt(read / total):.2g} as read): a "
+        "motor or encoder mounted the other way; "
+        f"hint: --units {cols} reads {'it' if one else 'them'} so (and {rates} for the log's "
+        "velocity and acceleration columns, if it has them"
+        + ("; the motors' columns of this motor-side log" if motors else "")
+        + ")"
+        + (
+            "; or a negative gear_ratio in the drive file, a motor turning the other way"
+            if gears
+            else ""
+        )
+    )
+
+
+def _left_over(
+    r: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    drive: Drive | None = None,
+) -> float:
+    """The sum of squares [N^2 m^2] of the residuals ``r`` (N, n) left by each joint's own
+    viscous, Coulomb, offset and armature columns (``dq``, ``sign(dq)``, 1, ``ddq``); with
+    a ``drive``, each motor's where its friction acts (``K_f^T`` of those of ``K_f dq``)
+    and its rotor's (``K^T`` of ``K ddq``), the joints a motor couples fitted together
+    (:func:`_own_terms`)."""
+    return sum(g.left for g in _own_terms(r, dq, ddq, drive))
+
+
+@dataclass(frozen=True)
+class _OwnTerms:
+    """One group's least-squares fit in :func:`_own_terms`: its motors (joints), per motor
+    the coefficients ``fv, fc, fo, Ia`` (4,) and their covariance (4, 4) (white-noise
+    formula), the residual sum of squares ``left`` [N^2 m^2], and per motor the mean of
+    ``|v|`` and of ``v^2`` at its velocities ``v``."""
+
+    motors: list[int]
+    coef: NDArray[np.float64]
+    cov: NDArray[np.float64]
+    left: float
+    speed: NDArray[np.float64]
+
+
+def _own_terms(
+    r: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    drive: Drive | None = None,
+) -> list[_OwnTerms]:
+    """Each joint's (motor's) own viscous, Coulomb, offset and armature coefficients fitted
+    to the residuals ``r`` (N, n), group by group (:func:`_motor_groups`: a coupled wrist's
+    joints together), as :func:`_left_over` describes."""
+    n = r.shape[1]
+    Kf = np.eye(n) if drive is None else drive.friction_transmission
+    K = np.eye(n) if drive is None else drive.transmission
+    v, a = dq @ Kf.T, ddq @ K.T
+    out = []
+    for joints, motors in _motor_groups((K != 0) | (Kf != 0)):
+        cols = []
+        for k in motors:  # motor k's columns at the group's joints: (N, m) each
+            for f in (v[:, k], np.sign(v[:, k]), np.ones(len(r))):
+                cols.append(f[:, None] * Kf[k, joints])
+            cols.append(a[:, k, None] * K[k, joints])
+        X = np.stack(cols, axis=-1).reshape(len(r) * len(joints), len(cols))
+        y = r[:, joints].reshape(-1)
+        coef = np.linalg.lstsq(X, y, rcond=None)[0]
+        left = float(np.sum((y - X @ coef) ** 2))
+        dof = max(X.shape[0] - X.shape[1], 1)
+        cov = (left / dof) * np.linalg.pinv(X.T @ X)
+        m = len(motors)
+        blocks = np.array([cov[4 * i : 4 * i + 4, 4 * i : 4 * i + 4] for i in range(m)])
+        speed = np.array([[np.mean(np.abs(v[:, k])), np.mean(v[:, k] ** 2)] for k in motors])
+        coefs = np.asarray(coef, dtype=np.float64).reshape(m, 4)
+        out.append(_OwnTerms(motors, coefs, blocks, left, speed))
+    return out
+
+
+#: A motor's (joint's) friction and rotor read of the opposite sign in one recording to
+#: another's (:func:`opposite_friction_among`) when each is at least this many standard
+#: deviations from zero (white-noise formula: samples a few ms apart are correlated, so a
+#: wide margin).
+OWN_TERMS_SIGNIFICANCE = 8.0
+#: ... and the one's size at least this share of the other's (a sign, not a drift).
+OWN_TERMS_SIZE_SHARE = 0.3
+
+
+def _own_signs(
+    robot: Robot, log: TorqueLog, drive: Drive | None
+) -> dict[int, tuple[float, float, float, float, float, float]] | None:
+    """Per motor (joint) of a log as recorded: the power its fitted friction dissipates
+    (``fc mean|v| + fv mean(v^2)``) and the rotor inertia fitted (``Ia``), each with its
+    standard deviation, fitted to what the robot's links leave of its torques
+    (:func:`_own_terms`): both positive for torques of the right sign; then ``mean|v|``
+    and ``mean(v^2)`` at the motor. None: too few samples with known accelerations."""
+    rec = _recorded(log, drive)
+    if rec is None:
+        return None
+    q, dq, ddq = (rec.q, rec.dq, rec.ddq)
+    if rec.drive is not None:
+        q, dq, ddq = rec.drive.joint_states(q, dq, ddq)
+    model = rnea(robot, q, dq, ddq)
+    if robot.spring is not None:
+        model = model + robot.spring.torques(q)
+    out = {}
+    for g in _own_terms(rec.joint_torques - model, dq, ddq, rec.drive):
+        for i, k in enumerate(g.motors):
+            grad = np.array([g.speed[i, 1], g.speed[i, 0], 0.0, 0.0])  # d power / d coef
+            power, power_std = float(grad @ g.coef[i]), math.sqrt(grad @ g.cov[i] @ grad)
+            ia, ia_std = float(g.coef[i, 3]), math.sqrt(g.cov[i][3, 3])
+            out[k] = (power, power_std, ia, ia_std, float(g.speed[i, 0]), float(g.speed[i, 1]))
+    return out
+
+
+def _comparable(flipped: tuple, right: tuple, share: float) -> bool:
+    """Whether a motor's terms read of the opposite sign (``flipped``: its
+    :func:`_own_signs` values and the signs of its power and inertia) are of about the
+    size of another recording's of the right sign (at least ``share`` of them), judged on
+    the power where both tell it, else on the inertia."""
+    (p, _, ia, *_), sp, si = flipped
+    (q, _, ib, *_), sq, sj = right
+    if sp and sq:
+        return abs(p) >= share * abs(q)
+    return bool(si and sj) and abs(ia) >= share * abs(ib)
+
+
+def opposite_friction_among(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str],
+    drive: Drive | None = None,
+    *,
+    reference: ArrayLike | None = None,
+) -> str | None:
+    """The finding that one recording's torques of a motor (joint) have the opposite sign
+    to another recording's, read from the motor's own friction and rotor (:func:`_own_signs`):
+    the friction dissipates and the inertia is positive in one, both the other way in
+    the other, each beyond :data:`OWN_TERMS_SIGNIFICANCE` standard deviations and of a
+    comparable size (:data:`OWN_TERMS_SIZE_SHARE`); or None.
+
+    The check the whole rigid-body torques make (:func:`opposite_sign`) does not tell the
+    sign of a joint whose torques the links barely make (a geared wrist: its rotor and
+    friction outweigh them), and a fit of several recordings, one of them of the opposite
+    sign there, averages that joint's friction to nothing (a current-logged UR5's motor
+    4 flipped in one of two recordings: fitted to 9.4 %, its Coulomb friction left out,
+    springs suggested). ``logs`` are as recorded (read through ``drive``); the hint is the
+    file's own ``--units`` entry in the log's columns.
+
+    ``reference`` (n, 3), a model's own ``fv, fc, Ia`` per motor (joint), where the drive's
+    friction acts [N m s/rad, N m, kg m^2]: each recording is compared with it too, its
+    power at the recording's own speeds (``fc mean|v| + fv mean(v^2)``), so that one
+    recording alone is judged (a model identified on logs of the right sign dissipates
+    where a flipped motor's fitted friction puts energy into the arm)."""
+    if len(logs) < (1 if reference is not None else 2) or not np.any(robot.phi):
+        return None
+    signs = [_own_signs(robot, log, drive) for log in logs]
+    model = None if reference is None else np.asarray(reference, dtype=np.float64)
+    z, share = OWN_TERMS_SIGNIFICANCE, OWN_TERMS_SIZE_SHARE
+
+    def sign(x: float, sd: float) -> int:
+        return 0 if not abs(x) > z * sd else (1 if x > 0 else -1)
+
+    def of_model(k: int, s: tuple[float, ...]) -> tuple | None:
+        """Motor k of the model at the speeds ``s`` of a recording's terms."""
+        if model is None or k >= model.shape[0]:
+            return None
+        fv, fc, ia = (float(x) for x in model[k])
+        power = fc * s[4] + fv * s[5]
+        return ((power, 0.0, ia, 0.0), sign(power, 0.0), sign(ia, 0.0))
+
+    found: dict[int, list[int]] = {}  # recording: its motors of the opposite sign
+    for k in range(logs[0].n):
+        each = [
+            None
+            if s is None or k not in s
+            else (s[k], sign(s[k][0], s[k][1]), sign(s[k][2], s[k][3]))
+            for s in signs
+        ]
+        right = [e for e in each if e is not None and min(e[1:]) >= 0 and max(e[1:]) > 0]
+        for r, e in enumerate(each):
+            if e is None or not (max(e[1:]) <= 0 and min(e[1:]) < 0):
+                continue
+            mine = signs[r]
+            assert mine is not None  # e is not None
+            own = of_model(k, mine[k])
+            ok = [o for o in (*right, own) if o is not None and min(o[1:]) >= 0 < max(o[1:])]
+            if any(_comparable(e, o, share) for o in ok):
+                found.setdefault(r, []).append(k)
+    if not found:
+        return None
+    r = min(found)
+    motors = found[r]
+    who = "motor" if drive is not None and drive.side == "motor" else "joint"
+    named = ", ".join(f"motor {k + 1}" if who == "motor" else robot.joint_names[k] for k in motors)
+    others = [names[i] for i in range(len(names)) if i != r and i not in found]
+    mine = signs[r]
+    assert mine is not None  # found holds recordings with their terms
+    power = any(mine[k][0] < -z * mine[k][1] for k in motors)
+    inertia = any(mine[k][2] < -z * mine[k][3] for k in motors)
+    what = " and ".join(
+        w
+        for w, said in (
+            ("the friction fitted there puts energy into the arm", power),
+            ("the rotor inertia fitted there is negative", inertia),
+        )
+        if said
+    )
+    against, where = (
+        (f"those of {', '.join(others) or 'the other recordings'}", "in the others they are")
+        if others or model is None
+        else ("the model's", "the model's identified friction and rotor are")
+    )
+    return (
+        f"{names[r]}: the torques of {named} read of the opposite sign to {against}: "
+        f"{what}, where {where} of the right sign (a file logged with another sign "
+        "convention; the check "
+        "against the model's torques does not tell a joint the links barely load); hint: "
+        f"--units {flip_entries(motors, names[r] if len(names) > 1 else None)} reads it flipped"
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class SignFinding:
+    """One recording's sign finding (:func:`recording_sign_findings`).
+
+    Attributes
+    ----------
+    name : str
+        The recording's name (its file).
+    kind : {"reversed", "opposite"}
+        Columns recorded reversed (position and effort, :func:`reversed_joint`), or torques
+        of the opposite sign (:func:`opposite_sign_among`, :func:`opposite_friction_among`).
+    text : str
+        The finding, without the name: the joints (motors) and the ``--units`` entries.
+    """
+
+    name: str
+    kind: str
+    text: str
+
+
+def recording_sign_findings(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str],
+    drive: Drive | None = None,
+    *,
+    sides: Sequence[TorqueLog] | None = None,
+    reference: ArrayLike | None = None,
+    first: bool = False,
+    among: bool = True,
+) -> tuple[SignFinding, ...]:
+    """The sign checks of several recordings, in the one order ``identify`` refuses by and
+    ``validate`` and ``observe`` judge by: per recording, columns recorded reversed
+    (:func:`reversed_joint`, on the log as recorded through ``drive``), else torques of
+    the opposite sign to the robot's (:func:`opposite_sign_among`, on its joint side,
+    against the others'); then, among the recordings not found so, one whose motor
+    (joint) the links barely load reads of the opposite sign to the others', told by its
+    own friction and rotor (:func:`opposite_friction_among`; against ``reference`` too,
+    a model's ``fv, fc, Ia`` (n, 3), so that one recording alone is judged).
+
+    Parameters
+    ----------
+    robot : Robot
+    logs : sequence of TorqueLog
+        The recordings as recorded (the drive's side and effort), each with enough samples
+        (:func:`too_few_samples`).
+    names : sequence of str
+        One name per recording.
+    drive : Drive, optional
+        What reads ``logs`` (:func:`~dynid.identification.log.joint_side_log`).
+    sides : sequence of TorqueLog, optional
+        The recordings at the joints, when already mapped (default: mapped here).
+    reference : array_like, shape (n, 3), optional
+        As :func:`opposite_friction_among`.
+    first : bool
+        Stop at the first finding (a check that refuses).
+    among : bool
+        Compare the recordings' own friction and rotors (False: logs that may hold
+        contacts, whose external torques the motors' own terms would take for a sign).
+
+    Returns
+    -------
+    tuple of SignFinding
+        In the recordings' order, then the finding among them; empty when all read right.
+    """
+    if sides is None:
+        sides = [joint_side_log(log, drive) for log in logs]
+    out: list[SignFinding] = []
+    for r, (name, log) in enumerate(zip(names, logs, strict=True)):
+        if (mirrored := reversed_joint(robot, log, drive)) is not None:
+            out.append(SignFinding(name, "reversed", mirrored))
+        else:
+            others = (x for i, x in enumerate(sides) if i != r)
+            if (opposite := opposite_sign_among(robot, sides[r], name, others)) is not None:
+                out.append(SignFinding(name, "opposite", opposite))
+        if first and out:
+            return tuple(out)
+    if not among:
+        return tuple(out)
+    said = {f.name for f in out}
+    rest = [r for r, name in enumerate(names) if name not in said]
+    kept = [names[r] for r in rest]
+    found = opposite_friction_among(
+        robot, [logs[r] for r in rest], kept, drive, reference=reference
+    )
+    if found is not None:
+        name = next(n for n in kept if found.startswith(f"{n}: "))
+        out.append(SignFinding(name, "opposite", found.removeprefix(f"{name}: ")))
+    return tuple(out)
+
+
+def _motor_groups(acts: NDArray[np.bool_]) -> list[tuple[list[int], list[int]]]:
+    """The joints and motors ``acts`` (motors x joints: motor k acts on joint j) links,
+    group by group: a joint alone with its motor, a coupled wrist's joints together."""
+    group = list(range(acts.shape[1]))
+
+    def root(j: int) -> int:
+        while group[j] != j:
+            j = group[j]
+        return j
+
+    for row in acts:
+        on = np.flatnonzero(row)
+        for j in on[1:]:
+            group[root(int(j))] = root(int(on[0]))
+    roots = sorted({root(j) for j in range(acts.shape[1])})
+    out = []
+    for g in roots:
+        joints = [j for j in range(acts.shape[1]) if root(j) == g]
+        out.append((joints, [int(k) for k in np.flatnonzero(acts[:, joints].any(axis=1))]))
+    return out

@@ -1,0 +1,185 @@
+"""The white noise of logged velocities, its band, and the joints that move beyond it.
+
+A joint whose velocity never leaves its noise band (fewer than 1 % of the samples beyond 5
+times the robust noise level, :func:`velocity_noise_std`, and :data:`MIN_MOTION`) is
+frozen: its friction cannot be identified (:func:`moving_joints`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import _checks
+from ..exceptions import ShapeError
+
+__all__ = [
+    "MIN_MOTION",
+    "MOVING_FRACTION",
+    "NOISE_BAND_STD",
+    "moving_joints",
+    "noise_band",
+    "velocity_noise_std",
+]
+
+#: Width of the velocity noise band, in standard deviations of the velocity noise.
+NOISE_BAND_STD = 5.0
+#: Smallest velocity [rad/s] (m/s for a prismatic joint) counted as motion, whatever the
+#: noise: below it no friction law can be told apart (noise-free logs of a frozen joint).
+MIN_MOTION = 1e-3
+#: Fraction of the samples that must lie outside the noise band for a joint to move.
+MOVING_FRACTION = 0.01
+
+
+def velocity_noise_std(dq: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.float64]:
+    """Std [rad/s] (n,) of the white noise on velocity samples ``dq`` (N, n), robustly.
+
+    .. math:: \\hat\\sigma_j = 1.4826 \\, \\min\\big(\\mathrm{MAD}(\\Delta^2 \\dot q_j) / \\sqrt 6,
+              \\; \\mathrm{MAD}(\\Delta^3 \\dot q_j) / \\sqrt{20}\\big)
+
+    The second and third differences of white noise of std ``sigma`` have std
+    ``sqrt(6) sigma`` and ``sqrt(20) sigma``, while those of a smooth motion sampled fast
+    are far smaller, the third smaller than the second: the smaller of the two estimates
+    leaves a noise-free log (a simulation) with a band near zero. The median absolute
+    deviation (scaled to a std for Gaussian noise) ignores the few steps of a fast reversal. Give
+    the measured velocities: a low-pass filter hides the noise from this estimate.
+
+    Samples at uneven times ``t`` (jitter, dropped samples): the differences become the
+    residuals of each sample from the line through its two neighbours and from the
+    parabola through the previous one and the next two, at their own times (Lagrange),
+    each scaled to the noise's std; on even times they are the differences above. The
+    differences of unevenly timed samples hold the motion itself (an xArm7 at 100 Hz,
+    stamps +-2 ms: torque noise read 0.07 N m for 0.05). Residuals across a step back in
+    time (logs joined) are left out.
+
+    Parameters
+    ----------
+    dq : array_like, shape (N, n)
+        Measured joint velocities [rad/s], N >= 3.
+    t : array_like, shape (N,), optional
+        The samples' times [s]; default: evenly spaced.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+
+    Raises
+    ------
+    ShapeError
+        ``dq`` not of shape (N, n) with N >= 3.
+    """
+    a = _checks.as_array("dq", dq)
+    if a.ndim != 2 or a.shape[0] < 3:
+        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
+    if t is not None:
+        tt = _checks.as_array("t", t)
+        if tt.shape != (a.shape[0],):
+            raise ShapeError(f"t must have shape ({a.shape[0]},) like dq's rows; got {tt.shape}")
+        dt = np.diff(tt)
+        h = float(np.median(dt))
+        if not (h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h)):  # pieces joined: uneven too
+            return _uneven_noise_std(a, tt)
+    est = []
+    for order, var in ((2, 6.0), (3, 20.0)):
+        if a.shape[0] <= order:  # three samples: no third difference
+            continue
+        mad = np.empty(a.shape[1])
+        for j in range(a.shape[1]):  # one joint at a time: temporaries of one column
+            d = np.diff(a[:, j], n=order)
+            d -= np.median(d)
+            mad[j] = np.median(np.abs(d, out=d))
+        est.append(1.4826 * mad / np.sqrt(var))
+    out: NDArray[np.float64] = np.minimum.reduce(est)
+    return out
+
+
+def _uneven_noise_std(a: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray[np.float64]:
+    """:func:`velocity_noise_std` of ``a`` (N, n) sampled at the uneven times ``t`` (N,)."""
+    est = []
+    for nodes in ((-1, 1), (-1, 1, 2)):
+        lo, hi = -min(nodes), max(nodes)
+        i = np.arange(lo, a.shape[0] - hi)
+        if i.size == 0:
+            continue
+        ti = t[i]
+        tk = [t[i + k] for k in nodes]
+        w = []
+        for k, tn in enumerate(tk):
+            wk = np.ones_like(ti)
+            for m, tm in enumerate(tk):
+                if m != k:
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        wk *= (ti - tm) / (tn - tm)
+            w.append(wk)
+        times = np.stack([t[i + k] for k in range(-lo, hi + 1)])
+        ok = np.all(np.diff(times, axis=0) > 0, axis=0)
+        if not ok.any():
+            continue
+        scale = np.sqrt(1.0 + sum(x**2 for x in w))[ok]
+        mad = np.empty(a.shape[1])
+        for j in range(a.shape[1]):
+            r = a[i, j] - sum(wk * a[i + k, j] for wk, k in zip(w, nodes, strict=True))
+            r = r[ok] / scale
+            r -= np.median(r)
+            mad[j] = np.median(np.abs(r))
+        est.append(1.4826 * mad)
+    out: NDArray[np.float64] = np.minimum.reduce(est) if est else np.zeros(a.shape[1])
+    return out
+
+
+def noise_band(noise_std: ArrayLike) -> NDArray[np.float64]:
+    """The velocity noise band [rad/s]: ``NOISE_BAND_STD * noise_std``.
+
+    Joints whose velocity stays inside it (or below :data:`MIN_MOTION`) do not move
+    (:func:`moving_joints`), and friction laws do not switch Coulomb friction on inside it
+    (:mod:`dynid.friction.laws.base`).
+
+    Parameters
+    ----------
+    noise_std : array_like, shape (n,) or scalar
+        White-noise std of the measured velocities [rad/s] (:func:`velocity_noise_std`).
+
+    Returns
+    -------
+    ndarray, same shape as ``noise_std``
+    """
+    out: NDArray[np.float64] = NOISE_BAND_STD * np.asarray(noise_std, dtype=np.float64)
+    return out
+
+
+def moving_joints(dq: ArrayLike, noise_std: ArrayLike | None = None) -> NDArray[np.bool_]:
+    """Which joints move beyond their velocity noise band (n,) bool.
+
+    A joint moves when more than :data:`MOVING_FRACTION` of its samples ``|dq|`` exceed
+    ``max(NOISE_BAND_STD * noise_std, MIN_MOTION)``.
+
+    Parameters
+    ----------
+    dq : array_like, shape (N, n)
+        Joint velocities [rad/s] (filtered or not).
+    noise_std : array_like, shape (n,) or scalar, optional
+        White-noise std of the measured velocities [rad/s]; default
+        :func:`velocity_noise_std` of ``dq`` (right for unfiltered velocities).
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+
+    Raises
+    ------
+    ShapeError
+        ``dq`` not of shape (N, n) with N >= 3, or ``noise_std`` of another joint count.
+    """
+    a = _checks.as_array("dq", dq)
+    if a.ndim != 2 or a.shape[0] < 3:
+        raise ShapeError(f"dq must have shape (N, n), N >= 3; got {a.shape}")
+    sd = velocity_noise_std(a) if noise_std is None else _checks.as_array("noise_std", noise_std)
+    sd = np.broadcast_to(sd, (a.shape[1],)) if sd.ndim == 0 else sd
+    if sd.shape != (a.shape[1],):
+        raise ShapeError(f"noise_std must have shape ({a.shape[1]},); got {sd.shape}")
+    band = np.maximum(noise_band(sd), MIN_MOTION)
+    level = np.array(
+        [np.quantile(np.abs(a[:, j]), 1.0 - MOVING_FRACTION) for j in range(a.shape[1])]
+    )
+    out: NDArray[np.bool_] = level > band
+    return out
