@@ -35,7 +35,7 @@ A :class:`~dynid.friction.model.FrictionSum` (friction at the motors and at the 
 gets the sum of its parts' bounds, each seen at the joints through its own transmission.
 
 The friction is evaluated at the *measured* velocities, which lie within their noise band
-``b`` (:func:`velocity_bands`: :data:`~dynid.identification.sanity.NOISE_BAND_STD` robust
+``b`` (:func:`velocity_bands`: :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD` robust
 standard deviations of the velocity noise, per motor) of the true ones. A smooth Coulomb
 step (the sigmoid ``phi1 sigma(phi2 (v + phi3))``, the term ``f_t tanh(v / v_s)``) narrower
 than that band changes by up to its whole height between the two: per motor, each step's
@@ -130,8 +130,8 @@ def velocity_bands(
     """The velocity noise band [rad/s] of the motors of every part of ``friction`` (one
     (n,) array per part; none without friction), estimated on the velocities ``dq`` (N, n)
     [rad/s] seen through the part's transmission
-    (:func:`~dynid.identification.sanity.velocity_noise_std` times
-    :data:`~dynid.identification.sanity.NOISE_BAND_STD`, the median of its estimates over
+    (:func:`~dynid.identification.velocity_noise.velocity_noise_std` times
+    :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD`, the median of its estimates over
     windows of :data:`_NOISE_WINDOW` samples); zeros for fewer than 4 samples.
     """
     from ..identification.velocity_noise import noise_band, velocity_noise_std
@@ -161,7 +161,7 @@ def noise_bands(
 ) -> tuple[NDArray[np.float64], ...]:
     """The velocity noise band [rad/s] of the motors of every part of ``friction`` (one
     (n,) array per part) for joint velocities of white-noise std ``dq_std`` (n,) [rad/s],
-    independent per joint: :data:`~dynid.identification.sanity.NOISE_BAND_STD` times
+    independent per joint: :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD` times
     ``sqrt(K^2 dq_std^2)`` through the part's transmission ``K`` (the noise a validation's
     prepared velocities carry, :func:`~dynid.identification.input_noise.state_noise`)."""
     from ..identification.velocity_noise import noise_band
@@ -182,8 +182,8 @@ def derived_velocity_bands(
     """The velocity band [rad/s] of the motors of every part of ``friction`` (one (n,)
     array per part) for velocities derived from the positions ``q`` (N, n) [rad] sampled
     at ``t`` (N,) [s] by :func:`~dynid.signals.filtered_derivative` at ``cutoff_hz``
-    (module docstring): :data:`~dynid.identification.sanity.NOISE_BAND_STD` times the
-    position noise of each motor (:func:`~dynid.identification.sanity.velocity_noise_std`
+    (module docstring): :data:`~dynid.identification.velocity_noise.NOISE_BAND_STD` times the
+    position noise of each motor (:func:`~dynid.identification.velocity_noise.velocity_noise_std`
     of its positions, the median over windows) times the filter's noise gain; zeros for
     fewer than 4 samples."""
     from ..identification.velocity_noise import noise_band, velocity_noise_std

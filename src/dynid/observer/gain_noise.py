@@ -12,7 +12,7 @@ but raises those thresholds as much, so it does not detect sooner (a Panda at 2e
 velocity noise: contact thresholds of joint 1 0.72, 1.79 and 5.6 N m at gains 20, 50 and
 150). :class:`GainNoiseTally` adds up ``s_j^2`` and the residual's mean square over the
 calibration's blocks (``sigma`` estimated on each block's velocities by
-:func:`~dynid.identification.sanity.velocity_noise_std`; velocities derived from positions
+:func:`~dynid.identification.velocity_noise.velocity_noise_std`; velocities derived from positions
 through a low-pass show no white noise and give about 0); :class:`GainNoise` names the
 joints where ``s_j^2`` makes up at least :data:`DOMINANT` of the residual's mean square.
 """

@@ -24,7 +24,7 @@ the command applies, so that the Python API behaves as the command does.
   Several logs are checked together: one in other units than the others is refused, one
   far outside the joint limits warned about (:mod:`dynid.workflows.recordings`).
 * One-sample torque spikes (a sensor or logging fault, by the rule ``identify`` replaces
-  them by before fitting: :func:`~dynid.identification.sanity.despiked`) are replaced by
+  them by before fitting: :func:`~dynid.identification.spikes.despiked`) are replaced by
   the line between their neighbours before the observer runs, with a warning per log
   naming the joints, the counts and the times
   (:func:`~dynid.workflows.recordings.despiked_recordings`): the residual of a 30 N m
