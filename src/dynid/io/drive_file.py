@@ -10,10 +10,17 @@ Keys (all optional but ``schema`` in a file of its own; n = the robot's joint co
     effort = "torque" | "current"     # what the tau columns hold (torque)
     torque_constant = [...]           # n [N m / A]: at the motor for side = "motor"
     rotor_inertia = "identify" | [...]  # n [kg m^2] at the motors (identify)
-    friction_at = "motor" | "joint"   # default motor when K is not the identity
+    friction_at = "motor" | "joint"   # where identified friction acts (default below)
 
 Every per-joint list (``gear_ratio``, ``offset``, ``torque_constant``, ``rotor_inertia``)
 may be one number, used for every joint (``gear_ratio = 1``: a direct drive).
+Without ``friction_at`` the friction identified through the drive acts at the motors when
+``K`` is not the identity (else at the joints), and a robot description's own friction
+(URDF ``<dynamics>``, MJCF ``damping``/``frictionloss``, a robot TOML's sigmoid per joint),
+the joints' by definition, stays at the joints; ``friction_at = "motor"`` given moves that
+too to the motors (said in one note), ``friction_at = "joint"`` puts identified friction at
+the joints. A model's friction that records its place (``at`` in ``identification.json``,
+``feasible.json``, a robot TOML's ``[friction]`` table) acts there whatever the drive says.
 ``qm = K (q - offset)``, ``dqm = K dq``, ``tau_joint = K^T tau_motor``
 (:mod:`dynid.model.drive`). Every fault (an unknown key, a wrong type or length, a singular
 ``K``, a coupling outside the chain or given twice, currents without constants) is one
@@ -244,8 +251,9 @@ def drive_toml(drive: Drive) -> str:
         f"gear_ratio = {vec(np.diag(K))}",
         "coupling = [" + ", ".join(f"[{i + 1}, {j + 1}, {float(K[i, j])!r}]" for i, j in off) + "]",
         f"offset = {vec(drive.offset)}",
-        f'friction_at = "{drive.friction_at}"',
     ]
+    if drive.friction_at is not None:  # as given: a default place stays a default
+        lines.append(f'friction_at = "{drive.friction_at}"')
     if drive.torque_constant is not None:
         lines.append(f"torque_constant = {vec(drive.torque_constant)}")
     ia = drive.rotor_inertia

@@ -60,7 +60,7 @@ def friction_tables(friction: Friction | FrictionSum | None) -> str:
         return ""
     out = []
     for key, part in zip(("friction", "joint_friction"), friction_parts(friction), strict=False):
-        at = "motor" if part.drive is not None and part.drive.friction_at == "motor" else "joint"
+        at = "motor" if part.drive is not None and part.drive.friction_place == "motor" else "joint"
         rec = law_record(part)
         lines = [f"[{key}]", f'model = "{rec.pop("model")}"', f'at = "{at}"']
         units = dict(zip(part.law.params, part.law.units, strict=True))
