@@ -118,5 +118,6 @@ def _one_table(
         if table is None
         else drive_from_mapping(table, n, source=f"{source} [drive]")
     )
-    drive = dataclasses.replace(drive, friction_at=at)
+    if drive.friction_place != at:  # a default place that is the table's stays a default
+        drive = dataclasses.replace(drive, friction_at=at)
     return law_friction(rec, drive, n, source, key)
