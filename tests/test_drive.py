@@ -185,7 +185,7 @@ def test_drive_file_and_robot_toml_drive_table(tmp_path):
     f.write_text('schema = "dynid-drive/1"\n' + text)
     d = load_drive(f, 2)
     np.testing.assert_array_equal(d.transmission, [[100.0, 0.0], [20.0, 80.0]])
-    assert d.friction_at == "motor" and d.identifies_rotor_inertia
+    assert d.friction_place == "motor" and d.identifies_rotor_inertia
     r = tmp_path / "arm.toml"
     r.write_text(
         'name = "two"\n[[joints]]\nname = "j1"\nparent = "l0"\nchild = "l1"\n'
@@ -566,7 +566,7 @@ def test_gear_ratio_1_in_a_drive_file_identifies_a_joint_side_armature(tmp_path)
     f.write_text('schema = "dynid-drive/1"\ngear_ratio = 1\nrotor_inertia = "identify"\n')
     drive = load_drive(f, 6)
     np.testing.assert_array_equal(drive.transmission, np.eye(6))
-    assert drive.identifies_rotor_inertia and drive.friction_at == "joint"
+    assert drive.identifies_rotor_inertia and drive.friction_place == "joint"
     np.testing.assert_array_equal(Drive.from_gears(1, n=6).transmission, np.eye(6))
     robot, model, data = _ur5()
     armature = np.array([0.3, 0.3, 0.2, 0.05, 0.05, 0.04])  # [kg m^2]

@@ -51,7 +51,7 @@ def test_an_offset_alone_is_not_a_violation_and_motors_are_checked_to_their_limi
     fr = ClassicalFriction(fv=[1.0, 1.0], fc=[0.5, 0.0], fo=[-5.0, 3.0])
     assert law_violations(fr, np.array([2.0, 2.0])) == ()
     drive = Drive.from_gears([10.0, 20.0], rotor_inertia=np.zeros(2))
-    assert drive.friction_at == "motor"
+    assert drive.friction_place == "motor"
     pushing = LAWS["quadratic"].model(np.array([[1.0, -0.1, 0.0, 0.0], [1.0, 0.0, 1.0, 0.0]]))
     (v,) = law_violations(pushing.at(drive), np.array([2.0, 2.0]))
     # fv + fq |v| < 0 beyond |v| = 10 rad/s, inside the motor's limit 10 * 2 = 20 rad/s

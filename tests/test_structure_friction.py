@@ -68,7 +68,7 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     fr = ClassicalFriction(VISCOUS, np.linspace(0.6, 0.2, 7), np.zeros(7))
     logs = recordings(panda, (91, 92), friction=fr, drive=truth_drive, duration=4.0)
     given = Drive.from_gears(np.ones(7), [(7, 6, 0.8)], rotor_inertia=np.zeros(7))
-    assert given.friction_at == "motor"
+    assert given.friction_place == "motor"
     model = identify_recordings(panda, logs, cutoff_hz=None, drive=given)
     sel = model.info.selection
     names = [c["name"] for c in sel["candidates"]]
@@ -76,7 +76,7 @@ def test_friction_of_a_coupled_drive_is_placed_where_the_data_say(panda, truth):
     judged = [c for c in sel["candidates"] if not c.get("left_out")]  # the per-joint aside
     assert len(judged) == 74  # 35 per placement, 5 at both, the model without friction once
     assert sel["chosen"] == f"links + viscous + coulomb + at:{truth}", sel["chosen"]
-    assert model.drive.friction_at == truth
+    assert model.drive.friction_place == truth
     np.testing.assert_allclose(model.friction.params[:, :2], fr.as_array()[:, :2], atol=1e-7)
     assert model.fit.relative_error_percent < 1e-7
     # the model's own friction acts where it was placed

@@ -76,7 +76,7 @@ def test_friction_written_at_the_joints_acts_there_through_a_geared_drive(tmp_pa
     friction through :func:`robot_friction`: the friction at the joints, not ``x k^2``."""
     path = _file(tmp_path, at)
     robot, drive = load_toml(path), drive_of_robot_file(path, 7)
-    assert drive.friction_at == "motor"  # the [drive] table alone would put it there
+    assert drive.friction_place == "motor"  # the [drive] table alone would put it there
     q, dq, ddq = motion.q, motion.dq, motion.ddq
     truth = rnea(dynid.panda(), q, dq, ddq) + _at_joints(dq) + GEAR**2 * IA * ddq
     log = simulate_measurement(

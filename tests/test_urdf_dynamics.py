@@ -57,7 +57,7 @@ def test_export_then_load_gives_the_same_friction_as_pinocchio_reads(tmp_path, c
     with caplog.at_level(logging.INFO, logger="dynid.io.robot.urdf_parse"):
         robot = load_urdf(path)
     fr = robot.friction
-    assert fr.kind == "classical" and fr.drive.is_bare and fr.drive.friction_at == "joint"
+    assert fr.kind == "classical" and fr.drive is None  # per joint: a description's
     np.testing.assert_allclose(fr.fv, FV, rtol=0, atol=1e-12)
     np.testing.assert_allclose(fr.fc, FC, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(fr.fo, 0.0)
@@ -201,7 +201,7 @@ def test_the_urdf_friction_stays_at_the_joints_through_a_geared_drive(tmp_path):
     placed at the motors, ``K^T f(K dq)``, 2500 times the viscous torque."""
     robot = load_urdf(_arm(tmp_path))
     drive = Drive.from_gears([50.0, 50.0])
-    assert drive.friction_at == "motor"
+    assert drive.friction_place == "motor"
     dq = np.array([[0.3, -0.2], [-0.05, 0.4]])
     placed = robot_friction(robot, drive)
     np.testing.assert_allclose(placed.torques(dq), FV * dq + FC * np.sign(dq), atol=1e-12)

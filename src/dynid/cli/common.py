@@ -18,12 +18,13 @@ import numpy as np
 from .. import _checks, spatial
 from .._checks import text as as_text
 from ..exceptions import DataError, OptionError, ShapeError, in_file
-from ..io.drive_file import drive_of_robot_file, load_drive
+from ..io.drive_file import drive_of_robot_file, load_drive, with_file_rotors
 from ..io.robot_file import load_robot as load_robot_file
 from ..kinematics.inverse import default_q0
 from ..model.builtin import BUILTIN_ROBOTS
 from ..model.robot import Robot
 from ..plots.save import save_figure as write_figure
+from ..progress import NOTE
 from ..workflows.options import NO_FILTER
 from ..workflows.prior import load_prior as workflow_prior
 from .console import Console
@@ -279,7 +280,9 @@ def add_drive_option(p: argparse.ArgumentParser) -> None:
         metavar="FILE.toml",
         help="drive train (schema dynid-drive/1: side, gear_ratio, coupling, offset, effort, "
         "torque_constant, rotor_inertia, friction_at; see the README); default: the [drive] "
-        "table of a robot TOML (--robot, --params), else link-side torques of a direct drive",
+        "table of a robot TOML (--robot, --params), else link-side torques of a direct drive. "
+        "A robot description's own friction (URDF <dynamics>, MJCF damping/frictionloss) "
+        'stays at the joints unless the file says friction_at = "motor"',
     )
 
 
@@ -310,11 +313,20 @@ def add_q_start_option(p: argparse.ArgumentParser) -> None:
     )
 
 
-def load_drive_arg(args: argparse.Namespace, n: int) -> Any:
+def load_drive_arg(args: argparse.Namespace, n: int, *, robot_rotors: bool = False) -> Any:
     """The :class:`~dynid.model.drive.Drive` of ``--drive`` (or of a --robot TOML's
-    ``[drive]`` table, or the one a --robot feasible.json holds), or None."""
+    ``[drive]`` table, or the one a --robot feasible.json holds), or None. With
+    ``robot_rotors`` (a command that validates a description), a ``--drive`` that leaves
+    the rotor inertias to identify takes the --robot file's
+    (:func:`~dynid.io.drive_file.with_file_rotors`), said in a note."""
     if getattr(args, "drive", None) is not None:
-        return load_drive(args.drive, n)
+        drive = load_drive(args.drive, n)
+        spec = getattr(args, "robot", None)
+        if robot_rotors and spec is not None and Path(str(spec)).is_file():
+            drive, said = with_file_rotors(drive, spec, n)
+            if said is not None:
+                _log.log(NOTE, said)
+        return drive
     spec = getattr(args, "robot", None)
     if spec is not None and str(spec).lower().endswith(".json") and Path(spec).is_file():
         from ..io.feasible import load_feasible_drive  # here: one-shot commands skip scipy

@@ -147,7 +147,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 float(t.values[k]), float(t.std[k]), bool(t.kept[k]), holders[k]
             ) + (f" {COMBINED}" if lab in model.info.combined and t.kept[k] else "")
         drive = getattr(t.term, "drive", None)
-        row = "motor" if drive is not None and drive.friction_at == "motor" else "joint"
+        row = "motor" if drive is not None and drive.friction_place == "motor" else "joint"
         n = getattr(drive, "n", None) or max(j for _, j in cells)
         scales = _velocity_scales(t.term, n)
         for stem, values in scales.items():
@@ -270,10 +270,10 @@ def _motors_hold(term: Any, model: IdentifiedModel) -> list[int]:
     alone (:func:`~dynid.identification.structure.joint_side_joints`); none for another
     term (a rotor inertia left out is left out: without a drive no motor holds it)."""
     drive = getattr(term, "drive", None)
-    if not isinstance(term, LinearFriction) or drive is None or drive.friction_at != "joint":
+    if not isinstance(term, LinearFriction) or drive is None or drive.friction_place != "joint":
         return []
     at_motors = any(
-        isinstance(t.term, LinearFriction) and t.term.drive.friction_at == "motor"
+        isinstance(t.term, LinearFriction) and t.term.drive.friction_place == "motor"
         for t in model.appended
     )
     if not at_motors:

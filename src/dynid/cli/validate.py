@@ -153,7 +153,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         drop_invalid=args.drop_invalid,
         cutoff_hz=args.cutoff,
         max_gap_s=args.max_gap,
-        drive=load_drive_arg(args, robot.n),
+        drive=load_drive_arg(args, robot.n, robot_rotors=not isinstance(model, IdentifiedModel)),
         q_start=args.q_start,
     )
     result = validate_files(model, args.data, options, feasible=args.params, label=label)

@@ -652,7 +652,7 @@ def fit_law_through(
     ShapeError, DataError, ConvergenceError
         As :func:`fit_law`.
     """
-    if drive is None or drive.friction_at == "joint":
+    if drive is None or drive.friction_place == "joint":
         return fit_law(law, dq, residual, dq_noise_std=dq_noise_std, warn=warn, width=width)
     dq, residual = _pair(dq, residual)
     K = drive.transmission

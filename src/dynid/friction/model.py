@@ -42,7 +42,7 @@ All evaluate on velocities of shape ``(..., n)`` and return torques of the same 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -241,7 +241,7 @@ class FrictionSum:
         return np.concatenate([p.as_array() for p in self.parts], axis=1)
 
     def placed(self, drive: Drive | None) -> FrictionSum:
-        """A robot's friction sum where ``drive`` puts it: each part placed as
+        """A given friction sum where ``drive`` puts it: each part placed as
         :meth:`Friction.placed` places it (a part naming its own drive acts as it says)."""
         return FrictionSum(tuple(p.placed(drive) for p in self.parts))
 
@@ -309,43 +309,59 @@ def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | Frict
     """A robot's friction, ``robot.friction``, typed as the :class:`Friction` it is (the
     model layer names it by a protocol), or None.
 
-    A robot holds its friction per joint, without a drive; with ``drive`` it is returned
-    where that drive puts it: per motor (``tau_f = K^T f(K dq)``) when the drive's friction
-    acts at the motors (``friction_at = "motor"``), else as held (a friction that names its
-    own drive acts as it says). This is the one place a robot's own friction is placed:
+    A robot description holds its friction per joint, without a drive: a URDF's
+    ``<dynamics>``, an MJCF's ``damping`` and ``frictionloss``, a robot TOML's sigmoid per
+    joint are the joints' by definition. With ``drive`` such a part stays at the joints
+    unless the drive file says ``friction_at = "motor"`` itself, which moves it to the
+    motors (``tau_f = K^T f(K dq)``; :func:`own_at_motors_note` says so); a geared
+    drive's default place (:attr:`Drive.friction_place`) is where identification fits
+    friction, not where a description's acts (an MJCF exported from a model identified
+    through a gear-50..100 drive, read back with the same drive file, validated at
+    6.3e5 %). A part that names its own drive (a robot TOML's ``[friction]`` table with
+    ``at``) acts as it says. This is the one place a robot's own friction is placed:
     simulation, validation, payload identification and the observer all read it here.
     Without ``drive``: as held (what a robot description file writes)."""
     own = cast(Friction | FrictionSum | None, robot.friction)
-    return None if own is None else own.placed(drive)
+    if own is None or drive is None or drive.friction_at != "motor":
+        return own
+    parts = tuple(p.at(drive) if p.drive is None else p for p in friction_parts(own))
+    return parts[0] if len(parts) == 1 else FrictionSum(parts)
 
 
 def own_at_motors_note(robot: Robot, drive: Drive | None) -> str | None:
-    """The note when ``robot``'s own friction (a description file's) acts at the motors
-    of a geared ``drive`` (``friction_at = "motor"``, a geared drive's default,
-    :func:`robot_friction`): its coefficients are then read as the motors' while a URDF's
-    ``<dynamics>`` hold the joints' (an SO-101 exported to URDF, validated through a
-    hand-written drive of gear ratio 345, read 6e6 % with no word why); None otherwise."""
+    """The one line when ``robot``'s own friction (a description file's: the joints' by
+    definition) is read at the motors of a geared ``drive`` because the drive file says
+    ``friction_at = "motor"`` itself (:meth:`~dynid.friction.laws.base.Friction.placed`):
+    its coefficients are then read as the motors', the gear ratio squared apart from the
+    joints' for a viscous term; None otherwise (no such friction, no such drive, or the
+    default place, which leaves a description's friction at the joints). A dynid export's
+    joint friction read this way validated at 6e5 % (unusable)."""
     if robot.friction is None or drive is None or drive.friction_at != "motor":
         return None
     if np.allclose(drive.transmission, np.eye(robot.n)):
         return None
+    if not any(p.drive is None for p in friction_parts(cast(Any, robot.friction))):
+        return None  # every part records its own place and holds it
     return (
-        f"the robot's own friction ({robot.name}) acts at the motors through the drive "
-        '(friction_at = "motor", the default of a geared drive): its coefficients are '
-        "read as the motors'; a URDF's or MJCF's joint friction (as dynid exports write "
-        'it) is the joints\': friction_at = "joint" in the drive file reads it so'
+        f"the robot's own friction ({robot.name}: a description's, the joints' by "
+        "definition) is read at the motors because the drive file says friction_at = "
+        "\"motor\": its coefficients are taken as the motors' (a joint's damping is the "
+        "motor's times the gear ratio squared); without friction_at the drive leaves a "
+        "description's friction at the joints, as a URDF and an MJCF (and dynid's exports) "
+        "write it"
     )
 
 
 def placed_friction(
     friction: FrictionModel | FrictionSum | None, drive: Drive | None
 ) -> FrictionModel | FrictionSum | None:
-    """A friction given for a robot's own (a ``friction.json``, a model) where ``drive``
-    puts a robot's own (:func:`robot_friction`): a law per joint without a drive of its
-    own acts per motor (``K^T f(K dq)``) when the drive's friction acts at the motors; any
-    other acts as it says. Simulation, validation and the observer read a given friction
-    alike (a file validated through a geared drive read at the joints what simulation put
-    at the motors: "unusable, 100 %" for the true model)."""
+    """A friction given for a model (a ``friction.json``, a ground truth) where ``drive``
+    puts it (:meth:`~dynid.friction.laws.base.Friction.placed`): a law per joint without
+    a drive of its own acts per motor (``K^T f(K dq)``) when the drive's friction acts at
+    the motors (:attr:`Drive.friction_place`); any other acts as it says. Simulation,
+    validation and the observer read a given friction alike (a file validated through a
+    geared drive read at the joints what simulation put at the motors: "unusable, 100 %"
+    for the true model)."""
     return friction.placed(drive) if isinstance(friction, Friction) else friction
 
 

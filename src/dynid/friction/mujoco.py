@@ -233,7 +233,7 @@ def joint_coulomb_viscous(
                 None,
                 terms.damping,
                 terms.frictionloss,
-                friction_at_motor=d.friction_at == "motor",
+                friction_at_motor=d.friction_place == "motor",
             ),
             offset=terms.offset,
         )

@@ -224,7 +224,7 @@ def friction_violations(
             f[:, j] += x * cols[id(term)][:, j, term.parts.index(p)]
         return f
 
-    where = "motor" if drive.friction_at == "motor" else "joint"
+    where = "motor" if drive.friction_place == "motor" else "joint"
     vmax = speed_limits(drive.friction_transmission, dq_max)
     return power_violations(torques, vmax, coefficients, where)
 

@@ -658,9 +658,9 @@ def _placed(
     acts through, and the standstill band there."""
     at = Drive.identity(n) if model_drive is None else model_drive
     where = "motor" if where == "both" else where  # the friction at the joints beside it
-    if where and model_drive is not None and where != model_drive.friction_at:
+    if where and model_drive is not None and where != model_drive.friction_place:
         model_drive = at = replace(model_drive, friction_at=where)  # type: ignore[arg-type]
-    b = tuple((bands or {}).get(str(at.friction_at), band))
+    b = tuple((bands or {}).get(str(at.friction_place), band))
     return model_drive, at, b or (0.0,) * n
 
 

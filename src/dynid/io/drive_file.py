@@ -10,10 +10,17 @@ Keys (all optional but ``schema`` in a file of its own; n = the robot's joint co
     effort = "torque" | "current"     # what the tau columns hold (torque)
     torque_constant = [...]           # n [N m / A]: at the motor for side = "motor"
     rotor_inertia = "identify" | [...]  # n [kg m^2] at the motors (identify)
-    friction_at = "motor" | "joint"   # default motor when K is not the identity
+    friction_at = "motor" | "joint"   # where identified friction acts (default below)
 
 Every per-joint list (``gear_ratio``, ``offset``, ``torque_constant``, ``rotor_inertia``)
 may be one number, used for every joint (``gear_ratio = 1``: a direct drive).
+Without ``friction_at`` the friction identified through the drive acts at the motors when
+``K`` is not the identity (else at the joints), and a robot description's own friction
+(URDF ``<dynamics>``, MJCF ``damping``/``frictionloss``, a robot TOML's sigmoid per joint),
+the joints' by definition, stays at the joints; ``friction_at = "motor"`` given moves that
+too to the motors (said in one note), ``friction_at = "joint"`` puts identified friction at
+the joints. A model's friction that records its place (``at`` in ``identification.json``,
+``feasible.json``, a robot TOML's ``[friction]`` table) acts there whatever the drive says.
 ``qm = K (q - offset)``, ``dqm = K dq``, ``tau_joint = K^T tau_motor``
 (:mod:`dynid.model.drive`). Every fault (an unknown key, a wrong type or length, a singular
 ``K``, a coupling outside the chain or given twice, currents without constants) is one
@@ -22,6 +29,7 @@ may be one number, used for every joint (``gear_ratio = 1``: a direct drive).
 
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -44,6 +52,7 @@ __all__ = [
     "drive_of_robot_file",
     "drive_toml",
     "load_drive",
+    "with_file_rotors",
 ]
 
 _CHOICES = {
@@ -226,6 +235,44 @@ def drive_of_robot_file(spec: str | Path, n: int) -> Drive | None:
     return drive_from_mapping(doc["drive"], n, source=f"{p.name} [drive]")
 
 
+def with_file_rotors(drive: Drive, spec: str | Path, n: int) -> tuple[Drive, str | None]:
+    """``drive`` with the rotor inertias the robot file ``spec`` holds when the drive
+    leaves them to identify, and the note that says so; else ``drive`` and None.
+
+    A robot description is validated, not identified: its rotor inertias unknown read as
+    none (a Panda export of gears 50..100 validated at 19.5 % through its own drive file).
+    The file's (an MJCF's ``armature``, a robot TOML's ``[drive]`` table) are taken as the
+    joints' ``diag(K_f^T diag(I_f) K_f)`` [kg m^2] and put at the motors of ``drive``:
+    ``I_a`` solving ``(K o K)^T I_a = diag(...)`` (``o`` elementwise), exact when ``K`` is
+    the file's own (coupled or not); not taken when that gives a negative inertia. A file
+    without rotor inertias (a URDF) gets a note that the prediction holds none."""
+    if drive.rotor_inertia is not None:
+        return drive, None
+    held = drive_of_robot_file(spec, n)
+    name = Path(spec).name
+    if held is None or held.rotor_inertia is None or not np.any(held.rotor_inertia):
+        return drive, (
+            f"the drive file leaves the rotor inertias to identify and {name} holds none "
+            "(a URDF cannot): the prediction holds no rotor inertia; give rotor_inertia "
+            "in the drive file"
+        )
+    at_joints = np.diag(held.rotor_mass_matrix(held.rotor_inertia))
+    K = drive.transmission
+    ia = np.linalg.solve((K * K).T, at_joints)
+    what = "armature" if Path(spec).suffix.lower() == ".xml" else "[drive] rotor inertias"
+    if np.any(ia < -1e-9 * float(np.max(at_joints))):
+        return drive, (
+            f"the drive file leaves the rotor inertias to identify and {name}'s {what} "
+            "give a negative one at its motors: the prediction holds no rotor inertia"
+        )
+    ia = np.clip(ia, 0.0, None)
+    said = (
+        f"the drive file leaves the rotor inertias to identify: {name}'s {what} are taken, "
+        "at its motors " + " ".join(f"{x:.4g}" for x in ia) + " kg m^2"
+    )
+    return dataclasses.replace(drive, rotor_inertia=ia), said
+
+
 def drive_toml(drive: Drive) -> str:
     """The drive as a ``[drive]`` TOML table (gear ratios and coupling entries), which
     :func:`load_drive` reads back to the same drive (floats as ``repr``)."""
@@ -244,8 +291,9 @@ def drive_toml(drive: Drive) -> str:
         f"gear_ratio = {vec(np.diag(K))}",
         "coupling = [" + ", ".join(f"[{i + 1}, {j + 1}, {float(K[i, j])!r}]" for i, j in off) + "]",
         f"offset = {vec(drive.offset)}",
-        f'friction_at = "{drive.friction_at}"',
     ]
+    if drive.friction_at is not None:  # as given: a default place stays a default
+        lines.append(f'friction_at = "{drive.friction_at}"')
     if drive.torque_constant is not None:
         lines.append(f"torque_constant = {vec(drive.torque_constant)}")
     ia = drive.rotor_inertia

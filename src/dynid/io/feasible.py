@@ -344,7 +344,7 @@ def fitted_robot(result: FeasibleResult) -> Robot:
 
 
 def _at_motors(friction: Friction) -> bool:
-    return friction.drive is not None and friction.drive.friction_at == "motor"
+    return friction.drive is not None and friction.drive.friction_place == "motor"
 
 
 def save_feasible_json(path: str | Path, source: FeasibleResult | Robot) -> Path:
@@ -501,7 +501,7 @@ def load_feasible_linear_friction(path: str | Path) -> Friction | FrictionSum | 
     if d.get("linear_friction") is None:
         return None
     drive = load_feasible_drive(path)
-    at = drive if drive is not None and drive.friction_at == "motor" else None
+    at = drive if drive is not None and drive.friction_place == "motor" else None
     n, name = len(d["links"]), Path(path).name
     parts = [law_friction(d["linear_friction"], at, n, name, "linear_friction")]
     if d.get("joint_friction") is not None:

@@ -15,8 +15,14 @@ two terms to the rigid-body joint torques, both linear in their parameters (Khal
           \\tau_f = K^T f(K \\dot q)
 
 ``I_a`` [kg m^2] is each rotor's inertia about its axis, at the motor; ``f`` is the friction
-law evaluated at the motor velocities (``friction_at="motor"``, the default when ``K`` is not
-the identity) or at the joints (``K`` replaced by the identity in ``tau_f``).
+law evaluated at the motor velocities (``friction_at="motor"``) or at the joints (``K``
+replaced by the identity in ``tau_f``). The drive keeps ``friction_at`` as given (None: not
+said) and resolves it in :attr:`Drive.friction_place`: the motors when ``K`` is not the
+identity, else the joints. That default is where identification puts the friction it fits;
+a robot description's own friction (a URDF's ``<dynamics>``, an MJCF's ``damping`` and
+``frictionloss``, a robot TOML's sigmoid per joint) is the joints' by definition and moves to
+the motors only when the drive says ``friction_at="motor"`` itself
+(:meth:`dynid.friction.laws.base.Friction.placed`).
 
 A log records either side (``side``) and either effort (``effort``): motor currents
 ``i`` [A] become torques through ``torque_constant`` (N m per A at the motor for a
@@ -68,8 +74,9 @@ class Drive:
         currents.
     rotor_inertia : ndarray, shape (n,), or None
         Known rotor inertias [kg m^2] at the motors, or None to identify them.
-    friction_at : {"motor", "joint"}
-        Where the friction law acts; default motor when ``K`` is not the identity.
+    friction_at : {"motor", "joint"} or None
+        Where the friction law acts, as given; None when not given (:attr:`friction_place`
+        resolves it: the motors when ``K`` is not the identity, else the joints).
 
     Raises
     ------
@@ -121,14 +128,10 @@ class Drive:
             ia = _checks.as_exact("rotor_inertia", self.rotor_inertia, (n,))
             if np.any(ia < 0):
                 raise ModelError(f"rotor_inertia must be >= 0 [kg m^2]; got {ia.tolist()}")
-        at = self.friction_at
-        if at is None:
-            at = "joint" if np.array_equal(K, np.eye(n)) else "motor"
         object.__setattr__(self, "transmission", _checks.frozen(K))
         object.__setattr__(self, "offset", _checks.frozen(off))
         object.__setattr__(self, "torque_constant", None if kt is None else _checks.frozen(kt))
         object.__setattr__(self, "rotor_inertia", None if ia is None else _checks.frozen(ia))
-        object.__setattr__(self, "friction_at", at)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -187,9 +190,23 @@ class Drive:
         return self.rotor_inertia is None
 
     @property
+    def friction_place(self) -> FrictionAt:
+        """Where the friction law acts: ``friction_at`` when given, else the motors when
+        ``K`` is not the identity and the joints when it is (module docstring)."""
+        if self.friction_at is not None:
+            return self.friction_at
+        return "joint" if np.array_equal(self.transmission, np.eye(self.n)) else "motor"
+
+    @property
+    def friction_at_given(self) -> bool:
+        """True when ``friction_at`` was given (the drive file says it), False when
+        :attr:`friction_place` is the default."""
+        return self.friction_at is not None
+
+    @property
     def friction_transmission(self) -> NDArray[np.float64]:
         """The ``K`` of the friction term: the transmission, or the identity at the joints."""
-        return self.transmission if self.friction_at == "motor" else np.eye(self.n)
+        return self.transmission if self.friction_place == "motor" else np.eye(self.n)
 
     @property
     def is_coupled(self) -> bool:
@@ -290,7 +307,9 @@ class Drive:
 
     # ------------------------------------------------------------------ records
     def as_dict(self) -> dict[str, object]:
-        """JSON/TOML-ready record (schema ``dynid-drive/1``): ``transmission`` as rows."""
+        """JSON/TOML-ready record (schema ``dynid-drive/1``): ``transmission`` as rows,
+        ``friction_at`` resolved (:attr:`friction_place`: where a model identified through
+        the drive holds its friction)."""
         return {
             "schema": DRIVE_SCHEMA,
             "side": self.side,
@@ -303,7 +322,7 @@ class Drive:
             "rotor_inertia": "identify"
             if self.rotor_inertia is None
             else self.rotor_inertia.tolist(),
-            "friction_at": self.friction_at,
+            "friction_at": self.friction_place,
         }
 
     def describe(self) -> str:
@@ -322,5 +341,5 @@ class Drive:
             if self.rotor_inertia is None
             else "rotor inertia " + " ".join(f"{x:.4g}" for x in self.rotor_inertia) + " kg m^2"
         )
-        parts.append(f"friction at the {self.friction_at}s")
+        parts.append(f"friction at the {self.friction_place}s")
         return "; ".join(parts)

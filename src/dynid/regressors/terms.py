@@ -504,7 +504,7 @@ class LinearFriction:
             F[..., m, k * m + i] = parts[..., i]
         if self.mask:
             F = F[..., self._held]
-        if self.drive.friction_at == "joint":
+        if self.drive.friction_place == "joint":
             return F
         return np.einsum("mj,...mc->...jc", self.drive.transmission, F)
 
@@ -523,7 +523,7 @@ class LinearFriction:
         its band and where it acts."""
         n = self.drive.n
         band = np.asarray(self.law_band, dtype=np.float64) if self.law_band else np.zeros(n)
-        at_motors = self.drive.friction_at == "motor"
+        at_motors = self.drive.friction_place == "motor"
         return FrictionValues(
             self.law, self.as_array(np.asarray(values)), band, self.drive if at_motors else None
         )
@@ -560,7 +560,7 @@ class LinearFriction:
             "width": list(self.width),
             "vst": self.vst,
             "mask": list(self.mask),
-            "at": self.drive.friction_at,
+            "at": self.drive.friction_place,
             "prefix": self.prefix,
         }
 
@@ -572,7 +572,7 @@ class LinearFriction:
         direct drive of ``n`` joints when None)."""
         d = dict(definition)
         at = Drive.identity(n) if drive is None else drive
-        if d.get("at", at.friction_at) != at.friction_at:
+        if d.get("at", at.friction_place) != at.friction_place:
             at = replace(at, friction_at=d["at"])
         return cls(
             at,

@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError, ShapeError
-from ..friction.model import FrictionModel, FrictionSum, robot_friction
+from ..friction.model import FrictionModel, FrictionSum, placed_friction, robot_friction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -228,9 +228,11 @@ def _checked(
         effects.check(robot)
     if drive is not None:
         drive.check(n)
-    # a ground truth given stands for the robot's own: both act where the drive puts it
-    truth = robot if isinstance(friction, str) else robot.with_friction(friction)
-    return robot_friction(truth, drive)
+    # the robot's own (a description's): the joints' unless the drive file says motor; a
+    # ground truth given: where the drive puts a given friction (placed_friction)
+    if isinstance(friction, str):
+        return robot_friction(robot, drive)
+    return placed_friction(friction, drive)
 
 
 def _true_torques(

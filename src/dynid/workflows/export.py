@@ -164,7 +164,7 @@ def export_robot(
         friction = linear
         at_joints = isinstance(linear, Friction) and linear.drive is None
         if isinstance(linear, Friction) and at_joints and drive is not None:
-            friction = linear.at(drive) if drive.friction_at == "motor" else linear
+            friction = linear.at(drive) if drive.friction_place == "motor" else linear
     written = ExportOptions(
         template=None if opt.urdf_template is None else Path(opt.urdf_template),
         base=opt.base,

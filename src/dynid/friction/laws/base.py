@@ -247,7 +247,7 @@ class Friction:
     @property
     def at_motors(self) -> bool:
         """Whether the law acts at the motors of a drive (``K^T f(K dq)``)."""
-        return self.drive is not None and self.drive.friction_at == "motor"
+        return self.drive is not None and self.drive.friction_place == "motor"
 
     @property
     def transmission(self) -> NDArray[np.float64]:
@@ -266,12 +266,13 @@ class Friction:
         return Friction(self.law, self.params, self.band, drive)
 
     def placed(self, drive: Drive | None) -> Friction:
-        """A robot's friction, given per joint without a drive, where ``drive`` puts it:
-        per motor (``K^T f(K dq)``, :meth:`at`) when its friction acts at the motors
-        (``friction_at = "motor"``), else itself. Called in one place,
-        :func:`~dynid.friction.model.robot_friction`, which simulation and every
-        comparison with a robot's own friction read."""
-        if drive is None or self.drive is not None or drive.friction_at != "motor":
+        """A friction given per joint without a drive (a ``friction.json``, a ground truth
+        handed to simulation) where ``drive`` puts it: per motor (``K^T f(K dq)``,
+        :meth:`at`) when its friction acts at the motors (:attr:`Drive.friction_place`,
+        the place identification fits friction in), else itself. A robot description's
+        own friction is placed by :func:`~dynid.friction.model.robot_friction` instead
+        (the joints', unless the drive file says ``friction_at = "motor"``)."""
+        if drive is None or self.drive is not None or drive.friction_place != "motor":
             return self
         return self.at(drive)
 

@@ -155,7 +155,11 @@ def _joint_terms(
     if d is not None:
         d.check(n)
         jt = drive_joint_terms(
-            d.transmission, d.rotor_inertia, None, None, friction_at_motor=d.friction_at == "motor"
+            d.transmission,
+            d.rotor_inertia,
+            None,
+            None,
+            friction_at_motor=d.friction_place == "motor",
         )
         notes = jt.notes
         armature = jt.armature if d.rotor_inertia is not None else None

@@ -60,7 +60,7 @@ def friction_tables(friction: Friction | FrictionSum | None) -> str:
         return ""
     out = []
     for key, part in zip(("friction", "joint_friction"), friction_parts(friction), strict=False):
-        at = "motor" if part.drive is not None and part.drive.friction_at == "motor" else "joint"
+        at = "motor" if part.drive is not None and part.drive.friction_place == "motor" else "joint"
         rec = law_record(part)
         lines = [f"[{key}]", f'model = "{rec.pop("model")}"', f'at = "{at}"']
         units = dict(zip(part.law.params, part.law.units, strict=True))
@@ -118,5 +118,6 @@ def _one_table(
         if table is None
         else drive_from_mapping(table, n, source=f"{source} [drive]")
     )
-    drive = dataclasses.replace(drive, friction_at=at)
+    if drive.friction_place != at:  # a default place that is the table's stays a default
+        drive = dataclasses.replace(drive, friction_at=at)
     return law_friction(rec, drive, n, source, key)

@@ -53,7 +53,6 @@ Conventions
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import warnings
 import xml.etree.ElementTree as ET
@@ -65,7 +64,6 @@ from numpy.typing import NDArray
 
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...friction.model import ClassicalFriction, Friction
-from ...model.drive import Drive
 from ...model.inertia import inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ...progress import NOTE
@@ -197,10 +195,9 @@ def _friction(w: _Walk) -> Friction | None:
     if not np.any(fv_fc != 0.0):
         return None
     n = len(fv_fc)
-    # at the joints, where the file puts it: a geared drive given later does not move it
-    # to the motors (a joint's damping read per motor, times the gear ratio squared)
-    at = dataclasses.replace(Drive.identity(n), friction_at="joint")
-    return ClassicalFriction(fv_fc[:, 0], fv_fc[:, 1], np.zeros(n)).at(at)
+    # per joint, without a drive: a description's friction, which a geared drive leaves at
+    # the joints unless its file says friction_at = "motor" (Friction.placed)
+    return ClassicalFriction(fv_fc[:, 0], fv_fc[:, 1], np.zeros(n))
 
 
 def robot_from_urdf_string(
