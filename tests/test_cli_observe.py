@@ -3,7 +3,10 @@
 
 from __future__ import annotations
 
+import html
 import json
+import logging
+import re
 
 import numpy as np
 import pytest
@@ -257,12 +260,13 @@ def test_calibrating_an_identified_model_in_blocks_keeps_no_series(logs, monkeyp
     np.testing.assert_allclose(lean.thresholds.noise, noise, rtol=1e-9, atol=1e-12)
 
 
-def _without_velocities(src, dst) -> None:
-    """``src``'s log with its velocity columns left out (t, q, tau)."""
+def _without_velocities(src, dst, columns: int = 15) -> None:
+    """``src``'s log with its velocity columns left out (t, q, tau; tau_ext too if it has
+    them: ``columns`` 22)."""
     lines = [x for x in src.read_text().splitlines() if not x.startswith("#")]
     head = lines[0].split(",")
     keep = [i for i, h in enumerate(head) if not h.startswith("dq")]
-    assert len(keep) == 15, head
+    assert len(keep) == columns, head
     dst.write_text("\n".join(",".join(x.split(",")[i] for i in keep) for x in lines) + "\n")
 
 
@@ -353,3 +357,54 @@ def test_calibration_says_when_velocity_noise_times_the_gain_sets_the_thresholds
     derived = ["observe", *model, "--data", str(logs / "free_q2.csv"), "--calibrate"]
     assert main([*derived, "--out", str(logs / "cal_q2")]) == 0
     assert "velocity noise x gain" not in capsys.readouterr().out
+
+
+def _answer(page: str) -> str:
+    """The report's first screen: its answer box."""
+    i = page.index('id="verdict"')
+    return page[i : page.index("</section>", i)]
+
+
+@pytest.mark.filterwarnings("ignore:.*of each piece:UserWarning")
+def test_delays_of_derived_velocities_carry_their_caveat_beside_them(
+    logs, tmp_path, capsys, caplog
+):
+    """A log without velocity columns: the delays come from a zero-phase low-pass that sees
+    ahead, and the printed score line, events.json's score and the report's delay sentence
+    say so beside the delay; the same log with its recorded velocities says nothing of it.
+    The report's note on the log keeps the file name's case (it wrote 'Hit_q.csv'), and
+    events.json's samples and duration_s are one-entry lists for the one log, equal to the
+    file's rows and first-to-last time."""
+    from dynid.observer.scoring import LOOK_AHEAD_WORDS
+
+    d = logs
+    _without_velocities(d / "hit.csv", tmp_path / "hit_q.csv", columns=22)
+    p = ["observe", "--params", "panda", "--no-figures"]
+    assert (
+        main([*p, "--data", str(d / "free.csv"), "--calibrate", "--out", str(tmp_path / "c")]) == 0
+    )
+    th = ["--thresholds", str(tmp_path / "c" / "thresholds.json")]
+    said = {}
+    for name in ("hit_q.csv", "hit.csv"):
+        src = tmp_path / name if name == "hit_q.csv" else d / name
+        capsys.readouterr()
+        with caplog.at_level(logging.INFO, logger="dynid"):  # an earlier -q raised it
+            assert main([*p, *th, "--data", str(src), "--out", str(tmp_path / name[:-4])]) == 0
+        (line,) = [x for x in capsys.readouterr().out.splitlines() if "delay median" in x]
+        doc = json.loads((tmp_path / name[:-4] / "events.json").read_text())
+        page = (tmp_path / name[:-4] / "report.html").read_text()
+        said[name] = (line, doc, _answer(page))
+    line, doc, answer = said["hit_q.csv"]
+    assert doc["score"]["detected"] == 2 and doc["score"]["delays_look_ahead"] is True
+    assert line.endswith(f"max {doc['score']['delay_max_ms']:.0f} ms ({LOOK_AHEAD_WORDS})")
+    (fact,) = [x for x in answer.split("<li>") if "delay median" in x]
+    assert html.escape(f" ms ({LOOK_AHEAD_WORDS}).", quote=True) in fact
+    text = re.sub(r"<[^>]+>", "", answer)
+    assert "Note: hit_q.csv: no velocity columns" in text and "Hit_q" not in text
+    rows = [x for x in (tmp_path / "hit_q.csv").read_text().splitlines()[1:] if x]
+    t = np.array([float(x.split(",")[0]) for x in rows])
+    assert doc["data"] == ["hit_q.csv"] and doc["samples"] == [len(rows)]
+    assert doc["duration_s"] == pytest.approx([t[-1] - t[0]], rel=1e-12)
+    line, doc, answer = said["hit.csv"]
+    assert doc["score"]["detected"] == 2 and doc["score"]["delays_look_ahead"] is False
+    assert "zero-phase" not in line and "zero-phase" not in answer

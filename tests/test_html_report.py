@@ -871,3 +871,24 @@ def test_the_friction_page_names_what_friction_json_holds(tmp_path):
     assert "the model's own friction (classical at the motors" in text and "3.12 %" in text
     assert "3.136" not in text and "the lowest of" not in text
     assert ">motor 1<" in page and ">motor 2<" in page
+
+
+@pytest.mark.parametrize(
+    ("said", "shown"),
+    [
+        ("free.csv: no velocity columns", "free.csv: no velocity columns"),
+        ("hit.csv", "hit.csv"),
+        ("shoulder_lift_joint moves fast", "shoulder_lift_joint moves fast"),
+        ("q2 wraps", "q2 wraps"),
+        ("friction is in the logs: 0.3 N m", "Friction is in the logs: 0.3 N m"),
+        ("the friction is panda's own", "The friction is panda's own"),
+        ("low-speed error", "Low-speed error"),
+        ("", ""),
+    ],
+)
+def test_a_note_opening_with_a_file_name_keeps_its_case(said, shown):
+    """Only an ordinary opening word is capitalised: a file name or an identifier keeps
+    its case (the report wrote 'Note: Free.csv'), and the rest is never changed."""
+    from dynid.report.html import capitalised
+
+    assert capitalised(said) == shown

@@ -286,3 +286,18 @@ def test_a_one_sample_crossing_is_said_to_last_one_sample():
     said = dropped_words(2.01, 2.01, "joint4", -0.7, 1.26, "isolated", 0.05)
     assert said.startswith("2.010 s, joint4") and "one sample < 50 ms" in said
     assert " 0 ms" not in said and ".." not in said
+
+
+def test_delays_of_look_ahead_velocities_carry_their_caveat_in_the_score_line():
+    """A score whose velocities came from a zero-phase low-pass says so right after its
+    delays, pooled over logs when any one of them did; a score without says nothing."""
+    from dynid.observer.scoring import LOOK_AHEAD_WORDS, combined, score_words
+
+    ev, lab = [[1.02, 1.4]], [[1.0, 1.3]]
+    ahead = score_events(ev, lab, (0.0, 5.0), look_ahead=True)
+    plain = score_events(ev, lab, (0.0, 5.0))
+    assert score_words(ahead).endswith(f"delay median 20 ms, max 20 ms ({LOOK_AHEAD_WORDS})")
+    assert score_words(plain).endswith("delay median 20 ms, max 20 ms")
+    assert combined([plain, ahead]).look_ahead and not combined([plain, plain]).look_ahead
+    none = score_events(np.zeros((0, 2)), lab, (0.0, 5.0), look_ahead=True)
+    assert LOOK_AHEAD_WORDS not in score_words(none)  # no delay to qualify

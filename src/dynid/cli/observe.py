@@ -65,9 +65,10 @@ event overlaps it or starts within --label-tolerance (0.1 s, the observer's lag)
 its end; an event overlapping no contact is a false alarm. The summary prints per log
 and in total the contacts labelled, detected and missed (each missed one with its times
 and, from tau_ext, its peak true torque), the false alarms and their rate per minute of
-contact-free time, and the delays (event start less contact start, median and max);
-events.json holds them under score; residuals.png hatches the labelled contacts. A log
-without labels is not scored.
+contact-free time, and the delays (event start less contact start, median and max;
+with velocities derived from the positions, the zero-phase low-pass sees ahead, and the
+delays, shorter than an online observer's, say so); events.json holds them under score;
+residuals.png hatches the labelled contacts. A log without labels is not scored.
 One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
 (a push near the threshold on a joint at rest crosses it again and again as the
 standstill margin follows the velocity noise), and an event shorter than --min-duration

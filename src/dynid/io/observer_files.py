@@ -26,11 +26,12 @@
 [s], ``joints`` (1-based) and ``joint_names`` (the same joints by name), ``peak`` [N m]
 (one per joint, signed), ``level`` (``contact`` or ``collision``) and ``log`` (the name
 of the event's log, one log or several), with the model's ``joints`` (names), the data
-files, their sample counts, durations and the time their events cover (``duration_s``,
-``flagged_s`` [s] per log), the model's files and their SHA-256 (``model_files``,
-``model_sha256``) and the units. ``dropped`` (detecting with the event rules recorded)
-holds the crossings over the contact threshold that the minimum duration dropped, which
-are not events: ``min_duration_s`` and ``merge_s`` [s], ``count`` (all of them) and
+files, their sample counts, durations and the time their events cover (``data``,
+``samples``, ``duration_s`` and ``flagged_s`` [s]: lists with one entry per log in
+``data``'s order, a one-entry list for one log), the model's files and their SHA-256
+(``model_files``, ``model_sha256``) and the units. ``dropped`` (detecting with the event
+rules recorded) holds the crossings over the contact threshold that the minimum duration
+dropped, which are not events: ``min_duration_s`` and ``merge_s`` [s], ``count`` (all of them) and
 ``crossings`` (those furthest over the threshold, at most
 :data:`~dynid.observer.events.MAX_DROPPED` per log), each ``{"start", "end",
 "duration_s"}`` [s], ``joints`` and ``joint_names`` (over the threshold), ``joint`` (the
@@ -161,6 +162,7 @@ _SCORE_FIELDS = {
     "false_alarms_per_min": Field("number", nullable=True, low=0.0, unit="1/min"),
     "delay_median_ms": Field("number", nullable=True, unit="ms"),
     "delay_max_ms": Field("number", nullable=True, unit="ms"),
+    "delays_look_ahead": Field("bool"),
     "missed_contacts": Field(
         "objects",
         required=True,
@@ -216,8 +218,10 @@ DROPPED = Record(
         ),
     }
 )
-#: ``events.json``: the events, the crossings dropped and the score declared; the logs'
-#: and the model's metadata (``data``, ``samples``, ``duration_s``, ``model``, ...) kept unchecked.
+#: ``events.json``: the events, the crossings dropped and the score declared; the logs
+#: (``data``, ``samples``, ``duration_s``, ``flagged_s``) as lists with one entry per log
+#: in ``data``'s order, one log or several (a reader indexes or sums them alike); the
+#: model's metadata (``model``, ``source``, ...) kept unchecked.
 EVENTS = Format(
     EVENTS_SCHEMA,
     Record(
@@ -239,6 +243,8 @@ EVENTS = Format(
                     }
                 ),
             ),
+            "data": Field("strings"),
+            "samples": Field("numbers", shape=(None,), low=0),
             "duration_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
             "flagged_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
             "score": Field("object", record=SCORE),
@@ -633,6 +639,7 @@ def _score_record(sc: ContactScore) -> dict[str, Any]:
         "false_alarms_per_min": sc.false_alarms_per_min,
         "delay_median_ms": None if sc.delay_median is None else 1e3 * sc.delay_median,
         "delay_max_ms": None if sc.delay_max is None else 1e3 * sc.delay_max,
+        "delays_look_ahead": sc.look_ahead,
         "missed_contacts": [{"start": m.start, "end": m.end, "peak": m.peak} for m in sc.missed],
     }
 

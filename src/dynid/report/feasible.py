@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .html import cell, esc, figure, is_number, number, section, table, verdict
+from .html import capitalised, cell, esc, figure, is_number, number, section, table, verdict
 from .identify import used_structure
 from .run import Answer, RunFiles
 
@@ -79,7 +79,7 @@ def answer(run: RunFiles) -> Answer | None:
     implausible = [
         n for n in rep.get("notes") or [] if isinstance(n, str) and n.startswith("implausible")
     ]
-    facts += [esc(n[0].upper() + n[1:]) for n in implausible]
+    facts += [esc(capitalised(n)) for n in implausible]
     good = ok and is_number(res) and res < RESIDUAL_GOOD
     plain = good and not rep.get("on_bound") and not implausible
     level = "poor" if not ok else "good" if plain else "fair"
@@ -120,7 +120,7 @@ def _structure_fact(run: RunFiles, feas: dict) -> list[str]:
     friction = " + ".join(f"{esc(rec.get('model'))} law at {w}" for rec, w in laws) or "none"
     said = f"friction identified with the links: {friction}"
     if used is None:
-        return [said[0].upper() + said[1:]]
+        return [capitalised(said)]
     return [f"Structure of the consistent fit: <b>{esc(used)}</b>; {said}"]
 
 

@@ -11,6 +11,7 @@ import base64
 import html
 import math
 import os
+import re
 import urllib.parse
 from collections.abc import Sequence
 from pathlib import Path
@@ -19,6 +20,7 @@ from typing import Any, TypeGuard
 __all__ = [
     "MAX_VECTOR",
     "bar",
+    "capitalised",
     "cell",
     "esc",
     "figure",
@@ -40,6 +42,20 @@ __all__ = [
 
 #: Longest numeric vector shown inline.
 MAX_VECTOR = 12
+
+
+#: A first word that is an ordinary word (letters, hyphens, apostrophes), not a file name
+#: or an identifier (``free.csv``, ``shoulder_lift_joint``, ``q2``).
+_WORD = re.compile(r"[A-Za-z][A-Za-z'-]*(?=[\s,;:!?)]|$)")
+
+
+def capitalised(text: str) -> str:
+    """``text`` with its first letter upper case when it opens with an ordinary word;
+    unchanged when it opens with a file name or an identifier (``"free.csv: ..."``,
+    ``"shoulder_lift_joint ..."``), whose case is theirs. The rest is never changed."""
+    if not _WORD.match(text):
+        return text
+    return text[0].upper() + text[1:]
 
 
 def esc(text: object) -> str:

@@ -41,7 +41,19 @@ from ..identification.verdict import (
     with_caveat,
     worst,
 )
-from .html import bar, cell, esc, figure, is_number, number, percent, section, table, verdict
+from .html import (
+    bar,
+    capitalised,
+    cell,
+    esc,
+    figure,
+    is_number,
+    number,
+    percent,
+    section,
+    table,
+    verdict,
+)
 from .model_terms import terms_sections
 from .run import Answer, RunFiles
 from .springs import spring_facts, springs_section
@@ -143,7 +155,7 @@ def _heldout_facts(
         headline = said or headline
         low = held.get("low_speed")
         if isinstance(low, str) and low:  # where the rest of the error sits
-            facts.append(esc(low[0].upper() + low[1:]))
+            facts.append(esc(capitalised(low)))
     elif headline and judged is None:
         facts.append(
             "Sensor-noise floor not measured (heldout.json absent: the run was made with "
@@ -177,7 +189,7 @@ def _own_facts(
         facts.append(f"{int(spikes)} one-sample torque spike(s) replaced, as the fit replaced them")
     low = held.get("low_speed")
     if isinstance(low, str) and low:  # where the rest of the error sits
-        facts.append(esc(low[0].upper() + low[1:]))
+        facts.append(esc(capitalised(low)))
     return facts, problems, headline
 
 
@@ -720,7 +732,7 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
             "held-out relative error [%]",
         ]
         said = f"{held.get('block', 'Held-out data')}: {VERDICT_SAMPLES} (the verdict's numbers)"
-        parts.append(f"<p>{esc(said[0].upper() + said[1:])}.</p>" + table(headers, rows))
+        parts.append(f"<p>{esc(capitalised(said))}.</p>" + table(headers, rows))
     if not parts:
         return ""
     return section("torques", "Torques on held-out data", *parts)
@@ -766,7 +778,7 @@ def _structure_section(doc: dict) -> str:
     ] + (["left out per joint"] if left else [])
     rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
     kept = determined_sentence(sel.get("kept_determined"))
-    rule += "" if kept is None else f" {esc(kept[0].upper() + kept[1:])}."
+    rule += "" if kept is None else f" {esc(capitalised(kept))}."
     parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
     per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
     if per:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from .html import cell, esc, is_number, number, section, table
+from .html import capitalised, cell, esc, is_number, number, section, table
 
 __all__ = ["terms_sections"]
 
@@ -38,10 +38,10 @@ def _heading(term: dict[str, Any]) -> str:
         where = "the motors" if definition.get("at") == "motor" else "the joints"
         parts = definition.get("parts")
         law = ": " + " + ".join(map(str, parts)) if isinstance(parts, list) and parts else ""
-        return f"{name.capitalize()} at {where}{esc(law)} (value \u00b1 std)"
+        return f"{capitalised(name)} at {where}{esc(law)} (value \u00b1 std)"
     if term.get("kind") == "rotor_inertia":
-        return f"{name.capitalize()}: armature or rotor inertia at the motors (value \u00b1 std)"
-    return f"{name.capitalize()} (value \u00b1 std)"
+        return f"{capitalised(name)}: armature or rotor inertia at the motors (value \u00b1 std)"
+    return f"{capitalised(name)} (value \u00b1 std)"
 
 
 def _unit(code: str) -> str:

@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..identification.verdict import LEVELS
-from .html import esc, figure, href, is_number, number, section, table, verdict
+from .html import capitalised, esc, figure, href, is_number, number, section, table, verdict
 from .json_tables import json_section
 from .run import Answer, RunFiles
 
@@ -134,8 +134,9 @@ def _flagged(doc: Any) -> str:
 
 def _scored(doc: Any) -> str | None:
     """The events against the labelled contacts in one escaped sentence (``events.json``'s
-    ``score``: counts, false alarms per minute of contact-free time, delays), or None where
-    the file has none."""
+    ``score``: counts, false alarms per minute of contact-free time, delays, and beside
+    them, where ``delays_look_ahead``, that a zero-phase filter's delays are shorter than
+    an online observer's), or None where the file has none."""
     sc = doc.get("score") if isinstance(doc, dict) else None
     keys = ("labelled", "detected", "missed", "false_alarms")
     if not isinstance(sc, dict) or not all(is_number(sc.get(k)) for k in keys):
@@ -149,6 +150,10 @@ def _scored(doc: Any) -> str | None:
         said += f" ({rate:.3g} per minute of contact-free time)"
     if is_number(mid := sc.get("delay_median_ms")) and is_number(top := sc.get("delay_max_ms")):
         said += f"; delay median {mid:.0f} ms, max {top:.0f} ms"
+        if sc.get("delays_look_ahead") is True:  # beside the delay it qualifies
+            from ..observer.scoring import LOOK_AHEAD_WORDS  # here: any run's page loads this
+
+            said += f" ({LOOK_AHEAD_WORDS})"
     return esc(said + ".")
 
 
@@ -210,7 +215,7 @@ def _notes(run: RunFiles) -> list[str]:
     out = []
     for n in notes:
         head, rest = (n.split(": ", 1) + [""])[:2] if ": " in n else (n, "")
-        said = esc(head[0].upper() + head[1:])
+        said = esc(capitalised(head))
         out.append(f"<b>Note: {said}</b>" + (f": {esc(rest)}" if rest else ""))
     return out
 

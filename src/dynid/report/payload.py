@@ -26,7 +26,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..identification.verdict import FLOOR_FAIR, FLOOR_GOOD
-from .html import cell, esc, is_number, number, section, table, verdict
+from .html import capitalised, cell, esc, is_number, number, section, table, verdict
 from .run import Answer, RunFiles
 
 __all__ = ["MASS_SURE", "payload_answer"]
@@ -73,7 +73,7 @@ def payload_answer(run: RunFiles) -> Answer | None:
         facts.append("Inertia not identified from these data (mass and CoM only)")
     head = _headline(doc, std, rel, undetermined)
     if load_doubts:
-        facts = [esc(d[0].upper() + d[1:]) for d in load_doubts] + facts
+        facts = [esc(capitalised(d)) for d in load_doubts] + facts
         label = "not a load to trust"
         return Answer(verdict("poor", esc(head), facts, label), (_section(doc, std, frame),))
     reasons = _reservations(doc, rel, undetermined)

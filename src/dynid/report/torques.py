@@ -28,7 +28,7 @@ from ..identification.verdict import (
     joint_levels,
     judge_prediction,
 )
-from .html import cell, esc, figure, is_number, percent, section, table, verdict
+from .html import capitalised, cell, esc, figure, is_number, percent, section, table, verdict
 from .run import Answer, RunFiles
 from .springs import spring_facts, springs_section
 
@@ -73,7 +73,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
     else:
         label = {"poor": "poor: improve the model", "unusable": "unusable: check the data"}[level]
     facts = [
-        f"<b>{esc(label[0].upper() + label[1:])}</b>: {esc(reason)}",
+        f"<b>{esc(capitalised(label))}</b>: {esc(reason)}",
         f"Relative error without {added} {percent(without.get('relative_error_percent'))}"
         + (
             f", with {added}"

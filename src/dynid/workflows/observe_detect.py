@@ -212,7 +212,7 @@ def detected_log(
         figure=None if strided is None else strided.series(),
         peak_ratio=det.largest_ratio,
         friction=None if seen is model.friction else seen,
-        score=scored(log.t, events, labels, ext, tolerance_s),
+        score=scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived),
         dropped=det.dropped,
         dropped_count=det.dropped_count,
     )
@@ -247,12 +247,15 @@ def scored(
     labels: Labels | None,
     ext: NDArray | None,
     tolerance_s: float = DEFAULT_TOLERANCE_S,
+    *,
+    look_ahead: bool = False,
 ) -> ContactScore | None:
     """The ``events`` of a log at times ``t`` (N,) [s] scored against its ``labels``, else
     against the true external torques ``ext`` (N, n) [N m] (in contact where some joint
     exceeds :data:`~dynid.observer.scoring.TRUTH_LEVEL`); the missed contacts' peaks known
     wherever the true torques are, the labels' contacts too; None with neither
-    (:mod:`dynid.observer.scoring`)."""
+    (:mod:`dynid.observer.scoring`); ``look_ahead``: the velocities came from a zero-phase
+    low-pass (:attr:`~dynid.observer.scoring.ContactScore.look_ahead`)."""
     if labels is not None:
         intervals, source = label_intervals(t, labels.flags), labels.source
         peaks = None if ext is None else interval_peaks(t, ext, intervals)
@@ -264,7 +267,15 @@ def scored(
         return None
     ev = np.array([(e.start, e.end) for e in events], dtype=np.float64).reshape(-1, 2)
     span = (float(t[0]), float(t[-1])) if t.shape[0] else (0.0, 0.0)
-    return score_events(ev, intervals, span, tolerance_s=tolerance_s, peaks=peaks, source=source)
+    return score_events(
+        ev,
+        intervals,
+        span,
+        tolerance_s=tolerance_s,
+        peaks=peaks,
+        source=source,
+        look_ahead=look_ahead,
+    )
 
 
 def observed_wrench(
