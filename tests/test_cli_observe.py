@@ -388,7 +388,7 @@ def test_delays_of_derived_velocities_carry_their_caveat_beside_them(
     for name in ("hit_q.csv", "hit.csv"):
         src = tmp_path / name if name == "hit_q.csv" else d / name
         capsys.readouterr()
-        with caplog.at_level(logging.INFO, logger="dynid"):  # an earlier -q raised it
+        with caplog.at_level(logging.INFO, logger="dynid"):  # the notes the report records
             assert main([*p, *th, "--data", str(src), "--out", str(tmp_path / name[:-4])]) == 0
         (line,) = [x for x in capsys.readouterr().out.splitlines() if "delay median" in x]
         doc = json.loads((tmp_path / name[:-4] / "events.json").read_text())

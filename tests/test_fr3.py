@@ -180,3 +180,13 @@ def test_kinematics_commands_on_fr3_say_nothing_of_its_link_parameters(capsys, m
     log_to_stderr("identify", NOTE)
     load_robot("fr3")
     assert capsys.readouterr().err.count("note:") == 1
+
+
+def test_a_run_in_a_process_leaves_its_logging_as_it_was(monkeypatch):
+    """main() called in a process (-q) restores the root logger's level and handlers."""
+    root = logging.getLogger()
+    monkeypatch.setattr(root, "handlers", [])
+    monkeypatch.setattr(root, "level", logging.WARNING)
+    q = ",".join(["0"] * 7)
+    assert main(["fk", "--q", q, "-q"]) == 0
+    assert root.level == logging.WARNING and root.handlers == []

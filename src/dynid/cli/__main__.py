@@ -270,7 +270,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     Run as the program (``argv`` None), the stop signals are ignored once the run is over:
     the interpreter resets their handlers as it exits, and a late Ctrl-C would kill it
     after a complete run, reported as interrupted (exit 130 beside a complete ``--out``).
+    Called in a process (``argv`` given), the root logger's level and handlers are left
+    as they were: a ``-q`` run does not silence the next.
     """
+    root = logging.getLogger()
+    level, handlers = root.level, list(root.handlers)
     try:
         return _main(argv)
     except KeyboardInterrupt:  # while the modules are imported, before the run's own handler
@@ -284,6 +288,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         if argv is None:
             for sig in (signal.SIGINT, *TERMINATING):
                 signal.signal(sig, signal.SIG_IGN)
+        else:
+            root.setLevel(level)
+            for h in [h for h in root.handlers if h not in handlers]:
+                root.removeHandler(h)
 
 
 def _main(argv: Sequence[str] | None) -> int:
