@@ -18,9 +18,11 @@ from dynid.exceptions import DataError, DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.recordings import prepare_recordings
 from dynid.io.torque_log import load_torque_log
+from dynid.observer.model import from_robot
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 from dynid.workflows.identify import IdentifyOptions, identify_files
+from dynid.workflows.observe_logs import prepared_log
 from dynid.workflows.recordings import read_recordings
 
 FRICTION = ClassicalFriction(np.linspace(0.6, 0.2, 7), np.zeros(7), np.zeros(7))
@@ -114,3 +116,18 @@ def test_a_joint_in_degrees_is_still_named_degrees(panda, files, tmp_path):
     deg = _save(tmp_path / "deg.csv", log.t, q, log.tau)
     with pytest.raises(DataError, match=r"joint7.*degrees.*pi/180"):
         read_recordings(deg, panda)
+
+
+def test_observe_names_a_wrap_on_a_turn_limited_joint_as_the_fit_does(panda, files):
+    """The observer's preparation of the wrapped log names joint7's jumps and limits in the
+    same words as identify's (one finding), and unwraps it as the log moved (up to the
+    whole turn it starts in)."""
+    rec = read_recordings(files["b"], panda)
+    with pytest.warns(DynidWarning) as said:
+        prep = prepared_log(Path("b.csv"), rec.logs[0], from_robot(panda), None)
+    text = " ".join(str(w.message) for w in said)
+    assert "b.csv: joint(s) 7 recorded wrapped" in text and "do not allow a whole turn" in text
+    by_hand = read_recordings(files["b_by_hand"], panda).logs[0]
+    d = prep.log.q - by_hand.q
+    turns = np.round(d[0] / (2 * np.pi))
+    assert np.max(np.abs(d - 2 * np.pi * turns)) < 1e-12

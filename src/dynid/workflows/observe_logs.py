@@ -26,7 +26,7 @@ from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
-from ..identification.pieces import unwrapped, with_start_turns, wrappable
+from ..identification.pieces import unwrapped, with_start_turns, wrappable, wrapped_finding
 from ..observer.detection import residual_std_blocks, standstill_blocks
 from ..observer.friction import (
     DERIVED_CUTOFF_HZ,
@@ -117,15 +117,11 @@ def prepared_log(
     whole = with_start_turns(path.name, log, model.robot, model.drive, max_gap_s=max_gap)
     if side is None or whole is not log:
         side = joint_side_log(whole, model.drive)
-    log = side
-    log, turned = unwrapped(log, wrappable(model.robot))  # joints whose limits span a turn
-    if turned:  # M(q) is periodic; velocities derived across a wrap are not
-        warnings.warn(
-            f"{path.name}: joint(s) {', '.join(str(j + 1) for j in turned)} recorded wrapped "
-            "into [-pi, pi] (jumps of a whole turn): unwrapped",
-            DynidWarning,
-            stacklevel=4,
-        )
+    # M(q) is periodic; velocities derived across a wrap are not
+    log, turned = unwrapped(side, wrappable(model.robot))
+    if turned:
+        said = wrapped_finding(sorted(turned), robot=model.robot, log=side)
+        warnings.warn(f"{path.name}: {said}", DynidWarning, stacklevel=4)
     starts = _pieces(path, log, max_gap)
     dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
     cut = _cut_at_jumps(path, log, dq, starts)
