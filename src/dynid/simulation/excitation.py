@@ -349,10 +349,16 @@ def _classical_regressor(
 
 def _criterion(W: NDArray[np.float64], criterion: str) -> float:
     """The optimised criterion of ``[Y_b, F]`` (lower is better): ``log cond`` (unscaled) or
-    ``-mean log s`` of the column-scaled singular values (``logdet``)."""
+    ``-mean log s`` of the column-scaled singular values (``logdet``).
+
+    ``log cond`` is ``log(lambda_max / lambda_min) / 2`` of the Gram matrix ``W^T W`` (its
+    eigenvalues are the squared singular values): a ninth of the SVD's time on the
+    optimiser's (N n, r + 3 n) regressors, and at the conditions met here (up to about 1e4,
+    squared 1e8) its relative error stays near 1e-8, far below the finite-difference step.
+    The reported numbers (:func:`_conds`) come from the SVD."""
     if criterion == "cond":
-        s = np.linalg.svd(W, compute_uv=False)
-        return float(np.log(s[0] / max(s[-1], 1e-300)))
+        lam = np.linalg.eigvalsh(W.T @ W)
+        return float(0.5 * np.log(lam[-1] / max(lam[0], 1e-300)))
     nrm = np.linalg.norm(W, axis=0)
     s = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
     return -float(np.mean(np.log(np.maximum(s, 1e-300))))
