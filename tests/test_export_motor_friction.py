@@ -167,7 +167,7 @@ def test_coupled_motor_friction_is_written_on_the_diagonal_and_the_rest_is_named
     assert f"largest: joints 1-2, {30.0 * G * FV_M[1]:.4g}" in lines[0], lines[0]
     said = f"up to {2 * G * FC_M[1]:.4g} N m at joint 2, {30.0 * FC_M[1]:.4g} N m at joint 1"
     assert said in lines[0], lines[0]
-    assert "motor 2 turns at 30 dq1 + 100 dq2" in lines[0], lines[0]
+    assert "motor 2 turning at 30 dq1 + 100 dq2" in lines[0], lines[0]
     (text, _), mj_lines = _warnings(mjcf_from_robot, _arm(), friction=law)
     model = mujoco.MjModel.from_xml_string(text)
     np.testing.assert_allclose(model.dof_damping, back.fv, rtol=1e-12)
@@ -227,8 +227,27 @@ def test_a_coupled_smooth_law_says_its_rounding_and_its_coupling_apart(tmp_path)
     assert float(said.group(1)) == pytest.approx(rms.max(), rel=5e-3)
     fc2 = load_urdf(path).friction.fc[1] / G  # motor 2's Coulomb friction as written
     left = re.search(
-        r"left out, up to ([0-9.e+-]+) N m at joint 2, ([0-9.e+-]+) N m at joint 1", lines[0]
+        r"left out up to ([0-9.e+-]+) N m at joint 2, ([0-9.e+-]+) N m at joint 1", lines[0]
     )
     assert left is not None, lines[0]
     assert float(left.group(1)) == pytest.approx(2 * G * fc2, rel=1e-3)
     assert float(left.group(2)) == pytest.approx(30.0 * fc2, rel=1e-3)
+
+
+def test_coupled_coulomb_left_out_bounds_any_coupling():
+    """Drives with couplings of either sign on several motors: no velocities within the
+    limits leave out more than the bound (direct numpy over sampled velocities), and a
+    drive whose one coupled motor has a negative entry reaches it."""
+    rng = np.random.default_rng(47)
+    dq = rng.choice([-1.0, 1.0], (20000, 4)) * 10 ** rng.uniform(-3, 0.5, (20000, 4))
+    for trial in range(5):
+        K = np.diag(rng.uniform(20, 120, 4)) * rng.choice([-1.0, 1.0], 4)
+        for m, j in [(3, 2), (2, 1), (3, 0)][: trial % 3 + 1]:
+            K[m, j] = rng.uniform(-40, 40)
+        fc = rng.uniform(0.01, 0.1, 4)
+        full = np.sign(dq @ K.T) * fc @ K
+        direct = np.abs(full - np.abs(np.diag(K)) * fc * np.sign(dq)).max(axis=0)
+        bound = coupled_coulomb_left_out(K, fc)
+        assert np.all(direct <= bound * (1 + 1e-12)), (trial, direct, bound)
+        if trial % 3 == 0:  # motor 4 alone coupled (to joint 3): every sign reachable
+            np.testing.assert_allclose(direct, bound, rtol=1e-12)

@@ -217,19 +217,22 @@ def _coupled_coulomb_note(K: NDArray[np.float64], left: NDArray[np.float64]) -> 
     largest first, and the coupled motors' velocities their friction's sign follows."""
 
     def velocity(m: int) -> str:
-        terms = [f"{K[m, k]:.4g} dq{k + 1}" for k in np.flatnonzero(K[m])]
-        return f"motor {m + 1} turns at {' + '.join(terms)}"
+        terms = [
+            f"{'-' if K[m, k] < 0 else '+'} {abs(K[m, k]):.4g} dq{k + 1}"
+            for k in np.flatnonzero(K[m])
+        ]
+        first = terms[0][2:] if terms[0][0] == "+" else "-" + terms[0][2:]
+        return f"motor {m + 1} turning at {' '.join([first, *terms[1:]])}"
 
     coupled = np.flatnonzero(np.any((K - np.diag(np.diag(K))) != 0, axis=1))
     order = [int(j) for j in np.argsort(-left, kind="stable") if left[j] > 0]
     where = ", ".join(f"{left[j]:.4g} N m at joint {j + 1}" for j in order)
+    motors = " and ".join(velocity(int(m)) for m in coupled)
     return (
-        "Coulomb friction of coupled motors has no per-joint term (URDF and MJCF friction "
-        "is per joint and cannot hold this law): a motor's friction takes the sign of its "
-        f"own velocity ({'; '.join(velocity(int(m)) for m in coupled)}), each joint holds "
-        "its own motor's with the sign of the joint's velocity, |K_jj| fc_j sign(dq_j); "
-        f"left out, up to {where} (the other motors' sum_m |K_mj| fc_m, and twice "
-        "|K_jj| fc_j where the joint's own motor is turned against it by another joint)"
+        "Coulomb friction of coupled motors has no per-joint term in URDF or MJCF (a motor's "
+        f"follows the sign of the motor's velocity, {motors}, "
+        "and a joint holds its own motor's with the sign of the joint's velocity, "
+        f"|K_jj| fc_j sign(dq_j)) and is left out up to {where}"
     )
 
 
