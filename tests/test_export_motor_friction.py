@@ -21,6 +21,7 @@ from scipy.optimize import nnls
 from dynid.exceptions import DynidWarning
 from dynid.friction.laws import law_named
 from dynid.friction.model import ClassicalFriction
+from dynid.friction.mujoco import coupled_coulomb_left_out
 from dynid.friction.validation import validate_torques
 from dynid.io.robot.export_options import ExportOptions
 from dynid.io.robot.mjcf import mjcf_from_robot
@@ -152,7 +153,9 @@ def test_coupled_motor_friction_is_written_on_the_diagonal_and_the_rest_is_named
     """A coupled wrist (motor 2 turned by joint 1 as well, K_21 = 30) with classical
     friction at its motors: URDF and MJCF hold diag(K^T diag(fv) K) and |K_jj| fc_j, and
     the warning names the viscous coupling dropped (K_21 K_22 fv_2) and the Coulomb friction
-    of motor 2 on joint 1 (|K_21| fc_2), which no per-joint term holds."""
+    of motor 2 on joint 1 (|K_21| fc_2) and on joint 2, whose motor's sign follows
+    30 dq1 + G dq2 rather than dq2 (2 G fc_2), which no per-joint term holds; the warning
+    used to name joint 1 alone, with the smaller number."""
     drive = Drive.from_gears([G, G], [(2, 1, 30.0)], side="joint", friction_at="motor")
     law = ClassicalFriction(FV_M, FC_M, 0 * FV_M).at(drive)
     K = drive.transmission
@@ -162,9 +165,89 @@ def test_coupled_motor_friction_is_written_on_the_diagonal_and_the_rest_is_named
     np.testing.assert_allclose(back.fc, np.abs(np.diag(K)) * FC_M)
     assert len(lines) == 1, lines
     assert f"largest: joints 1-2, {30.0 * G * FV_M[1]:.4g}" in lines[0], lines[0]
-    assert f"up to {30.0 * FC_M[1]:.4g} N m at joint 1" in lines[0], lines[0]
+    said = f"up to {2 * G * FC_M[1]:.4g} N m at joint 2, {30.0 * FC_M[1]:.4g} N m at joint 1"
+    assert said in lines[0], lines[0]
+    assert "motor 2 turning at 30 dq1 + 100 dq2" in lines[0], lines[0]
     (text, _), mj_lines = _warnings(mjcf_from_robot, _arm(), friction=law)
     model = mujoco.MjModel.from_xml_string(text)
     np.testing.assert_allclose(model.dof_damping, back.fv, rtol=1e-12)
     np.testing.assert_allclose(model.dof_frictionloss, back.fc, rtol=1e-12)
     assert "Coulomb friction of coupled motors" in mj_lines[0], mj_lines
+
+
+def _wrist_drive_K():
+    """The transmission of a UR5-like arm with a coupled wrist: gears 120/120/100/80/60/50,
+    motor 6 also turned by joint 5 with ratio 30."""
+    K = np.diag([120.0, 120.0, 100.0, 80.0, 60.0, 50.0])
+    K[5, 4] = 30.0
+    return K
+
+
+def test_coupled_coulomb_left_out_is_the_largest_difference_over_velocities():
+    """Regression (a coupled wrist's export warned of 0.36 N m at joint 5 where joint 6
+    missed 1.2 N m): the bound equals the largest |K^T (fc sign(K dq)) - |K_jj| fc_j
+    sign(dq_j)| over velocities within 3.15 rad/s, computed directly with numpy."""
+    rng = np.random.default_rng(46)
+    K = _wrist_drive_K()
+    fc = np.array([0.06, 0.06, 0.045, 0.02, 0.015, 0.012])
+    dq = rng.choice([-1.0, 1.0], (20000, 6)) * 3.15 * 10 ** rng.uniform(-3, 0, (20000, 6))
+    full = np.sign(dq @ K.T) * fc @ K
+    diag = np.abs(np.diag(K)) * fc * np.sign(dq)
+    direct = np.abs(full - diag).max(axis=0)
+    bound = coupled_coulomb_left_out(K, fc)
+    np.testing.assert_allclose(bound, direct, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(bound[4:], [30 * fc[5], 2 * 50 * fc[5]], rtol=1e-12)
+    assert not np.any(coupled_coulomb_left_out(np.diag(np.diag(K)), fc))
+
+
+def test_a_coupled_smooth_law_says_its_rounding_and_its_coupling_apart(tmp_path):
+    """A smooth law at the motors of a coupled drive (motor 2 turned by joint 1, K_21 = 30):
+    the refit's RMS difference is each joint's own motor's law against its reflection of
+    the terms fitted per motor (scipy's NNLS over the motor's range), no longer joint 1
+    moving alone turning motor 2 too; the coupling is said on its own, 2 |K_22| fc_2 at joint 2 and
+    |K_21| fc_2 at joint 1 from the Coulomb friction read back from the URDF."""
+    wide = 0.2 * G * DQ_MAX
+    drive = Drive.from_gears([G, G], [(2, 1, 30.0)], side="joint", friction_at="motor")
+    law = _motor_law(vs=wide, drive=drive)
+    rms = np.zeros(2)
+    for j, top in enumerate(np.abs(drive.transmission) @ DQ_MAX):  # each motor's range
+        u = np.linspace(0.0, top, 201)[1:]
+        (fv, fc), _ = nnls(
+            np.column_stack([u, np.ones_like(u)]), FV_M[j] * u + FC_M[j] * np.tanh(u / wide[j])
+        )
+        v = np.linspace(0.0, DQ_MAX[j], 201)[1:]
+        own = G * (FV_M[j] * G * v + FC_M[j] * np.tanh(G * v / wide[j]))
+        rms[j] = np.sqrt(np.mean((own - G * G * fv * v - G * fc) ** 2))
+    path, lines = _warnings(export_urdf, tmp_path / "r.urdf", _arm(), ExportOptions(friction=law))
+    said = re.search(
+        r"RMS difference at the joints up to ([0-9.e+-]+) N m, at joint (\d)", lines[0]
+    )
+    assert said is not None, lines
+    assert int(said.group(2)) == int(np.argmax(rms)) + 1
+    assert float(said.group(1)) == pytest.approx(rms.max(), rel=5e-3)
+    fc2 = load_urdf(path).friction.fc[1] / G  # motor 2's Coulomb friction as written
+    left = re.search(
+        r"left out up to ([0-9.e+-]+) N m at joint 2, ([0-9.e+-]+) N m at joint 1", lines[0]
+    )
+    assert left is not None, lines[0]
+    assert float(left.group(1)) == pytest.approx(2 * G * fc2, rel=1e-3)
+    assert float(left.group(2)) == pytest.approx(30.0 * fc2, rel=1e-3)
+
+
+def test_coupled_coulomb_left_out_bounds_any_coupling():
+    """Drives with couplings of either sign on several motors: no velocities within the
+    limits leave out more than the bound (direct numpy over sampled velocities), and a
+    drive whose one coupled motor has a negative entry reaches it."""
+    rng = np.random.default_rng(47)
+    dq = rng.choice([-1.0, 1.0], (20000, 4)) * 10 ** rng.uniform(-3, 0.5, (20000, 4))
+    for trial in range(5):
+        K = np.diag(rng.uniform(20, 120, 4)) * rng.choice([-1.0, 1.0], 4)
+        for m, j in [(3, 2), (2, 1), (3, 0)][: trial % 3 + 1]:
+            K[m, j] = rng.uniform(-40, 40)
+        fc = rng.uniform(0.01, 0.1, 4)
+        full = np.sign(dq @ K.T) * fc @ K
+        direct = np.abs(full - np.abs(np.diag(K)) * fc * np.sign(dq)).max(axis=0)
+        bound = coupled_coulomb_left_out(K, fc)
+        assert np.all(direct <= bound * (1 + 1e-12)), (trial, direct, bound)
+        if trial % 3 == 0:  # motor 4 alone coupled (to joint 3): every sign reachable
+            np.testing.assert_allclose(direct, bound, rtol=1e-12)

@@ -28,8 +28,10 @@ as a [friction] table (exactly, as feasible.json does). URDF holds per joint dam
 sharp Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they cannot
 hold of the friction (a smooth law's rounding, a standstill band, the offsets, a Stribeck
 peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
-off-diagonal terms) and of the drive (MJCF: a coupled rotor's off-diagonal inertia); URDF
-names the rotor inertias it drops, by joint, in a warning of its own.
+off-diagonal terms: its motors' Coulomb friction, which follows the motors' velocities, is
+left out up to the N m named at each joint it acts on) and of the drive (MJCF: a coupled
+rotor's off-diagonal inertia); URDF names the rotor inertias it drops, by joint, in a
+warning of its own.
 
 A feasible.json of a fit that was not accepted ("feasible": false: its held-out error too
 far above least squares', or a constraint that does not hold) is refused with the reason

@@ -32,6 +32,7 @@ from .model import FrictionModel, FrictionSum, friction_parts
 __all__ = [
     "CoulombViscous",
     "DriveJointTerms",
+    "coupled_coulomb_left_out",
     "coulomb_viscous_from_sigmoid",
     "drive_joint_terms",
     "joint_coulomb_viscous",
@@ -168,15 +169,71 @@ def drive_joint_terms(
     if fc is not None:
         fcv = np.asarray(fc)
         loss = np.abs(np.diag(Kf)) * fcv
-        lost = np.abs(Kf - np.diag(np.diag(Kf))).T @ np.abs(fcv)  # per joint [N m]
-        if np.any(lost):
-            j = int(np.argmax(lost))
-            notes.append(
-                "Coulomb friction of coupled motors on other joints has no per-joint term and "
-                "is dropped (the joint's dry friction holds its own motor's; up to "
-                f"{lost[j]:.4g} N m at joint {j + 1}, sum_m |K_mj| fc_m over the other motors)"
-            )
+        left = coupled_coulomb_left_out(Kf, fcv)
+        if np.any(left > 0):
+            notes.append(_coupled_coulomb_note(Kf, left))
     return DriveJointTerms(arm, damp, loss, tuple(notes))
+
+
+def coupled_coulomb_left_out(K: ArrayLike, fc: ArrayLike) -> NDArray[np.float64]:
+    """The largest joint torque [N m] (n,) that per-joint Coulomb friction leaves out of
+    Coulomb friction at the motors of a coupled drive, at any joint velocities.
+
+    Motor ``m`` turns at ``(K dq)_m`` and its friction ``fc_m sign((K dq)_m)`` acts on the
+    joints through ``K^T``: joint ``j`` feels ``sum_m K_mj fc_m sign((K dq)_m)``. A file's
+    joint holds ``|K_jj| fc_j sign(dq_j)``, its own motor's friction with the sign of its
+    own velocity. Left out, at most
+
+    .. math:: \\sum_{m \\ne j} |K_{mj}| f_{c,m} + 2 |K_{jj}| f_{c,j} [\\text{motor } j
+              \\text{ turned by another joint}],
+
+    the other motors' friction, and the own motor's counted twice where its sign follows
+    other joints too (a slow joint ``j`` while a coupled joint turns its motor the other
+    way). The bound is reached when the signs can be set independently (one coupled motor,
+    as a wrist's: any joint velocity limits reach it, joint ``j`` slow enough); zero on a
+    diagonal ``K``.
+
+    Parameters
+    ----------
+    K : array_like, shape (n, n)
+        Motor velocities per joint velocity where the friction acts.
+    fc : array_like, shape (n,)
+        Coulomb friction per motor [N m] (its magnitude is used).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+    """
+    T = np.asarray(K, dtype=np.float64)
+    f = np.abs(np.asarray(fc, dtype=np.float64))
+    own = np.abs(np.diag(T)) * f
+    other = np.abs(T).T @ f - own
+    turned = np.any((T - np.diag(np.diag(T))) != 0, axis=1)  # motor j follows other joints
+    return np.asarray(other + 2.0 * own * turned, dtype=np.float64)
+
+
+def _coupled_coulomb_note(K: NDArray[np.float64], left: NDArray[np.float64]) -> str:
+    """The line naming the joints where :func:`coupled_coulomb_left_out` is not zero,
+    largest first, and the coupled motors' velocities their friction's sign follows."""
+
+    def velocity(m: int) -> str:
+        terms = [
+            f"{'-' if K[m, k] < 0 else '+'} {abs(K[m, k]):.4g} dq{k + 1}"
+            for k in np.flatnonzero(K[m])
+        ]
+        first = terms[0][2:] if terms[0][0] == "+" else "-" + terms[0][2:]
+        return f"motor {m + 1} turning at {' '.join([first, *terms[1:]])}"
+
+    coupled = np.flatnonzero(np.any((K - np.diag(np.diag(K))) != 0, axis=1))
+    order = [int(j) for j in np.argsort(-left, kind="stable") if left[j] > 0]
+    where = ", ".join(f"{left[j]:.4g} N m at joint {j + 1}" for j in order)
+    motors = " and ".join(velocity(int(m)) for m in coupled)
+    return (
+        "Coulomb friction of coupled motors has no per-joint term in URDF or MJCF (a motor's "
+        f"follows the sign of the motor's velocity, {motors}, "
+        "and a joint holds its own motor's with the sign of the joint's velocity, "
+        f"|K_jj| fc_j sign(dq_j)) and is left out up to {where}"
+    )
 
 
 def joint_coulomb_viscous(
@@ -238,7 +295,7 @@ def joint_coulomb_viscous(
             offset=terms.offset,
         )
     if refit.size:
-        notes += _refit_note(friction, jt, vmax, negative, refit)
+        notes += _refit_note(friction, jt, terms, vmax, negative, refit)
     return replace(jt, notes=notes + jt.notes)
 
 
@@ -320,17 +377,27 @@ def _dissipative(
 def _refit_note(
     friction: FrictionModel,
     written: DriveJointTerms,
+    motor: MjcfTerms,
     vmax: NDArray[np.float64],
     negative: NDArray[np.intp],
     refit: NDArray[np.intp],
 ) -> tuple[str, ...]:
-    """The line saying that the law of the motors (joints) ``refit`` was written as the
+    """The line saying that the law of the motors (joints) ``refit`` (per motor as
+    ``motor`` holds it, reflected to the joints as ``written``) was written as the
     closest nonnegative viscous and Coulomb friction, with the largest RMS difference at
     the joints they turn (:func:`joint_rms_difference`, joint-side torques over the
-    joints' range ``vmax``); none for a narrow smooth law held to round-off (its rounding
-    is said by :func:`unheld_friction`)."""
+    joints' range ``vmax``; of a coupled drive, each joint's own motor's law alone, the
+    coupling being said by :func:`drive_joint_terms`); none for a narrow smooth law held
+    to round-off (its rounding is said by :func:`unheld_friction`)."""
     turned = np.any(friction.transmission[refit] != 0, axis=0)
-    rms = joint_rms_difference(friction, written.damping, written.frictionloss, vmax)
+    own, damping, loss = friction, written.damping, written.frictionloss
+    T = friction.transmission
+    if friction.drive is not None and np.any(T != np.diag(np.diag(T))):
+        # each joint against its own motor's law; the coupling is said by drive_joint_terms
+        d = np.diag(T)
+        own = friction.at(replace(friction.drive, transmission=np.diag(d)))
+        damping, loss = d**2 * motor.damping, np.abs(d) * motor.frictionloss
+    rms = joint_rms_difference(own, damping, loss, vmax)
     rms = np.where(turned, rms, 0.0)
     j = int(np.argmax(rms))
     if not negative.size and rms[j] < ROUND_OFF_NM:
