@@ -26,7 +26,8 @@ determined to 3 %, kept ``M(q)`` of the wrist right;
 :attr:`~.candidates.Selection.determined` names what was kept so). A smooth Coulomb's
 width is then chosen per joint (:mod:`dynid.identification.widths`), and the Stribeck
 bump on the smooth sign judged at the width of the best smooth law
-(:mod:`dynid.identification.bumps`).
+(:mod:`dynid.identification.bumps`); the chosen Stribeck velocity is refined between its
+grid neighbours on the same held-out error (:mod:`dynid.identification.stribeck_velocity`).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
@@ -91,6 +92,7 @@ from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded, sign_confirmed
 from .recordings import Recordings, prepare_recordings
+from .stribeck_velocity import refined_velocity
 from .structural import absorbed_by
 from .structure import (
     ERROR_FLOOR_PERCENT,
@@ -323,7 +325,7 @@ def select_structure(
     judged += _smooth_bumps(judged, cands, fit, groups, by_group, where, skip, fit_rtol)
     if per_joint:
         judged += _per_joint(judged, by_group, robot.n, fit_rtol, where)
-    chosen = _chosen(judged)
+    chosen = _refined_stribeck(judged, fit, groups, by_group, where, skip, fit_rtol, notes)
     notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
     best = min(_physical(judged), key=lambda c: c.score)
     determined = _kept_determined(chosen, best, judged, by_group, robot.n, fit_rtol, where)
@@ -580,6 +582,68 @@ def _smooth_bumps(
 
     bump_widths(start, widths, at_width, _better)
     return new
+
+
+def _refined_stribeck(
+    judged: list[Candidate],
+    fit: Callable[[list[Structure], str], list[Fitted]],
+    groups: _Groups,
+    by_group: _Folds,
+    where: dict[Structure, _Key],
+    skip: tuple[int, ...],
+    rtol: float,
+    notes: list[str],
+) -> Structure:
+    """The structure chosen (:func:`_chosen`) with its Stribeck velocity refined between
+    its grid neighbours on the held-out error (:func:`~.stribeck_velocity.refined_velocity`,
+    driven by the scores of the chosen law without its coefficients left out at the grid's
+    velocities): the candidates judged at the new velocities appended to ``judged`` (each
+    velocity's fitted in a regressor of its own, recorded in ``groups``, ``by_group`` and
+    ``where``), and the structure of lowest held-out error among the chosen and those at
+    its coefficients, dissipative, said in ``notes``; the chosen itself where it holds no
+    Stribeck law or its grid was not judged."""
+    chosen = _chosen(judged)
+    if "stribeck" not in chosen.friction:
+        return chosen
+    full = replace(chosen, drop=())
+    scores = {
+        c.structure.vst: c.score
+        for c in judged
+        if c.structure == replace(full, vst=c.structure.vst) and not c.unphysical
+    }
+    new: list[Candidate] = []
+
+    def at(v: float) -> float | None:
+        mine = [replace(full, vst=v), *([replace(chosen, vst=v)] if chosen.drop else [])]
+        for family, model, terms, held in fit(mine, "structure search, the Stribeck velocity"):
+            own = (full.armature, full.at, f"{family} {v:g}")
+            groups[own] = (model, terms)
+            folds = without_recordings(model, skip) if skip else heldout_of(model)
+            by_group[own] = (model, terms, folds)
+            for c in held:
+                where[c] = own
+                new.append(
+                    _judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol)
+                )
+        return next((c.score for c in new if c.structure == mine[0]), None)
+
+    tried = refined_velocity(scores, chosen.vst, at)
+    here = [c for c in judged if c.structure == chosen]
+    judged += new
+    same = [c for c in new if c.structure.drop == chosen.drop and not c.unphysical]
+    best = min(here + same, key=lambda c: c.score, default=None)
+    if best is None or not here or not tried:
+        return chosen
+    grid = sorted(scores)
+    k = grid.index(chosen.vst)
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+    notes.append(
+        f"Stribeck velocity refined on held-out data between the grid's {lo:g} and {hi:g} "
+        f"rad/s ({len(tried)} more fit(s), at {', '.join(f'{v:g}' for v in tried)}): "
+        f"{best.structure.vst:g} rad/s, held-out error {best.heldout_error_percent:.4g} % "
+        f"(at the grid's {chosen.vst:g}: {here[0].heldout_error_percent:.4g} %)"
+    )
+    return best.structure
 
 
 def _plain_smooth(c: Structure) -> bool:
