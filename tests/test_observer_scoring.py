@@ -64,12 +64,34 @@ def test_matching_a_miss_a_false_alarm_two_events_in_one_contact_one_over_two():
     assert (s.labelled, s.detected, s.false_alarms) == (5, 4, 1)
     assert [(m.start, m.end, m.peak) for m in s.missed] == [(5.0, 6.0, 0.7)]
     np.testing.assert_allclose(s.delays, [0.05, 0.02, 0.28])
-    # contact-free: 12 s less [1, 2.1], [5, 6.1], [8, 9.1] (two windows joined), [10, 10.3]
-    assert s.contact_free_s == pytest.approx(12.0 - 1.1 - 1.1 - 1.1 - 0.3)
+    # contact-free: 12 s less [0.98, 2.1], [4.98, 6.1], [7.98, 9.1] (two windows joined),
+    # [9.98, 10.3]: the lead of 0.02 s before each contact, the tolerance after
+    assert s.contact_free_s == pytest.approx(12.0 - 1.12 - 1.12 - 1.12 - 0.32)
     assert s.false_alarms_per_min == pytest.approx(60.0 / s.contact_free_s)
     assert s.delay_median == pytest.approx(0.05) and s.delay_max == pytest.approx(0.28)
     tight = score_events(events, labels, (0.0, 12.0), tolerance_s=0.05)
-    assert (tight.detected, tight.false_alarms) == (3, 2)  # the late event: a false alarm
+    # the late event a false alarm; 0.1 s apart, the last two contacts are two groups,
+    # and the event open over both detects neither (a false alarm too)
+    assert (tight.detected, tight.false_alarms) == (1, 3)
+
+
+def test_an_event_starting_long_before_a_contact_or_open_over_several_detects_nothing():
+    """A whole-log event (0 to 15 s over contacts at 3, 7 and 11 s): a false alarm, all
+    three missed, no delay; an event starting 0.01 s before a contact (within the lead of
+    0.02 s) detects it with a delay of -10 ms, one starting 0.05 s before does not; an
+    event from inside the first contact still open over the second: a false alarm."""
+    labels = np.array([[3.0, 3.3], [7.0, 7.5], [11.0, 11.2]])
+    whole = score_events([[0.0, 15.0]], labels, (0.0, 15.0))
+    assert (whole.labelled, whole.detected, whole.false_alarms) == (3, 0, 1)
+    assert len(whole.missed) == 3 and whole.delays == () and whole.delay_median is None
+    near = score_events([[2.99, 3.2], [6.95, 7.4]], labels, (0.0, 15.0), lead_s=0.02)
+    assert (near.detected, near.false_alarms) == (1, 1)
+    np.testing.assert_allclose(near.delays, [-0.01])
+    first, false = match_events([[3.05, 7.2]], labels, 0.1, 0.02)
+    np.testing.assert_array_equal(first, [-1, -1, -1])
+    np.testing.assert_array_equal(false, [True])
+    later = score_events([[0.0, 15.0], [7.05, 7.3]], labels, (0.0, 15.0))
+    assert (later.detected, later.false_alarms) == (1, 1) and later.delays == pytest.approx((0.05,))
 
 
 def test_no_labels_every_event_false_and_totals_pool_logs():
@@ -133,7 +155,7 @@ def test_observe_scores_a_simulated_log_against_its_true_torques(pushes, capsys)
     report = (d / "sim" / "report.html").read_text()
     assert "3 labelled, 3 detected, 0 missed; 0 false alarm(s)" in report
     assert log["contact_free_s"] == pytest.approx(
-        4.0 - sum(b + 0.1 - a for a, b in log["contacts"])
+        4.0 - sum(b + 0.1 - a + log["lead_s"] for a, b in log["contacts"])
     )
 
 
@@ -164,6 +186,35 @@ def test_observe_scores_against_a_label_column_by_default_name_or_mapped(pushes,
     peak = None if mapped else 0.0
     assert score["missed_contacts"] == [{"start": 3.5, "end": 3.7, "peak": peak}]
     assert (out_dir / "residuals.png").stat().st_size > 0
+
+
+def test_a_whole_log_event_of_an_offset_torque_is_scored_a_false_alarm(pushes, capsys):
+    """The three pushes labelled, joint 2's torque offset by 10 N m (a sensor offset the
+    model lacks): one event over the whole log, scored 0 detected, 3 missed, 1 false alarm
+    and no delay, in the summary and in events.json (not 3 detected with a delay of
+    -0.8 s)."""
+    from dynid.io.torque_log import load_torque_log
+
+    d = pushes
+    t = load_torque_log(d / "hit.csv").t
+    flags = ((t >= 0.8) & (t <= 1.1)) | ((t >= 1.9) & (t <= 2.3)) | ((t >= 3.0) & (t <= 3.2))
+    _with_column(d / "hit.csv", d / "lab.csv", "collision", flags.astype(float))
+    lines = (d / "lab.csv").read_text().splitlines()
+    col = lines[2].split(",").index("tau2")
+    rows = [r.split(",") for r in lines[3:]]
+    for r in rows:
+        r[col] = f"{float(r[col]) + 10.0:.17g}"
+    (d / "offset.csv").write_text("\n".join(lines[:3] + [",".join(r) for r in rows]))
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    cmd = ["observe", "--params", "panda", "--no-figures", *th, "--data", str(d / "offset.csv")]
+    assert main([*cmd, "--out", str(d / "offset")]) == 0
+    out = capsys.readouterr().out
+    assert "1 event(s)" in out
+    assert "3 labelled, 0 detected, 3 missed; 1 false alarm(s)" in out
+    assert "delay" not in out.split("scored against")[1]
+    score = json.loads((d / "offset" / "events.json").read_text())["score"]
+    assert (score["detected"], score["missed"], score["false_alarms"]) == (0, 3, 1)
+    assert score["delay_median_ms"] is None and score["delay_max_ms"] is None
 
 
 def test_a_log_without_labels_is_not_scored(pushes, capsys):

@@ -334,3 +334,19 @@ def test_a_sign_law_without_a_band_on_noisy_velocities_is_observed_with_the_nois
     events = detect(t, r, fixed, standstill=w)
     assert len(events) == 1 and j + 1 in events[0].joints, events
     assert a <= events[0].start <= a + 0.1
+
+
+@pytest.mark.parametrize("law", ["stribeck", "smooth_stribeck"])
+@pytest.mark.parametrize("fs", [3.0, 1.4])
+def test_the_margin_at_rest_is_the_largest_static_friction_the_law_holds(law, fs):
+    """At rest the margin is fs for a positive Stribeck bump and fc for a negative one
+    (closed forms), the largest |friction less viscous and offset| of the law without a
+    band over velocities near rest; never fc + |fs - fc|."""
+    fc, vst = 2.0, 0.1
+    P = np.tile([0.5, fc, fs, vst, 0.3], (2, 1))  # fv, fc, fs, vst, fo
+    rest = standstill_margin(LawFriction(LAWS[law], P, np.full(2, 0.01)), np.zeros((1, 2)))[0]
+    assert rest == pytest.approx(np.full(2, max(fc, fs)), rel=1e-12)
+    v = np.linspace(1e-6, 10 * vst, 20001)[:, None] * np.array([1.0, -1.0])
+    sharp = LawFriction(LAWS["stribeck"], P, np.zeros(2))
+    held = np.max(np.abs(sharp.torques(v) - 0.5 * v - 0.3), axis=0)
+    assert rest == pytest.approx(held, rel=1e-6)

@@ -61,8 +61,10 @@ A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN no
 named collision, contact or label (the first the log has), or mapped with --columns
 label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in
 contact where some joint's |tau_ext| exceeds 0.1 N m). A contact is detected when an
-event overlaps it or starts within --label-tolerance (0.1 s, the observer's lag) after
-its end; an event overlapping no contact is a false alarm. The summary prints per log
+event starts from 0.02 s (or 3 samples) before it to --label-tolerance (0.1 s, the
+observer's lag) after its end, and closes before a later contact; an event that detects
+no contact is a false alarm (one starting long before a contact, a whole-log event over
+several contacts: the contacts are missed). The summary prints per log
 and in total the contacts labelled, detected and missed (each missed one with its times
 and, from tau_ext, its peak true torque), the false alarms and their rate per minute of
 contact-free time, and the delays (event start less contact start, median and max;
@@ -213,7 +215,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="SECONDS",
         help="logs with labelled contacts (a label column, or the true tau_ext of a "
         "simulated log): an event starting up to this long after a contact's end still "
-        f"detects it, the observer's lag (default {DEFAULT_TOLERANCE_S:g} s)",
+        f"detects it, the observer's lag (default {DEFAULT_TOLERANCE_S:g} s); contacts "
+        "closer than this are one, which one event detects",
     )
     add_column_options(p)
     add_drop_invalid(p)

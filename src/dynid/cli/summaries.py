@@ -980,8 +980,9 @@ def _score_lines(result: ObserveResult, labels: list[str]) -> list[str]:
         return []
     scored = [(lab, x.score) for lab, x in zip(labels, result.logs, strict=True) if x.score]
     rows = [
-        f"scored against labelled contacts ({total.source}; an event starting up to "
-        f"{total.tolerance_s:g} s after a contact's end detects it):"
+        f"scored against labelled contacts ({total.source}; an event starting from "
+        f"{total.lead_s:g} s before a contact's start to {total.tolerance_s:g} s after its "
+        "end detects it, one starting earlier or open over later contacts is a false alarm):"
     ]
     width = max(len(lab) for lab, _ in scored)
     parts = [(lab, sc) for lab, sc in scored] if len(scored) > 1 else []

@@ -154,6 +154,7 @@ _S = Field("number", required=True, low=0.0, unit="s")
 _SCORE_FIELDS = {
     "source": Field("string", required=True),
     "tolerance_s": _S,
+    "lead_s": Field("number", low=0.0, unit="s"),
     "labelled": _COUNT,
     "detected": _COUNT,
     "missed": _COUNT,
@@ -631,6 +632,7 @@ def _score_record(sc: ContactScore) -> dict[str, Any]:
     return {
         "source": sc.source,
         "tolerance_s": sc.tolerance_s,
+        "lead_s": sc.lead_s,
         "labelled": sc.labelled,
         "detected": sc.detected,
         "missed": len(sc.missed),

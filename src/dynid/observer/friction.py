@@ -24,11 +24,13 @@ inside the standstill band the law's Coulomb term is off (or, for ``tanh(v / v_s
 at its level), while the true friction of a slow reversal or a standstill lies anywhere in
 ``[-f_c, f_c]``. Its bound per motor is
 
-.. math:: w(v) = \\big(\\max(|f_{c+}|, |f_{c-}|) + |f_s - f_c|\\big) [|v| \\le b]
+.. math:: w(v) = \\max_{\\pm,\\, e \\in [0, 1]} |f_{c\\pm} + (f_s - f_c) e| \\, [|v| \\le b]
           + |f_t| \\big(1 - \\tanh(|v| / v_s)\\big)
 
-(``b`` the band; the Stribeck bump is off inside it as well; a bump on the smooth sign
-is not yet at its level with it: ``|f_s - f_c| (1 - tanh(|v| / v_s))`` instead),
+(``b`` the band; the Stribeck bump is off inside it as well: the largest static friction
+the law can hold is ``f_s`` for a positive bump and ``f_c`` for a negative one, where the
+law's magnitude rises from ``f_s`` at rest to ``f_c``; a bump on the smooth sign is not yet
+at its level with it: ``|f_t|`` becomes ``max(|f_t|, |f_t + f_s - f_c|)`` instead),
 ``|K_f|^T w(K_f dq)`` at the joints; 0 for the sigmoid law (no Coulomb level) and for
 laws without a canonical form (before the noise band's term below).
 A :class:`~dynid.friction.model.FrictionSum` (friction at the motors and at the joints)
@@ -354,9 +356,9 @@ def standstill_margin(
     K, F = canon
     vm = v @ K.T  # motor velocities
     smooth = F[:, 9] > 0  # the bump on the smooth sign: with ft below
-    level = np.maximum(np.abs(F[:, 2]), np.abs(F[:, 3])) + np.where(smooth, 0.0, np.abs(F[:, 6]))
+    level = _static_level(F[:, 2], F[:, 3], np.where(smooth, 0.0, F[:, 6]))
     w = np.where(np.abs(vm) <= F[:, 5], level, 0.0)
-    ft, vs = np.abs(F[:, 8]) + np.where(smooth, np.abs(F[:, 6]), 0.0), F[:, 9]
+    ft, vs = _static_level(F[:, 8], F[:, 8], np.where(smooth, F[:, 6], 0.0)), F[:, 9]
     with np.errstate(divide="ignore", invalid="ignore"):
         x = np.where(vs > 0, np.abs(vm) / np.where(vs > 0, vs, 1.0), np.inf)
     w = w + ft * np.where(vs > 0, 1.0 - np.tanh(x), np.where(vm == 0.0, 1.0, 0.0))
@@ -367,6 +369,19 @@ def standstill_margin(
             a, band = np.abs(vm), F[:, 5]
             w = w + level * ((a > band) & (a <= band + b)) + level * (a < b - band)
     out: NDArray[np.float64] = w @ np.abs(K)
+    return out
+
+
+def _static_level(
+    up: NDArray[np.float64], down: NDArray[np.float64], bump: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Per motor (n,) [N m]: the largest static friction a Coulomb step of levels ``up``
+    and ``down`` (for positive and negative velocities) with a Stribeck bump ``bump``
+    (``fs - fc``, decaying from its full height at rest to 0) can hold, the largest of
+    ``|fc + bump e|`` over ``e`` in ``[0, 1]``: ``fs`` for a positive bump, ``fc`` for a
+    negative one (the law's magnitude rises from ``fs`` to ``fc`` as the velocity grows)."""
+    ends = (np.abs(up), np.abs(down), np.abs(up + bump), np.abs(down + bump))
+    out: NDArray[np.float64] = np.maximum.reduce(ends)
     return out
 
 

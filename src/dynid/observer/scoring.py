@@ -7,18 +7,24 @@ torques of a simulated log, in contact where some joint's ``|tau_ext|`` exceeds
 
 * :func:`label_intervals`: each run of labelled samples as ``[t_first, t_last]`` [s],
   the convention of an event's start and end (first and last sample over the threshold);
-* :func:`match_events`: a labelled contact ``[a, b]`` is *detected* when some event
-  ``[s, e]`` overlaps ``[a, b + tolerance]`` (``s <= b + tolerance`` and ``e >= a``: the
-  observer's first-order lag ``K_O / (s + K_O)`` brings the residual over the threshold
-  after a short contact has ended); an event that overlaps no such window is a *false
-  alarm*. Two events in one contact are one detection; one event over two contacts
-  detects both;
+* :func:`match_events`: an event ``[s, e]`` *detects* a labelled contact ``[a, b]`` when
+  it starts within ``[a - lead, b + tolerance]`` (the observer's first-order lag
+  ``K_O / (s + K_O)`` brings the residual over the threshold after a short contact has
+  ended; ``lead``, a few samples, allows for velocities from a zero-phase filter, which
+  sees ahead) and ends before the next contact's window opens. Contacts less than
+  ``tolerance`` apart form one group, which one event detects as a whole: two events in
+  one contact are one detection; one event over two contacts that close detects both. An
+  event that starts earlier than ``lead`` before a contact, or stays open over a later
+  contact beyond its group (a whole-log event of a joint with a flipped torque sign, say),
+  detects nothing: it is a *false alarm*, and the contacts it covers are missed unless
+  another event detects them;
 * :func:`score_events`: the counts of one log (:class:`ContactScore`), the missed
   contacts with their times and peak true torque where known, the false alarms per minute
-  of contact-free time (the log's duration less the labelled contacts and the tolerance
-  after each) and the detection delays (the first overlapping event's start less the
-  contact's start; none for a contact whose event was already open over an earlier
-  labelled contact); :func:`combined` the total over logs.
+  of contact-free time (the log's duration less the labelled contacts, the lead before
+  and the tolerance after each) and the detection delays (the first detecting event's
+  start less the contact's start, never below ``-lead``; none for a contact whose event
+  was already open over an earlier contact of its group); :func:`combined` the total over
+  logs.
 
 Delays measured on velocities from a zero-phase low-pass (derived from the positions)
 are shorter than an online observer's: the filter sees ahead. A score says so
@@ -39,7 +45,9 @@ from numpy.typing import ArrayLike, NDArray
 from ..exceptions import ShapeError
 
 __all__ = [
+    "DEFAULT_LEAD_S",
     "DEFAULT_TOLERANCE_S",
+    "LEAD_SAMPLES",
     "LOOK_AHEAD_WORDS",
     "TRUTH_LEVEL",
     "ContactScore",
@@ -48,6 +56,7 @@ __all__ = [
     "delay_words",
     "interval_peaks",
     "label_intervals",
+    "lead_for",
     "match_events",
     "score_events",
     "score_words",
@@ -57,6 +66,13 @@ __all__ = [
 #: An event starting up to this long [s] after a labelled contact's last sample still
 #: detects it: five time constants of the observer's lag at the default gain (50/s).
 DEFAULT_TOLERANCE_S = 0.1
+#: An event starting up to this long [s] before a labelled contact's first sample still
+#: detects it: a few samples of a 200 Hz-1 kHz log, and the look-ahead of velocities from a
+#: zero-phase low-pass at the observer's cut-off (20 Hz: a time constant of 8 ms).
+#: :func:`lead_for` widens it to :data:`LEAD_SAMPLES` samples of a slower log.
+DEFAULT_LEAD_S = 0.02
+#: The fewest sample periods of lead (:func:`lead_for`).
+LEAD_SAMPLES = 3
 #: A simulated log is in contact where some joint's true external torque exceeds this
 #: [N m] (``tau_ext`` of ``dynid simulate --contact``, zero outside its windows).
 TRUTH_LEVEL = 0.1
@@ -123,10 +139,22 @@ def _as_intervals(x: ArrayLike, name: str) -> NDArray[np.float64]:
     return a
 
 
+def lead_for(t: ArrayLike) -> float:
+    """The lead [s] of a log sampled at times ``t`` (N,) [s]: :data:`DEFAULT_LEAD_S`, or
+    :data:`LEAD_SAMPLES` median sample periods where that is longer."""
+    t = np.asarray(t, dtype=np.float64)
+    dt = float(np.median(np.diff(t))) if t.shape[0] > 1 else 0.0
+    return max(DEFAULT_LEAD_S, LEAD_SAMPLES * dt)
+
+
 def match_events(
-    events: ArrayLike, labels: ArrayLike, tolerance_s: float = DEFAULT_TOLERANCE_S
+    events: ArrayLike,
+    labels: ArrayLike,
+    tolerance_s: float = DEFAULT_TOLERANCE_S,
+    lead_s: float = DEFAULT_LEAD_S,
 ) -> tuple[NDArray[np.intp], NDArray[np.bool_]]:
-    """Which event detects each labelled contact, and which events are false alarms.
+    """Which event detects each labelled contact, and which events are false alarms
+    (module docstring).
 
     Parameters
     ----------
@@ -136,15 +164,19 @@ def match_events(
         ``[start, end]`` [s] of the labelled contacts, in time order
         (:func:`label_intervals`).
     tolerance_s : float
-        How long after a contact's end [s] an event may start and still detect it.
+        How long after a contact's end [s] an event may start and still detect it;
+        contacts closer than this form one group.
+    lead_s : float
+        How long before a contact's start [s] an event may start and still detect it.
 
     Returns
     -------
     first : ndarray of int, shape (k,)
-        Index of the earliest-starting event that overlaps ``[a, b + tolerance_s]`` of
-        each contact; -1: missed.
+        Index of the earliest-starting event that detects each contact (starts within
+        ``[a - lead_s, b + tolerance_s]`` of its group and ends before the next group's
+        window); -1: missed.
     false : ndarray of bool, shape (m,)
-        Events that overlap no contact's window.
+        Events that detect no contact.
 
     Raises
     ------
@@ -153,9 +185,18 @@ def match_events(
     """
     ev = _as_intervals(events, "events")
     lab = _as_intervals(labels, "labels")
-    over = (ev[None, :, 0] <= lab[:, None, 1] + tolerance_s) & (ev[None, :, 1] >= lab[:, None, 0])
     if ev.shape[0] == 0:  # no event: every contact missed
         return np.full(lab.shape[0], -1, dtype=np.intp), np.zeros(0, dtype=bool)
+    if lab.shape[0] == 0:  # no contact: every event a false alarm
+        return np.zeros(0, dtype=np.intp), np.ones(ev.shape[0], dtype=bool)
+    opens = np.concatenate(([True], lab[1:, 0] - lab[:-1, 1] > tolerance_s))
+    group = np.cumsum(opens) - 1  # each contact's group
+    a = lab[opens, 0]  # the groups' first and last samples
+    b = lab[np.concatenate((opens[1:], [True])), 1]
+    after = np.concatenate((a[1:] - lead_s, [np.inf]))  # the next group's window opens
+    s, e = ev[None, :, 0], ev[None, :, 1]
+    hit = (s >= a[:, None] - lead_s) & (s <= b[:, None] + tolerance_s) & (e < after[:, None])
+    over = hit[group]
     starts = np.where(over, ev[None, :, 0], np.inf)
     first = np.where(over.any(axis=1), np.argmin(starts, axis=1), -1).astype(np.intp)
     false: NDArray[np.bool_] = np.logical_not(over.any(axis=0))
@@ -185,21 +226,24 @@ class ContactScore:
     labelled : int
         Labelled contacts.
     detected : int
-        Of them, those some event overlaps.
+        Of them, those some event detects (:func:`match_events`).
     missed : tuple of MissedContact
         The others, in time order.
     false_alarms : int
-        Events that overlap no labelled contact.
+        Events that detect no labelled contact.
     contact_free_s : float
-        The log's duration less the labelled contacts and the tolerance after each [s].
+        The log's duration less the labelled contacts, the lead before and the tolerance
+        after each [s].
     delays : tuple of float
-        Detection delays [s] (event start less contact start) of the detected contacts
-        whose event started after the previous contact's end.
+        Detection delays [s] (event start less contact start, ``-lead_s`` at the least)
+        of the detected contacts whose event started after the previous contact's end.
     intervals : tuple of (float, float)
         The labelled contacts ``(start, end)`` [s].
     look_ahead : bool
         The observer ran on velocities from a zero-phase low-pass, which sees ahead: the
         delays are shorter than an online observer's.
+    lead_s : float
+        How long before a contact's start [s] an event may start and still detect it.
     """
 
     source: str
@@ -212,6 +256,7 @@ class ContactScore:
     delays: tuple[float, ...]
     intervals: tuple[tuple[float, float], ...] = ()
     look_ahead: bool = False
+    lead_s: float = DEFAULT_LEAD_S
 
     @property
     def false_alarms_per_min(self) -> float | None:
@@ -238,6 +283,7 @@ def score_events(
     peaks: ArrayLike | None = None,
     source: str = "",
     look_ahead: bool = False,
+    lead_s: float = DEFAULT_LEAD_S,
 ) -> ContactScore:
     """The score of one log's events against its labelled contacts.
 
@@ -257,6 +303,8 @@ def score_events(
         Where the labels came from.
     look_ahead : bool
         See :class:`ContactScore`.
+    lead_s : float
+        See :func:`match_events`.
 
     Returns
     -------
@@ -272,7 +320,7 @@ def score_events(
     top = None if peaks is None else np.asarray(peaks, dtype=np.float64).reshape(-1)
     if top is not None and top.shape != (lab.shape[0],):
         raise ShapeError(f"peaks must be ({lab.shape[0]},); got {top.shape}")
-    first, false = match_events(ev, lab, tolerance_s)
+    first, false = match_events(ev, lab, tolerance_s, lead_s)
     missed = tuple(
         MissedContact(
             float(lab[k, 0]),
@@ -287,7 +335,7 @@ def score_events(
         if k == 0 or start > lab[k - 1, 1]:  # not an event still open from the last one
             delays.append(float(start - lab[k, 0]))
     t0, t1 = span
-    covered = _union_length(np.clip(lab + [0.0, tolerance_s], t0, t1))
+    covered = _union_length(np.clip(lab + [-lead_s, tolerance_s], t0, t1))
     return ContactScore(
         source,
         float(tolerance_s),
@@ -299,6 +347,7 @@ def score_events(
         tuple(delays),
         tuple((float(a), float(b)) for a, b in lab),
         look_ahead,
+        float(lead_s),
     )
 
 
@@ -315,7 +364,7 @@ def _union_length(iv: NDArray[np.float64]) -> float:
 def combined(scores: Sequence[ContactScore]) -> ContactScore:
     """The total of several logs' scores (their counts, times, misses and delays pooled);
     ``source`` and ``tolerance_s`` of the first, ``intervals`` left empty, ``look_ahead``
-    where any log's is.
+    where any log's is, ``lead_s`` the longest.
 
     Raises
     ------
@@ -334,6 +383,7 @@ def combined(scores: Sequence[ContactScore]) -> ContactScore:
         float(sum(s.contact_free_s for s in scores)),
         tuple(d for s in scores for d in s.delays),
         look_ahead=any(s.look_ahead for s in scores),
+        lead_s=max(s.lead_s for s in scores),
     )
 
 

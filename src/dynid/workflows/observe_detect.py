@@ -39,6 +39,7 @@ from ..observer.scoring import (
     ContactScore,
     interval_peaks,
     label_intervals,
+    lead_for,
     score_events,
     truth_flags,
 )
@@ -254,7 +255,8 @@ def scored(
     against the true external torques ``ext`` (N, n) [N m] (in contact where some joint
     exceeds :data:`~dynid.observer.scoring.TRUTH_LEVEL`); the missed contacts' peaks known
     wherever the true torques are, the labels' contacts too; None with neither
-    (:mod:`dynid.observer.scoring`); ``look_ahead``: the velocities came from a zero-phase
+    (:mod:`dynid.observer.scoring`, the lead of :func:`~dynid.observer.scoring.lead_for`);
+    ``look_ahead``: the velocities came from a zero-phase
     low-pass (:attr:`~dynid.observer.scoring.ContactScore.look_ahead`)."""
     if labels is not None:
         intervals, source = label_intervals(t, labels.flags), labels.source
@@ -275,6 +277,7 @@ def scored(
         peaks=peaks,
         source=source,
         look_ahead=look_ahead,
+        lead_s=lead_for(t),
     )
 
 
