@@ -408,3 +408,43 @@ def test_delays_of_derived_velocities_carry_their_caveat_beside_them(
     line, doc, answer = said["hit.csv"]
     assert doc["score"]["detected"] == 2 and doc["score"]["delays_look_ahead"] is False
     assert "zero-phase" not in line and "zero-phase" not in answer
+
+
+def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_base(logs, capsys):
+    """With the model's uncertainty the collision level while moving is collision_factor x
+    (noise + k sigma_max), one number in thresholds.json, the printout and the report's
+    table (not 2 x detectable there and the fixed collision elsewhere); the fixed levels
+    beside it are named the base, without the uncertainty."""
+    from dynid.report.html import number
+
+    d = logs
+    model = ["--model", str(d / "id" / "identification.json"), "--no-figures"]
+    capsys.readouterr()
+    out = d / "cal_levels"
+    assert main(["observe", *model, "--data", str(d / "free.csv"), "--calibrate",
+                 "--out", str(out)]) == 0  # fmt: skip
+    printed = capsys.readouterr().out
+    doc = json.loads((out / "thresholds.json").read_text())
+    cal, rule, unc = doc["calibration"], doc["rule"], doc["uncertainty"]
+    moving = np.array(unc["noise"]) + unc["k_sigma"] * np.array(cal["sigma_max"])
+    np.testing.assert_allclose(cal["detectable"], moving, rtol=1e-12)
+    collision = rule["collision_factor"] * moving
+    np.testing.assert_allclose(cal["collision_moving"], collision, rtol=1e-12)
+    assert not np.allclose(collision, doc["collision"])  # two quantities, told apart
+    said = ", ".join(f"{v:.3g}" for v in collision)
+    assert f"collision level while moving: {said} N m" in printed
+    assert "the base levels apply without it (--no-uncertainty)" in printed
+    page = (out / "report.html").read_text()
+    box = page[page.index('<table class="calibration">') :]
+    box = box[: box.index("</table>")]
+    heads = re.findall(r"<th>([^<]*)</th>", box)
+    rows = [re.findall(r"<td>([^<]*)</td>", r) for r in re.findall(r"<tr><td>.*?</tr>", box)]
+    col = {h: [r[k] for r in rows] for k, h in enumerate(heads)}
+    assert col["collision level, moving [N m]"] == [number(x) for x in collision]
+    assert col["contact level, moving (smallest torque detected) [N m]"] == [
+        number(x) for x in moving
+    ]
+    assert col["contact base, without the uncertainty [N m]"] == [number(x) for x in doc["contact"]]
+    assert col["collision base, without the uncertainty [N m]"] == [
+        number(x) for x in doc["collision"]
+    ]

@@ -162,3 +162,25 @@ def test_the_calibration_judges_the_model_behind_the_thresholds(free, tmp_path, 
     assert said["twice"][:2] == ("poor", "poor") and said["twice"][3] == "poor"
     assert "the thresholds are wide because of the model's error" in said["twice"][2]
     assert "thresholds calibrated on a poor model" in said["twice"][2]
+
+
+@pytest.mark.parametrize(("level", "said"), [("unusable", "an unusable"), ("poor", "a poor")])
+def test_the_badge_of_thresholds_on_a_poor_or_unusable_model_takes_its_article(
+    free, tmp_path, level, said
+):
+    """A calibration whose model validate would call unusable is badged "thresholds
+    calibrated on an unusable model" (not "a unusable"), a poor one "on a poor model"."""
+    from dynid.report import RunSummary, render_html_report
+
+    path, _ = free
+    cal = tmp_path / "cal"
+    args = ["observe", "--params", "panda", "--data", str(path), "--calibrate", "-q"]
+    assert main([*args, "--no-figures", "--out", str(cal)]) == 0
+    doc = json.loads((cal / "thresholds.json").read_text())
+    doc["calibration"]["model_check"]["verdict"] |= {"level": level, "label": level}
+    (cal / "thresholds.json").write_text(json.dumps(doc))
+    page = render_html_report(
+        RunSummary(command="observe"), {"thresholds.json": cal / "thresholds.json"}
+    )
+    badge = re.search(r'<span class="level">([^<]*)</span>', page)
+    assert badge is not None and badge[1] == f"thresholds calibrated on {said} model"

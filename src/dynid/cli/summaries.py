@@ -822,6 +822,13 @@ def _check_lines(check: CalibrationCheck | None) -> list[str]:
         "smallest external torque detected while a joint moves: "
         + ", ".join(f"{v:.3g}" for v in check.detectable)
         + " N m (the largest contact threshold along the motion)"
+        + (
+            ""
+            if check.collision is None
+            else "; collision level while moving: "
+            + ", ".join(f"{v:.3g}" for v in check.collision)
+            + " N m (the largest collision threshold along it)"
+        )
     )
     if check.model is not None:  # the model behind the thresholds
         out.append(check.model.words())
@@ -851,7 +858,8 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             cols["max |r|/contact"] = np.nanmax(ratios, axis=0)
     base = " base" if th.uses_uncertainty or th.standstill else ""
     cols |= {f"contact{base} [N m]": th.contact, f"collision{base} [N m]": th.collision}
-    rest = undetected_at_rest(result.model, th)
+    moving = None if result.check is None else result.check.detectable
+    rest = undetected_at_rest(result.model, th, moving)
     at_rest = calibrating and th.standstill and np.any(rest > th.contact)
     if at_rest:
         cols["at rest [N m]"] = rest
@@ -873,13 +881,14 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if at_rest:
         rows.append(
             "at rest: a contact on a joint standing still inside its standstill band "
-            "goes undetected below this (its Coulomb level, which friction may hold, "
-            "plus the contact threshold)"
+            "goes undetected below this (the largest static friction the law may hold, "
+            "plus the contact level while moving)"
         )
     if th.uses_uncertainty and th.noise is not None:
         rows.append(
             f"thresholds grow with the model's uncertainty: {th.k_sigma:g} sigma + noise "
-            f"({', '.join(f'{v:.3g}' for v in th.noise)} N m)"
+            f"({', '.join(f'{v:.3g}' for v in th.noise)} N m); the base levels apply "
+            "without it (--no-uncertainty)"
         )
     margins = [m for x in result.logs if (m := _margin_peak(x)) is not None]
     if th.standstill and margins and np.any(margins):

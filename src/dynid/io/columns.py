@@ -56,7 +56,7 @@ from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .joint_state_csv import import_hint
 from .npz_files import check_npz
-from .torque_log import LABEL_COLUMNS
+from .torque_log import LABEL_COLUMNS, _where
 
 __all__ = [
     "CURRENT_UNITS",
@@ -366,6 +366,8 @@ class _Table:
     scaled: set[str] = field(default_factory=set)
     #: every column (CSV header) or array (NPZ) of the file, read or not, in file order
     header: list[str] = field(default_factory=list)
+    #: (line number of data row 0, rows) of a CSV whose rows map to lines one to one
+    lines: tuple[int, int] | None = None
 
     def has(self) -> str:
         """``the file has [...]`` for messages: its first 12 columns (or arrays)."""
@@ -422,8 +424,8 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
     groups_of: dict[str, list[str]] = {}  # layout key -> its columns, filled by layout()
     header: list[str] = []  # every column, filled by layout()
 
-    arrays, _ = csv_table(path, layout, "a header naming the columns", freeze=False)
-    table = _Table(path.name, {}, header=header)
+    arrays, lines = csv_table(path, layout, "a header naming the columns", freeze=False)
+    table = _Table(path.name, {}, header=header, lines=lines)
     for key in list(arrays):  # one at a time: scaled in place, then its immutable copy
         a = arrays.pop(key)
         if key.startswith(_GROUP):
@@ -582,11 +584,15 @@ class MappedLog:
         What the reader should be warned of (velocities derived from the positions).
     conversions : tuple of str
         The units converted as the map asked (:func:`conversion_notes`), said as notes.
+    invalid_rows : str
+        The first rows holding NaN or inf, which cleaning dropped, as the strict reader
+        names them: ``row 55 (line 58), row 303 (line 306), ...``; empty for none.
     """
 
     log: TorqueLog
     notes: tuple[str, ...] = ()
     conversions: tuple[str, ...] = ()
+    invalid_rows: str = ""
 
 
 def load_mapped_torque_log(
@@ -636,10 +642,15 @@ def load_mapped_torque_log(
     said = conversion_notes(
         columns, [k for k in _DEFAULT if k in {**columns.factors, **columns.flips}]
     )
+    ok = np.isfinite(t)
+    for a in (q, dq, tau, ddq):
+        if a is not None:
+            ok &= np.all(np.isfinite(a), axis=1)
+    invalid = "" if ok.all() else _where(np.flatnonzero(~ok), table.lines)
     try:
         if dq is not None:
             return MappedLog(
-                TorqueLog.from_raw(t, q, dq, tau, ddq, gap_factor=gap_factor), (), said
+                TorqueLog.from_raw(t, q, dq, tau, ddq, gap_factor=gap_factor), (), said, invalid
             )
         raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, ddq, gap_factor=gap_factor)
     except DataError as exc:
@@ -649,7 +660,7 @@ def load_mapped_torque_log(
         log = with_derived_velocities(raw, columns.velocity_cutoff_hz)
     except DataError as exc:  # a rate too low for the cut-off: the file named
         raise DataError(str(exc), file=path.name) from exc
-    return MappedLog(log, notes, said)
+    return MappedLog(log, notes, said, invalid)
 
 
 def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str, ...]:

@@ -14,7 +14,10 @@
                      "duration_s": T,     # s, the calibration logs' total duration
                      "false_alarms": k,   # events on them (null: not counted)
                      "detectable": [...], # N m per joint, the smallest torque detected
-                                          # while the joint moves
+                                          # while the joint moves (the largest contact
+                                          # threshold along the motion)
+                     "collision_moving": [...],  # N m per joint, the largest collision
+                                          # threshold along the motion
                      "peak": [...],       # N m per joint, the largest |r| read
                      "sigma_max": [...],  # N m per joint, the largest sigma (uncertainty)
                      "model_check": {     # the model judged on the logs as validate does
@@ -530,7 +533,9 @@ def save_observation(
     meta = dict(meta or {})
     if calibrating:
         cal = {"data": log_labels([x.path for x in result.logs]), **meta}
-        rest = undetected_at_rest(result.model, result.thresholds)
+        check = result.check
+        moving = None if check is None else check.detectable
+        rest = undetected_at_rest(result.model, result.thresholds, moving)
         if result.thresholds.standstill and np.any(rest > result.thresholds.contact):
             cal["at_rest"] = rest.tolist()  # the thresholds of a joint standing still
         if (check := result.check) is not None:  # is the observer good enough
@@ -540,6 +545,8 @@ def save_observation(
                 "detectable": check.detectable.tolist(),
                 "peak": check.peak.tolist(),
             }
+            if check.collision is not None:
+                cal["collision_moving"] = check.collision.tolist()
             if check.sigma_max is not None:
                 cal["sigma_max"] = check.sigma_max.tolist()
             if (m := check.model) is not None:  # the model behind the thresholds

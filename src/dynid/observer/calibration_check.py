@@ -34,6 +34,7 @@ __all__ = [
     "CalibrationCheck",
     "ModelCheck",
     "calibration_false_alarms",
+    "collision_level",
     "detectable",
     "model_words",
 ]
@@ -110,6 +111,9 @@ class CalibrationCheck:
         The largest ``|r|`` of the calibration logs [N m].
     model : ModelCheck or None
         The model judged on the calibration logs (None: not judged).
+    collision : ndarray, shape (n,), or None
+        The collision level wherever the joint moves [N m]: the largest collision
+        threshold along the motion (:func:`collision_level`; None: not given).
     """
 
     duration_s: float
@@ -118,6 +122,7 @@ class CalibrationCheck:
     detectable: NDArray[np.float64]
     peak: NDArray[np.float64]
     model: ModelCheck | None = None
+    collision: NDArray[np.float64] | None = None
 
     @property
     def false_alarms_per_min(self) -> float | None:
@@ -137,6 +142,15 @@ def detectable(thresholds: Thresholds, sigma_max: ArrayLike | None) -> NDArray[n
         s = np.asarray(sigma_max, dtype=np.float64)
         return np.asarray(thresholds.noise + thresholds.k_sigma * s, dtype=np.float64)
     return np.array(thresholds.contact, dtype=np.float64)
+
+
+def collision_level(thresholds: Thresholds, sigma_max: ArrayLike | None) -> NDArray[np.float64]:
+    """The collision level [N m] (n,) wherever a joint moves: ``collision_factor`` times
+    :func:`detectable` for thresholds with the uncertainty, else the fixed collision
+    threshold; the one number the summary, ``thresholds.json`` and the report give."""
+    if thresholds.uses_uncertainty and sigma_max is not None:
+        return np.asarray(thresholds.collision_factor * detectable(thresholds, sigma_max))
+    return np.array(thresholds.collision, dtype=np.float64)
 
 
 def calibration_false_alarms(

@@ -421,12 +421,17 @@ def _check_outside_band(left: NDArray[np.int64], N: int) -> None:
         )
 
 
-def undetected_at_rest(model: ObserverModel, thresholds: Thresholds) -> NDArray[np.float64]:
+def undetected_at_rest(
+    model: ObserverModel, thresholds: Thresholds, contact: ArrayLike | None = None
+) -> NDArray[np.float64]:
     """Per joint (n,) [N m]: the contact torque below which a contact on a joint at rest
     inside its standstill band goes undetected, its standstill margin at rest (the
-    friction's Coulomb level, which may hold any torque up to it without a motion) plus
-    its contact threshold; the threshold alone for thresholds without the margin."""
+    largest static friction the law can hold without a motion) plus its contact level
+    ``contact`` (n,) [N m] (the level while moving,
+    :func:`~dynid.observer.calibration_check.detectable`; default: the fixed contact
+    threshold); the level alone for thresholds without the margin."""
+    level = np.array(thresholds.contact if contact is None else contact, dtype=np.float64)
     if not thresholds.standstill:
-        return np.array(thresholds.contact)
+        return level
     rest = standstill_margin(model.friction, np.zeros((1, model.n)))[0]
-    return np.asarray(thresholds.contact + rest)
+    return np.asarray(level + rest)

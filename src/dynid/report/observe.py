@@ -89,19 +89,21 @@ def _calibration(doc: Any) -> tuple[str, list[str]] | None:
 
 
 def _joint_table(doc: dict, cal: dict) -> str:
-    """Per joint: the smallest external torque detected while moving (the largest contact
-    threshold there) and at rest, the collision level while moving (``collision_factor``
-    times the first) and the largest ``|r|`` the calibration read [N m]."""
+    """Per joint: the contact level while moving (the smallest external torque detected,
+    the largest contact threshold along the motion) and at rest, the collision level while
+    moving and the largest ``|r|`` the calibration read [N m], each as the file holds it
+    (``detectable``, ``at_rest``, ``collision_moving``, ``peak``; a file without
+    ``collision_moving`` shows no collision column), and, where the levels grow with the
+    model's uncertainty, the fixed levels of the file's ``contact`` and ``collision``
+    beside them, named as such."""
+    fixed = isinstance(doc.get("uncertainty"), dict)
     moving = cal.get("detectable") if _numbers(cal.get("detectable")) else doc.get("contact")
-    rule = doc.get("rule")
-    factor = rule.get("collision_factor") if isinstance(rule, dict) else None
-    collision = None
-    if is_number(factor) and isinstance(moving, list) and _numbers(moving):
-        collision = [factor * x for x in moving]
     given = [
-        ("smallest torque detected, moving [N m]", moving),
+        ("contact level, moving (smallest torque detected) [N m]", moving),
         ("at rest [N m]", cal.get("at_rest")),
-        ("collision level, moving [N m]", collision),
+        ("collision level, moving [N m]", cal.get("collision_moving")),
+        ("contact base, without the uncertainty [N m]", doc.get("contact") if fixed else None),
+        ("collision base, without the uncertainty [N m]", doc.get("collision") if fixed else None),
         ("largest |r| read [N m]", cal.get("peak")),
     ]
     columns = [(h, v) for h, v in given if isinstance(v, list) and _numbers(v)]
@@ -245,7 +247,8 @@ def answer(run: RunFiles) -> Answer | None:
         level, label = "info", "thresholds calibrated"
         model = _model_check(run.docs[found["thresholds.json"] or ""]["calibration"])
         if model is not None and model[1] in ("poor", "unusable"):  # wide: the model's
-            level, label = model[1], f"thresholds calibrated on a {model[1]} model"
+            article = "an" if model[1][0] in "aeiou" else "a"
+            level, label = model[1], f"thresholds calibrated on {article} {model[1]} model"
     elif events is None:
         head, level = esc("The run wrote residuals; no events file to judge."), "fair"
     elif events:

@@ -282,17 +282,25 @@ def read_torque_log(
             _log.info("%s: %s", path.name, note)  # (recordings.check_derived_velocities)
         c = mapped.log.cleaning
         if c.n_nan_rows or c.n_duplicates:
-            what = (
-                f"{c.n_nan_rows} row(s) of {c.n_input_rows} hold NaN or inf and "
-                f"{c.n_duplicates} repeat the previous timestamp"
-            )
+            said = []  # as the strict reader says it (dynid.io.torque_log)
+            if c.n_nan_rows:
+                rows = f": {mapped.invalid_rows}" if mapped.invalid_rows else ""
+                said.append(
+                    f"{c.n_nan_rows} row(s) of {c.n_input_rows} holding NaN, inf or an "
+                    f"empty cell{rows}"
+                )
+            if c.n_duplicates:
+                said.append(
+                    f"{c.n_duplicates} row(s) of {c.n_input_rows} repeating the previous timestamp"
+                )
             if not drop_invalid:
                 raise DataError(
-                    f"{what}; hint: fix the file or pass --drop-invalid "
+                    f"{'; '.join(said)}; hint: fix the file or pass --drop-invalid "
                     "(drop_invalid=True) to drop them",
                     file=path.name,
                 )
-            _log.warning("%s: dropped: %s", path.name, what)
+            for what in said:
+                _log.warning("%s: dropped %s", path.name, what)
         log = mapped.log
     if n is not None and log.n != n:
         raise DataError(

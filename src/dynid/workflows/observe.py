@@ -87,6 +87,7 @@ from ..observer.calibration_check import (
     CalibrationCheck,
     ModelCheck,
     calibration_false_alarms,
+    collision_level,
     detectable,
 )
 from ..observer.detection import Thresholds, calibrate
@@ -819,7 +820,9 @@ def _checked(
     elif th.quantile >= 1.0:
         count = 0  # every sample's |r| lies under margin (>= 1) times the largest
     duration = float(sum(x.duration() for x in logs))
-    return CalibrationCheck(duration, count, sigma_max, detectable(th, sigma_max), peak)
+    moving = detectable(th, sigma_max)
+    collision = collision_level(th, sigma_max)
+    return CalibrationCheck(duration, count, sigma_max, moving, peak, collision=collision)
 
 
 def _std(x: ObservedBlock) -> NDArray[np.float64]:
