@@ -62,9 +62,10 @@ named collision, contact or label (the first the log has), or mapped with --colu
 label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in
 contact where some joint's |tau_ext| exceeds 0.1 N m). A contact is detected when an
 event starts from 0.02 s (or 3 samples) before it to --label-tolerance (0.1 s, the
-observer's lag) after its end, and closes before a later contact; an event that detects
-no contact is a false alarm (one starting long before a contact, a whole-log event over
-several contacts: the contacts are missed). The summary prints per log
+observer's lag) after its end (an event still open over a later contact detects only the
+one it started in); an event that detects no contact is a false alarm (one starting long
+before any contact, such as a whole-log event: the contacts it covers are missed). The
+summary prints per log
 and in total the contacts labelled, detected and missed (each missed one with its times
 and, from tau_ext, its peak true torque), the false alarms and their rate per minute of
 contact-free time, and the delays (event start less contact start, median and max;

@@ -991,7 +991,7 @@ def _score_lines(result: ObserveResult, labels: list[str]) -> list[str]:
     rows = [
         f"scored against labelled contacts ({total.source}; an event starting from "
         f"{total.lead_s:g} s before a contact's start to {total.tolerance_s:g} s after its "
-        "end detects it, one starting earlier or open over later contacts is a false alarm):"
+        "end detects it; one starting earlier than that before any contact is a false alarm):"
     ]
     width = max(len(lab) for lab, _ in scored)
     parts = [(lab, sc) for lab, sc in scored] if len(scored) > 1 else []

@@ -11,13 +11,13 @@ torques of a simulated log, in contact where some joint's ``|tau_ext|`` exceeds
   it starts within ``[a - lead, b + tolerance]`` (the observer's first-order lag
   ``K_O / (s + K_O)`` brings the residual over the threshold after a short contact has
   ended; ``lead``, a few samples, allows for velocities from a zero-phase filter, which
-  sees ahead) and ends before the next contact's window opens. Contacts less than
-  ``tolerance`` apart form one group, which one event detects as a whole: two events in
-  one contact are one detection; one event over two contacts that close detects both. An
-  event that starts earlier than ``lead`` before a contact, or stays open over a later
-  contact beyond its group (a whole-log event of a joint with a flipped torque sign, say),
-  detects nothing: it is a *false alarm*, and the contacts it covers are missed unless
-  another event detects them;
+  sees ahead). Contacts less than ``tolerance`` apart form one group, which one event
+  detects as a whole: two events in one contact are one detection; one event over two
+  contacts that close detects both. An event still open over a later group detects only
+  the group it started in: the later one, with no onset of its own, is missed unless
+  another event starts in its window. An event that starts earlier than ``lead`` before
+  any contact (a whole-log event of a joint with a flipped torque sign, say) detects
+  nothing: it is a *false alarm*, and the contacts it covers are missed;
 * :func:`score_events`: the counts of one log (:class:`ContactScore`), the missed
   contacts with their times and peak true torque where known, the false alarms per minute
   of contact-free time (the log's duration less the labelled contacts, the lead before
@@ -173,8 +173,7 @@ def match_events(
     -------
     first : ndarray of int, shape (k,)
         Index of the earliest-starting event that detects each contact (starts within
-        ``[a - lead_s, b + tolerance_s]`` of its group and ends before the next group's
-        window); -1: missed.
+        ``[a - lead_s, b + tolerance_s]`` of its group); -1: missed.
     false : ndarray of bool, shape (m,)
         Events that detect no contact.
 
@@ -193,9 +192,8 @@ def match_events(
     group = np.cumsum(opens) - 1  # each contact's group
     a = lab[opens, 0]  # the groups' first and last samples
     b = lab[np.concatenate((opens[1:], [True])), 1]
-    after = np.concatenate((a[1:] - lead_s, [np.inf]))  # the next group's window opens
-    s, e = ev[None, :, 0], ev[None, :, 1]
-    hit = (s >= a[:, None] - lead_s) & (s <= b[:, None] + tolerance_s) & (e < after[:, None])
+    s = ev[None, :, 0]
+    hit = (s >= a[:, None] - lead_s) & (s <= b[:, None] + tolerance_s)
     over = hit[group]
     starts = np.where(over, ev[None, :, 0], np.inf)
     first = np.where(over.any(axis=1), np.argmin(starts, axis=1), -1).astype(np.intp)
