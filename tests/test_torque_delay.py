@@ -161,3 +161,38 @@ def test_option_refused_with_consistent() -> None:
     """``torque_delay_s`` does not apply to the one-step consistent fit."""
     with pytest.raises(OptionError, match="consistent"):
         IdentifyOptions(torque_delay_s=0.002, consistent=True)
+
+
+def test_friction_prepares_with_the_recorded_delay(fits, late) -> None:
+    """``friction``'s pieces of a model identified with a delay hold the states that
+    much earlier (``q - delay dq`` to second order) unless told 0."""
+    from dynid.friction.recordings import prepare_pieces
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        moved = prepare_pieces(fits[1], [late[2]]).logs[0]
+        kept = prepare_pieces(fits[1], [late[2]], torque_delay_s=0.0).logs[0]
+    np.testing.assert_array_equal(moved.t, kept.t)
+    assert moved.ddq is not None
+    want = kept.q - DELAY * kept.dq
+    assert np.max(np.abs(moved.q - want)) < 2 * DELAY**2 * np.max(np.abs(kept.ddq))
+
+
+def test_command_line_reads_milliseconds() -> None:
+    """``--torque-delay 2`` is 0.002 s for identify, validate and friction, and in the
+    options identify and friction build from the flags."""
+    from dynid.cli.__main__ import build_parser
+    from dynid.cli.common import options_from
+    from dynid.workflows.friction import FrictionOptions
+
+    parser = build_parser()
+    for command, cls, need in (
+        ("identify", IdentifyOptions, ["--robot", "panda"]),
+        ("validate", None, ["--model", "m.json"]),
+        ("friction", FrictionOptions, ["--model", "m.json"]),
+    ):
+        given = [command, *need, "--data", "x.csv", "--out", "o", "--torque-delay", "2"]
+        args = parser.parse_args(given)
+        assert args.torque_delay == pytest.approx(0.002)
+        if cls is not None:
+            assert options_from(args, cls).torque_delay_s == pytest.approx(0.002)
