@@ -11,7 +11,7 @@ import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 
@@ -40,6 +40,7 @@ _O = TypeVar("_O")
 FLAGS: dict[str, str] = {
     "cutoff_hz": "--cutoff",
     "max_gap_s": "--max-gap",
+    "torque_delay_s": "--torque-delay",
     "duration_s": "--duration",
     "rate_hz": "--rate",
     "jitter_s": "--jitter",
@@ -212,8 +213,15 @@ def add_seed_option(p: argparse.ArgumentParser, help: str = "random seed (defaul
     p.add_argument("--seed", type=seed_type, default=0, metavar="N", help=help)
 
 
-def add_log_options(p: argparse.ArgumentParser, *, drop_invalid: bool = True) -> None:
-    """``--max-gap SECONDS`` and ``--drop-invalid`` for commands that read a torque log."""
+def add_log_options(
+    p: argparse.ArgumentParser,
+    *,
+    drop_invalid: bool = True,
+    torque_delay: Literal["given", "recorded"] | None = None,
+) -> None:
+    """``--max-gap SECONDS`` and ``--drop-invalid`` for commands that read a torque log;
+    with ``torque_delay``, ``--torque-delay MS`` (:func:`add_torque_delay`: ``"recorded"``
+    for a command whose default is the identification's)."""
     p.add_argument(
         "--max-gap",
         type=positive_type,
@@ -224,6 +232,38 @@ def add_log_options(p: argparse.ArgumentParser, *, drop_invalid: bool = True) ->
     )
     if drop_invalid:
         add_drop_invalid(p)
+    if torque_delay is not None:
+        add_torque_delay(p, recorded=torque_delay == "recorded")
+
+
+def milliseconds_type(text: str) -> float:
+    """A finite number of milliseconds, returned in seconds."""
+    ms = number(float)(text)
+    if not math.isfinite(ms):
+        raise argparse.ArgumentTypeError(f"expected a finite number of milliseconds; got {text!r}")
+    return ms / 1000.0
+
+
+def add_torque_delay(p: argparse.ArgumentParser, *, recorded: bool = False) -> None:
+    """``--torque-delay MS``: how far the torques lag the positions, for commands that
+    prepare a torque log (``recorded``: the default is the identification's)."""
+    default = (
+        "the delay the model was identified with, 0 for a robot file"
+        if recorded
+        else "0: the torques as recorded"
+    )
+    p.add_argument(
+        "--torque-delay",
+        dest="torque_delay",
+        type=milliseconds_type,
+        default=None,
+        metavar="MS",
+        help="how far the torques lag the positions [ms] (a filtered sensor, bus latency; "
+        "positive: the torques late): each piece's torques are read that much later, by "
+        "interpolation, before filtering, and the samples at its ends that fall outside "
+        f"are dropped; identify and validate estimate it from the residual and say it when "
+        f"it matters (default: {default})",
+    )
 
 
 def add_drop_invalid(p: argparse.ArgumentParser) -> None:

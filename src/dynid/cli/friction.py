@@ -120,7 +120,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="low-pass cutoff of the states [Hz] (default: the one --model was identified "
         "with, else the one identification reads from the log's motion)" + CUTOFF_NONE_HELP,
     )
-    add_log_options(p)
+    add_log_options(p, torque_delay="recorded")
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     return p
 

@@ -184,7 +184,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "NaN/inf or a repeated timestamp (torque logs), instead of failing; says how many "
         "and where",
     )
-    add_log_options(p, drop_invalid=False)
+    add_log_options(p, drop_invalid=False, torque_delay="given")
     p.add_argument(
         "--std",
         choices=STD_METHODS,
@@ -276,6 +276,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         files += [] if args.no_figures else save_heldout_figures(args.out, held)
         v = held.verdict
         text.append(f"held-out verdict on {held.block}, every sample: {v.label}: {v.reason}")
+    if result.torque_delay is not None and result.torque_delay.named:
+        text.append(f"note: {result.torque_delay.sentence()}")
     if result.consistent is not None:
         sources = [str(p) for p in args.data]  # every recording fitted, not the first alone
         files += save_feasible_bundle(args.out, result.consistent, sources=sources)

@@ -137,7 +137,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_drive_option(p)
     add_q_start_option(p)
-    add_log_options(p)
+    add_log_options(p, torque_delay="recorded")
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     return p
 
@@ -153,6 +153,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         drop_invalid=args.drop_invalid,
         cutoff_hz=args.cutoff,
         max_gap_s=args.max_gap,
+        torque_delay_s=args.torque_delay,
         drive=load_drive_arg(args, robot.n, robot_rotors=not isinstance(model, IdentifiedModel)),
         q_start=args.q_start,
     )

@@ -67,7 +67,13 @@ from .fit import model_drive, torques_through
 from .pooled import joined_validation
 from .validation import Validation, own_friction, validate_torques
 
-__all__ = ["HeldOutTorques", "heldout_torques", "residual_springs", "residual_tilt"]
+__all__ = [
+    "HeldOutTorques",
+    "beside_columns",
+    "heldout_torques",
+    "residual_springs",
+    "residual_tilt",
+]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -446,7 +452,7 @@ def residual_tilt(
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt`; ``noise`` (n,) [N m] each
     joint's): of an identified model, its own columns projected out and with them each
     motor's viscous, Coulomb, offset and rotor-inertia columns mapped to the joints
-    through the model's drive as the fit maps them (:func:`_beside_columns`: terms the
+    through the model's drive as the fit maps them (:func:`beside_columns`: terms the
     structure chosen may have left out: a tilt the fit partly took as offsets made it drop
     the offset of joint 3, which then pulled the tilt to 0.17 deg for 0.3), the torques of
     the springs ``springs`` names (:func:`residual_springs`, fitted beside a tilt, on the
@@ -460,7 +466,7 @@ def residual_tilt(
     error = log.tau - v.tau_hat
     if isinstance(model, Robot):
         return gravity_tilt(model, log.q, error, noise)
-    columns = _beside_columns(model, log)
+    columns = beside_columns(model, log)
     if columns is None:
         return None
     tau = log.tau
@@ -494,7 +500,7 @@ def residual_springs(
     log = v.log
     if isinstance(model, Robot) or log.ddq is None or model.spring is not None:
         return None
-    beside = _beside_columns(model, log)
+    beside = beside_columns(model, log)
     if beside is None:
         return None
 
@@ -506,7 +512,7 @@ def residual_springs(
     return judged_springs(found, log.q, log.dq, log.tau - v.tau_hat)
 
 
-def _beside_columns(
+def beside_columns(
     model: IdentifiedModel, log: TorqueLog
 ) -> Callable[[NDArray[np.intp]], NDArray[np.float64]] | None:
     """The regressor (M, n, p) of ``model``'s own columns at the rows ``rows`` (M,) of the

@@ -178,6 +178,7 @@ def prepare_pieces(
     drive: Drive | None = None,
     decimate: int | Literal["recorded"] = RECORDED,
     measured_samples: bool = False,
+    torque_delay_s: float | None = None,
 ) -> Pieces:
     """Read every recording at the joints, unwrap, cut at its gaps and prepare each piece.
 
@@ -214,6 +215,10 @@ def prepare_pieces(
         validation judges it; else the grid (whose linear interpolation averages a
         sample's noise with its neighbour's: an xArm7 at 100 Hz, stamps +-2 ms, fitted
         0.277 N m RMS on a joint whose sensor noise is 0.3 N m).
+    torque_delay_s : float, optional
+        How far the torques lag the positions [s]
+        (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); None
+        (default): the delay the model was identified with (0 for another model).
 
     Returns
     -------
@@ -225,7 +230,7 @@ def prepare_pieces(
         No recording; a recording of another joint count than the model's, or with no
         piece long enough to filter (the file is named); another drive than the model's.
     """
-    prep = _recorded_preparation(model, max_gap_s, decimate, filter_tau)
+    prep = _recorded_preparation(model, max_gap_s, decimate, filter_tau, torque_delay_s)
     raw = _raw_pieces(model, logs, names, cutoff_hz, prep.max_gap_s, drive, trim_s)
     prep = dataclasses.replace(prep, cutoff_hz=raw.cutoff_hz, trim_s=raw.trim_s)
     own = measured_samples and not prep.filter_tau and prep.decimate == 1
@@ -362,13 +367,15 @@ def validate_recordings(
     max_gap_s: float | None | Literal["recorded"] = RECORDED,
     filter_tau: bool = False,
     drive: Drive | None = None,
+    torque_delay_s: float | None = None,
 ) -> RecordingsValidation:
     """:func:`validate_pieces` of :func:`prepare_pieces`, each piece prepared and predicted
     a block at a time when it is long (:func:`~dynid.friction.validation.validated_log`):
     the errors over every sample, the prepared logs and predictions of a long piece kept
     at every k-th sample only (``Validation.step``), so that a long recording is never
     held prepared whole. Parameters and errors as the two."""
-    prep = _recorded_preparation(model, max_gap_s, 1, filter_tau)  # every sample judged
+    # every sample judged
+    prep = _recorded_preparation(model, max_gap_s, 1, filter_tau, torque_delay_s)
     raw = _raw_pieces(model, logs, names, cutoff_hz, prep.max_gap_s, drive, trim_s)
     prep = dataclasses.replace(prep, cutoff_hz=raw.cutoff_hz, trim_s=raw.trim_s)
     parts, recording, skipped, left = [], [], [], []
@@ -398,11 +405,12 @@ def _recorded_preparation(
     max_gap_s: float | None | Literal["recorded"],
     decimate: int | Literal["recorded"],
     filter_tau: bool,
+    torque_delay_s: float | None = None,
 ) -> Preprocessing:
-    """The gap rule and the decimation: as given, or as the model was identified with
-    (:attr:`~dynid.identification.info.LogInfo.preprocessing`; the library defaults for
-    another model), with the torques filtered as ``filter_tau`` says; the cut-off and the
-    trim are the recordings' (:func:`_raw_pieces`).
+    """The gap rule, the decimation and the torques' delay: as given, or as the model was
+    identified with (:attr:`~dynid.identification.info.LogInfo.preprocessing`; the
+    library defaults for another model), with the torques filtered as ``filter_tau``
+    says; the cut-off and the trim are the recordings' (:func:`_raw_pieces`).
 
     Raises
     ------
@@ -417,7 +425,10 @@ def _recorded_preparation(
         decimate = own.decimate
     if int(decimate) < 1:
         raise OptionError(f"decimate must be at least 1; got {decimate}")
-    return Preprocessing(max_gap_s=max_gap_s, decimate=int(decimate), filter_tau=filter_tau)
+    delay = own.torque_delay_s if torque_delay_s is None else float(torque_delay_s)
+    return Preprocessing(
+        max_gap_s=max_gap_s, decimate=int(decimate), filter_tau=filter_tau, torque_delay_s=delay
+    )
 
 
 def _robot(model: TorqueModel) -> Robot | None:

@@ -202,6 +202,7 @@ def validate_torques(
     filter_tau: bool = False,
     max_gap_s: float | None = None,
     drive: Drive | None = None,
+    torque_delay_s: float | None = None,
 ) -> Validation:
     """Compare a model's torques with a measured log, without and with friction.
 
@@ -222,6 +223,10 @@ def validate_torques(
         The drive the log was recorded through (motor side, currents); default: an
         identified model's own (:func:`model_drive`). Its known rotor inertias are added to
         a robot's torques (an identified model holds its own). Errors are in joint torques.
+    torque_delay_s : float, optional
+        How far the log's torques lag its positions [s]
+        (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); None
+        (default): an identified model's recorded delay, else 0.
 
     Returns
     -------
@@ -240,7 +245,16 @@ def validate_torques(
     jlog = joint_side_log(log, d)
     cut = recorded_cutoff(model, jlog) if isinstance(cutoff_hz, str) else cutoff_hz
     del log  # a long log's raw signals are freed here when the caller holds no other reference
-    prep = Preprocessing(cutoff_hz=cut, trim_s=trim_s, max_gap_s=max_gap_s, filter_tau=filter_tau)
+    if torque_delay_s is None:
+        own = model.info.log if isinstance(model, IdentifiedModel) else None
+        torque_delay_s = 0.0 if own is None else own.torque_delay_s
+    prep = Preprocessing(
+        cutoff_hz=cut,
+        trim_s=trim_s,
+        max_gap_s=max_gap_s,
+        filter_tau=filter_tau,
+        torque_delay_s=float(torque_delay_s),
+    )
     return validated_log(model, jlog, friction, d, prep)
 
 

@@ -83,6 +83,11 @@ class LogInfo:
     stamp_jitter_s : float
         Standard deviation of the timestamps about their grid [s] (the largest of the
         recordings'; 0 for uniform stamps).
+    torque_delay_s : float
+        How far the torques were taken to lag the positions [s] (``--torque-delay``;
+        :attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`): each piece's
+        torques read that much later before filtering. ``validate`` and ``friction``
+        prepare their recordings with it unless told otherwise; 0 in older records.
     speed_max : tuple of float or None
         Each joint's largest speed [rad/s or m/s] over the samples used (as prepared, at
         the joints): the motion the model was identified on, which ``validate`` compares
@@ -108,6 +113,7 @@ class LogInfo:
     speed_max: tuple[float, ...] | None = None
     n_dropped: int = 0
     stamp_jitter_s: float = 0.0
+    torque_delay_s: float = 0.0
 
     @property
     def preprocessing(self) -> Preprocessing:
@@ -118,7 +124,10 @@ class LogInfo:
         friction fit and payload identification prepare their recordings with it unless told
         otherwise."""
         return Preprocessing(
-            cutoff_hz=self.cutoff_hz, max_gap_s=self.max_gap_s, decimate=int(self.decimate)
+            cutoff_hz=self.cutoff_hz,
+            max_gap_s=self.max_gap_s,
+            decimate=int(self.decimate),
+            torque_delay_s=float(self.torque_delay_s),
         )
 
 

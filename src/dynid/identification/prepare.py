@@ -39,6 +39,7 @@ __all__ = [
     "prepare_log",
     "prepared_blocks",
     "resamples",
+    "states_in_step",
     "trimmed_margins",
 ]
 
@@ -71,13 +72,21 @@ class Preprocessing:
     decimate : int
         Keep every ``decimate``-th sample after trimming (the classical route's
         decimation, :func:`~dynid.identification.rate.decimation`).
+    torque_delay_s : float
+        How far the torques lag the positions [s] (sensor filtering, bus latency; positive:
+        the torques late): before filtering, the positions, velocities (and accelerations)
+        are read at ``t - torque_delay_s`` (:func:`states_in_step`), so that each torque
+        is paired with the states it belongs to, and the samples at whose ends that
+        instant falls outside the piece are trimmed (the trim is at least
+        ``|torque_delay_s|``). The torques themselves are not interpolated: their noise, which
+        the validation's floor reads, stays as measured. Default 0: as recorded.
 
     Raises
     ------
     ShapeError
         ``decimate`` not an integer >= 1.
     DataError
-        ``trim_s < 0``.
+        ``trim_s < 0``; ``torque_delay_s`` not finite.
     """
 
     cutoff_hz: float | None = DEFAULT_CUTOFF_HZ
@@ -87,12 +96,15 @@ class Preprocessing:
     jitter_rtol: float = 1e-6
     filter_tau: bool = True
     decimate: int = 1
+    torque_delay_s: float = 0.0
 
     def __post_init__(self) -> None:
         if int(self.decimate) != self.decimate or self.decimate < 1:
             raise ShapeError(f"decimate must be an integer >= 1; got {self.decimate}")
         if self.trim_s is not None and self.trim_s < 0:
             raise DataError(f"seconds must be >= 0; got {self.trim_s}")
+        if not np.isfinite(self.torque_delay_s):
+            raise DataError(f"torque delay must be finite; got {self.torque_delay_s}")
 
 
 #: The default preparation (:class:`Preprocessing` with its defaults).
@@ -149,6 +161,7 @@ def prepare_log(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> TorqueLog:
         The default cutoff :data:`DEFAULT_CUTOFF_HZ` is not below the log's Nyquist
         frequency (a log slower than 10 Hz): a quarter of the rate is used instead.
     """
+    log = states_in_step(log, prep.torque_delay_s)
     plan = _plan(log, prep)
     n_out = len(plan.out)
     parts = _windows(plan, PREPARE_BLOCK_SAMPLES)
@@ -188,6 +201,7 @@ def prepared_blocks(
     """
     if block_samples is not None and block_samples < 1:
         raise ShapeError(f"block_samples must be >= 1; got {block_samples}")
+    log = states_in_step(log, prep.torque_delay_s)
     plan = _plan(log, prep)
     size = PREPARE_BLOCK_SAMPLES if block_samples is None else int(block_samples)
     for w in _windows(plan, size):
@@ -205,6 +219,27 @@ def measured_torques(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> NDArray[
     if plan.uniform:
         return np.array(log.tau[idx])
     return np.array(log.tau[nearest_samples(plan.t[idx], log.t)])
+
+
+def states_in_step(log: TorqueLog, torque_delay_s: float) -> TorqueLog:
+    """``log`` with its positions, velocities (and accelerations) read ``torque_delay_s``
+    [s] earlier, ``q(t - torque_delay_s)``, by a cubic spline through its own samples (an
+    extrapolation over the first or last ``|torque_delay_s|``, which :func:`prepare_log`
+    trims): torques that lag the positions by ``torque_delay_s`` paired with the states they
+    belong to, the torques as measured (:attr:`Preprocessing.torque_delay_s`). ``log``
+    itself for a delay of 0. A log whose velocities are derived from its positions gets
+    them derived again from the moved positions."""
+    if torque_delay_s == 0.0:
+        return log
+    from scipy.interpolate import CubicSpline  # here: a robot model loads no scipy
+
+    t = log.t - float(torque_delay_s)
+    moved = {
+        name: CubicSpline(log.t, x, axis=0)(t)
+        for name in ("q", "dq", "ddq")
+        if (x := getattr(log, name)) is not None
+    }
+    return replace(log, **moved)
 
 
 def nearest_samples(t: NDArray[np.float64], stamps: NDArray[np.float64]) -> NDArray[np.intp]:
@@ -320,6 +355,7 @@ def trimmed_margins(
     filtering of :mod:`~dynid.identification.log_rows`) needs them: the torques near
     the kept ends were filtered with what came before and after. None for a margin of
     fewer than 2 such samples."""
+    log = states_in_step(log, prep.torque_delay_s)
     plan = _plan(log, prep)
     out, M = plan.out, plan.t.shape[0]
     k = out.step
@@ -401,6 +437,7 @@ def _plan(log: TorqueLog, prep: Preprocessing) -> _Plan:
     trim_s = prep.trim_s
     if trim_s is None:
         trim_s = signals.edge_seconds(cutoff_hz) if cutoff_hz is not None else 0.0
+    trim_s = max(trim_s, abs(prep.torque_delay_s))  # torques read beyond the piece dropped
     # the samples of signals.trim_edges (t increases): its first and last, no mask of them
     first = int(np.searchsorted(t, t[0] + trim_s, side="left"))
     last = int(np.searchsorted(t, t[-1] - trim_s, side="right")) - 1

@@ -219,6 +219,7 @@ def prepare_torque_log(
     decimate: int | None = None,
     drive: Drive | None = None,
     check: bool = True,
+    torque_delay_s: float = 0.0,
 ) -> PreparedLog:
     """Read a torque log through the drive, check it, filter and decimate it.
 
@@ -228,7 +229,8 @@ def prepare_torque_log(
     and every ``decimate``-th sample (default :func:`~dynid.identification.rate.decimation`;
     the cut-off ``"auto"``: :func:`~dynid.identification.rate.cutoff_from_motion`).
     Parameters as in
-    :func:`~dynid.identification.classical.identify_from_log`.
+    :func:`~dynid.identification.classical.identify_from_log`; ``torque_delay_s`` [s] as
+    :attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`.
 
     Raises
     ------
@@ -263,7 +265,13 @@ def prepare_torque_log(
     k = decimation(fs, cutoff_hz) if decimate is None else int(decimate)
     if k < 1:
         raise ShapeError(f"decimate must be >= 1; got {decimate}")
-    prep = Preprocessing(cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=k)
+    prep = Preprocessing(
+        cutoff_hz=cutoff_hz,
+        trim_s=trim_s,
+        max_gap_s=max_gap_s,
+        decimate=k,
+        torque_delay_s=torque_delay_s,
+    )
     prepared = prepare_log(jlog, prep)
     raw = stamps = None
     head = tail = fine = None

@@ -191,6 +191,9 @@ class Recordings(TorqueRoute):
         :func:`~dynid.identification.log.default_max_gap` of each recording's step).
     cuts : tuple of int
         Per recording, the gaps longer than ``max_gap_s`` it was cut at.
+    torque_delay_s : float
+        How far the torques were taken to lag the positions [s] (each piece's read that
+        much later before filtering).
     gaps : tuple of tuple of (float, float)
         Per recording, each gap it was cut at: the last time stamp before it [s, the
         recording's own time] and its length [s] (empty: not recorded).
@@ -214,6 +217,7 @@ class Recordings(TorqueRoute):
     unwrapped: tuple[int, ...] = ()
     bands: Mapping[str, NDArray[np.float64]] = dataclasses.field(default_factory=dict)
     max_gap_s: float | None = None
+    torque_delay_s: float = 0.0
     cuts: tuple[int, ...] = ()
     gaps: tuple[tuple[tuple[float, float], ...], ...] = ()
     n_recorded: int = 0
@@ -389,6 +393,7 @@ class Recordings(TorqueRoute):
                 float(x) for x in np.max([np.max(np.abs(p.log.dq), axis=0) for p in ps], axis=0)
             ),
             max_gap_s=self.max_gap_s,
+            torque_delay_s=self.torque_delay_s,
             n_dropped=sum(c.n_dropped for c in found.values()),
             stamp_jitter_s=max(c.stamp_jitter_s for c in found.values()),
         )
@@ -439,6 +444,7 @@ def prepare_recordings(
     max_gap_s: float | None = None,
     decimate: int | None = None,
     drive: Drive | None = None,
+    torque_delay_s: float = 0.0,
 ) -> Recordings:
     """Cut, unwrap, filter, differentiate and decimate every recording (module docstring).
 
@@ -449,7 +455,7 @@ def prepare_recordings(
         The recordings, as read (motor side or currents when ``drive`` says so).
     names : sequence of str, optional
         One name per recording (default ``log1, log2, ...``), for messages and the record.
-    cutoff_hz, trim_s, decimate, drive
+    cutoff_hz, trim_s, decimate, drive, torque_delay_s
         As :func:`~dynid.identification.prepared_log.prepare_torque_log`; one cut-off for all.
     max_gap_s : float, optional
         Gaps up to this long [s] are bridged; longer ones cut the log into pieces.
@@ -512,6 +518,7 @@ def prepare_recordings(
         warnings.warn(shown, DynidWarning, stacklevel=2)
     cutoff, edge = _cutoff_and_edge(pieces, drive, turns, cutoff_hz, trim_s)
     kw = dict(cutoff_hz=cutoff, trim_s=edge, max_gap_s=max_gap_s, decimate=decimate)
+    kw["torque_delay_s"] = float(torque_delay_s)
     prepared, recording, skipped, gone = _prepared(robot, pieces, names, drive, **kw)
     if not prepared:
         raise DataError(
@@ -537,17 +544,27 @@ def prepare_recordings(
         bands=_bands([piece for _, piece in pieces], drive, derived),
         band_gain=gain,
         max_gap_s=None if max_gap_s is None else float(max_gap_s),
+        torque_delay_s=float(torque_delay_s),
         cuts=tuple(cuts),
         gaps=tuple(gaps),
         n_recorded=sum(log.n_samples for log in logs),
-        counts=tuple(
-            SampleCounts(
-                recorded=log.n_samples,
-                isolated=log.n_samples - sum(p.n_samples for k, p in pieces if k == r),
-                **gone[r],
-            )
-            for r, log in enumerate(logs)
-        ),
+        counts=_counts(logs, pieces, gone),
+    )
+
+
+def _counts(
+    logs: Sequence[TorqueLog],
+    pieces: list[tuple[int, TorqueLog]],
+    gone: dict[int, dict[str, int]],
+) -> tuple[SampleCounts, ...]:
+    """Per recording, its samples: recorded, isolated between gaps, and ``gone``'s."""
+    return tuple(
+        SampleCounts(
+            recorded=log.n_samples,
+            isolated=log.n_samples - sum(p.n_samples for k, p in pieces if k == r),
+            **gone[r],
+        )
+        for r, log in enumerate(logs)
     )
 
 
@@ -634,6 +651,7 @@ def _prepared(
             trim_s=kw["trim_s"],
             max_gap_s=kw["max_gap_s"],
             decimate=p.decimate,
+            torque_delay_s=kw["torque_delay_s"],
         )
         grid = grid_samples(piece, prep)  # kept, on the uniform grid of a resampled piece
         gone[r]["trimmed"] += piece.n_samples - kept

@@ -799,6 +799,7 @@ def identify_recordings(
     validate_on: TorqueLog | None = None,
     friction: tuple[str, ...] | None = None,
     base: BaseParameters | None = None,
+    torque_delay_s: float = 0.0,
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
@@ -820,11 +821,8 @@ def identify_recordings(
         Zero-phase low-pass cut-off [Hz] of every recording; ``"auto"`` (default) read from
         their motion (:func:`~dynid.identification.trim.common_cutoff`); None for
         noise-free data (the logs' ``ddq`` used if present, else differentiated).
-    trim_s : float, optional
-        Seconds dropped at each end of every piece after filtering (default: the filter's
-        edge, :func:`~dynid.identification.trim.edge_seconds`).
-    max_gap_s : float, optional
-        Gaps up to this long [s] are bridged; longer ones cut a log into pieces.
+    trim_s, max_gap_s, torque_delay_s
+        As :func:`~dynid.identification.recordings.prepare_recordings` (recorded).
     decimate : int, optional
         Keep every ``decimate``-th sample after filtering; default
         :func:`~dynid.identification.rate.decimation` (at least 10 % of the samples).
@@ -872,7 +870,7 @@ def identify_recordings(
     elif base is not None:
         raise OptionError("base applies to a structure given, not to one chosen (auto)")
     data, validation = _recordings(
-        robot, logs, names, validate_on, drive,
+        robot, logs, names, validate_on, drive, torque_delay_s=torque_delay_s,
         cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=decimate,
     )  # fmt: skip
     est = estimator_named(estimator)

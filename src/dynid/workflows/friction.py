@@ -88,6 +88,11 @@ class FrictionOptions:
         (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces.
+    torque_delay_s : float, optional
+        How far the torques lag the positions [s]: each piece's states read that much
+        earlier before filtering
+        (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); default:
+        the identification's recorded one, 0 for a robot.
     q_start : tuple of float, optional
         Joint positions [rad] at the first sample of one motor-side recording whose motor
         encoders wrap every turn: the motors' whole turns are those that put the joints
@@ -107,11 +112,13 @@ class FrictionOptions:
     cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
     q_start: tuple[float, ...] | None = None
+    torque_delay_s: float | None = None
 
     def __post_init__(self) -> None:
         check_choice(self, "law", ("auto", *LAWS), optional=False)
         check_cutoff(self)
         check_number(self, "max_gap_s")
+        check_number(self, "torque_delay_s", low=-1.0, high=1.0)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -223,6 +230,7 @@ def fit_friction_files(
             drive=drive,
             decimate=1,  # every sample, at its own time: the torques validate judges
             measured_samples=True,
+            torque_delay_s=opt.torque_delay_s,
         )
         every = _recorded_decimation(model)
         pieces = thinned(pieces, every)  # samples, not averages

@@ -37,6 +37,7 @@ from ..feasibility.convex import (
     SDPOptions,
     identify_consistent,
 )
+from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import ESTIMATORS, EstimatorName
@@ -48,6 +49,7 @@ from ..identification.residual_dependence import outside_model_note, round_off_n
 from ..identification.selection import identify_recordings
 from ..identification.static import identify_static
 from ..identification.structure import Structure
+from ..identification.torque_delay import TorqueDelay
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import (
@@ -211,6 +213,11 @@ class IdentifyOptions:
         sample kept (no decimation); recorded, so that validate and friction reuse it.
     max_gap_s : float, optional
         Torque logs: longest gap bridged by interpolation [s]; a longer one cuts the log.
+    torque_delay_s : float, optional
+        Torque logs: how far the torques lag the positions [s] (positive: the torques
+        late): each piece's torques read that much later before filtering
+        (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); recorded, so
+        that validate and friction reuse it.
     q_start : tuple of float, optional
         Torque logs: the joint positions [rad] at the first sample of one motor-side log
         whose motor encoders wrap every turn: the motors' whole turns are those that put
@@ -253,6 +260,7 @@ class IdentifyOptions:
     drive: Drive | None = None
     cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
+    torque_delay_s: float | None = None
     q_start: tuple[float, ...] | None = None
     folds: int | None = None
     validate_on: str | Path | None = None
@@ -268,6 +276,7 @@ class IdentifyOptions:
     def __post_init__(self) -> None:
         for name in ("max_std_percent", "max_gap_s"):
             check_number(self, name)
+        check_number(self, "torque_delay_s", low=-1.0, high=1.0)
         check_cutoff(self)
         check_number(self, "rtol", high=1.0, high_open=True)
         check_number(self, "prior_weight", low_open=False)
@@ -283,6 +292,13 @@ class IdentifyOptions:
             ("max_std_percent",),
             "consistent",
             "nothing is pruned; its data term is the residual itself, weighted by the estimator",
+        )
+        refused_with(
+            self,
+            ("torque_delay_s",),
+            "consistent",
+            "the one-step consistent fit prepares its logs without a delay; identify without "
+            "--consistent, then dynid retrieve",
         )
         if self.terms is not None and not isinstance(self.terms, Structure):
             _terms(self.terms)  # parsed now: a misspelt term is refused before any file is read
@@ -314,12 +330,19 @@ class IdentifyResult:
         sample (:func:`~dynid.friction.heldout_torques.heldout_torques`; ``heldout.json``
         and the held-out figures); None for static data, or when it could not be made (a
         :class:`~dynid.exceptions.DynidWarning` says why).
+    torque_delay : TorqueDelay or None
+        Torque logs: the lag of the torques behind the positions the fit's residual on its
+        own recordings points to (:func:`~dynid.friction.delay_check.logs_delay`; beyond
+        the ``torque_delay_s`` given); None for static data or the consistent fit. When
+        :attr:`~dynid.identification.torque_delay.TorqueDelay.named`, the model's notes
+        say it and ``identification.json``'s metadata hold it (``torque_delay``).
     """
 
     model: IdentifiedModel
     consistent: ConsistentResult | None
     files: tuple[Path, ...]
     heldout: HeldOutTorques | None = None
+    torque_delay: TorqueDelay | None = None
 
 
 def identify_files(
@@ -361,8 +384,8 @@ def identify_files(
         result, held = _identify_consistent(robot, paths, opt, prior)
         assert result.identified is not None  # _identify_consistent sets it
         return IdentifyResult(result.identified, result, tuple(paths), held)
-    model, held = _identify(robot, paths, opt)
-    return IdentifyResult(model, None, tuple(paths), held)
+    model, held, delay = _identify(robot, paths, opt)
+    return IdentifyResult(model, None, tuple(paths), held, delay)
 
 
 def _predicted_heldout(
@@ -395,9 +418,9 @@ def _say_gravity_scale(
 
 def _identify(
     robot: Robot, paths: list[Path], opt: IdentifyOptions
-) -> tuple[IdentifiedModel, HeldOutTorques | None]:
+) -> tuple[IdentifiedModel, HeldOutTorques | None, TorqueDelay | None]:
     """The unconstrained fit of :func:`identify_files` and, from torque logs, its
-    held-out prediction."""
+    held-out prediction and the torques' delay its residual points to."""
     path = paths[0]
     cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
     check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
@@ -413,6 +436,7 @@ def _identify(
             max_std_percent=opt.max_std_percent,
             rtol=opt.rtol,
             max_gap_s=opt.max_gap_s,
+            torque_delay_s=opt.torque_delay_s or 0.0,
             drive=opt.drive,
             estimator=opt.estimator,
             std=opt.std or "hac",
@@ -422,8 +446,9 @@ def _identify(
         model = in_file(path, fit) if len(paths) == 1 else fit()
         held = _predicted_heldout(model, logs, heldout.get("validate_on"))
         _say_gravity_scale(robot, model, logs, opt.drive)
+        model, delay = _with_torque_delay(model, logs)
     else:
-        held = None
+        held = delay = None
         _one_static_file(paths, opt)
         data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         outside = limit_violations(robot, data.q)
@@ -444,7 +469,24 @@ def _identify(
         misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
         if misfit is not None:
             warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
-    return _record(model, opt.columns), held
+    return _record(model, opt.columns), held, delay
+
+
+def _with_torque_delay(
+    model: IdentifiedModel, logs: Sequence[TorqueLog]
+) -> tuple[IdentifiedModel, TorqueDelay | None]:
+    """``model`` and the torques' delay its residual on ``logs`` points to
+    (:func:`~dynid.friction.delay_check.logs_delay`), said in the model's notes and
+    recorded in its metadata when named."""
+    delay = logs_delay(model, logs)
+    if delay is None or not delay.named:
+        return model, delay
+    info = dataclasses.replace(
+        model.info,
+        notes=(*model.info.notes, delay.sentence()),
+        extra={**model.info.extra, "torque_delay": delay.as_dict()},
+    )
+    return dataclasses.replace(model, info=info), delay
 
 
 def _read_logs(
@@ -501,7 +543,7 @@ def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
         raise OptionError(
             f"applies to torque logs, not static data ({paths[0].name})", field="terms"
         )
-    for name in ("cutoff_hz", "max_gap_s", "q_start"):
+    for name in ("cutoff_hz", "max_gap_s", "torque_delay_s", "q_start"):
         if getattr(opt, name) is not None:
             raise OptionError(
                 f"applies to torque logs, not static data ({paths[0].name})", field=name

@@ -48,6 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
+from ..friction.delay_check import validations_delay
 from ..friction.fit import same_drive, torques_through
 from ..friction.heldout_torques import residual_springs, residual_tilt
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
@@ -71,7 +72,8 @@ from ..identification.recorded_signs import SignFinding
 from ..identification.residual_dependence import held_terms, with_dependence_hint
 from ..identification.residual_spring import ResidualSpring
 from ..identification.spikes import SPIKES_BEFORE_JUDGING
-from ..identification.verdict import LEVELS, Verdict, with_replaced_spikes
+from ..identification.torque_delay import TorqueDelay
+from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
@@ -79,7 +81,7 @@ from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
-from .options import NO_FILTER, Cutoff, library_cutoff, velocity_cutoff
+from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
 from .recordings import (
     Recorded,
     despiked_recordings,
@@ -114,6 +116,11 @@ class ValidateOptions:
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a recording into
         pieces.
+    torque_delay_s : float, optional
+        How far the torques lag the positions [s] (positive: the torques late): each
+        piece's torques read that much later before filtering
+        (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); default:
+        the identification's recorded one, 0 for a robot.
     drive : Drive, optional
         The drive the recordings were recorded through, for a model without one.
     q_start : tuple of float, optional
@@ -133,6 +140,7 @@ class ValidateOptions:
     drop_invalid: bool = False
     cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
+    torque_delay_s: float | None = None
     drive: Drive | None = None
     q_start: tuple[float, ...] | None = None
 
@@ -146,6 +154,7 @@ class ValidateOptions:
                 continue
             if v is not None and not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
                 raise OptionError(f"{name} ({what}) must be a positive number; got {v!r}")
+        check_number(self, "torque_delay_s", low=-1.0, high=1.0)
         fr = self.friction
         if not isinstance(fr, str | Path) and not hasattr(fr, "torques"):
             raise OptionError(
@@ -214,6 +223,10 @@ class ValidateResult:
         (the joints or motors and the ``--units`` entries, ``q6=-1,tau6=-1``, in the log's
         own columns), said at the start of ``verdict``'s reason as ``opposite_sign`` is;
         empty otherwise.
+    torque_delay : TorqueDelay, optional
+        The lag of the torques behind the positions the residual points to
+        (:func:`~dynid.friction.delay_check.validations_delay`); said in ``verdict``'s
+        reason when :attr:`~dynid.identification.torque_delay.TorqueDelay.named`.
     """
 
     validation: RecordingsValidation
@@ -233,6 +246,7 @@ class ValidateResult:
     opposite_sign: tuple[tuple[str, str], ...] = ()
     springs: ResidualSpring | None = None
     reversed_columns: tuple[tuple[str, str], ...] = ()
+    torque_delay: TorqueDelay | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -247,7 +261,9 @@ class ValidateResult:
         reversed, with the ``--units`` that reads them; when there is one),
         ``verdict`` (``level``, ``label``, ``reason``), ``joint_names`` (when known) and
         ``springs`` (the stiffness per joint the residual points to, when judged:
-        :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`)."""
+        :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`) and
+        ``torque_delay`` (the torques' lag behind the positions, when named:
+        :meth:`~dynid.identification.torque_delay.TorqueDelay.as_dict`)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
         parts = {
@@ -274,6 +290,7 @@ class ValidateResult:
             **({"reversed_columns": dict(self.reversed_columns)} if self.reversed_columns else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
+            **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
 
@@ -351,6 +368,7 @@ def validate_files(
             cutoff_hz=library_cutoff(opt.cutoff_hz, RECORDED),
             max_gap_s=opt.max_gap_s,
             drive=drive,
+            torque_delay_s=opt.torque_delay_s,
         )
 
     val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
@@ -371,6 +389,7 @@ def validate_files(
         model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model)
     )
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
+    verdict, delay = _with_delay(model, verdict, val)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
     verdict = _signs_first(verdict, opposite, sign_map)
@@ -392,7 +411,20 @@ def validate_files(
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=springs,
+        torque_delay=delay,
     )
+
+
+def _with_delay(
+    model: IdentifiedModel | Robot, verdict: Verdict, val: RecordingsValidation
+) -> tuple[Verdict, TorqueDelay | None]:
+    """``verdict`` with the torques' lag behind the positions the residual points to
+    (:func:`~dynid.friction.delay_check.validations_delay`) appended when it is named, and
+    the delay."""
+    delay = validations_delay(model, val.parts)
+    if delay is not None and delay.named:
+        verdict = with_hint(verdict, delay.sentence())
+    return verdict, delay
 
 
 def _identified_speeds(model: IdentifiedModel | Robot) -> Any:

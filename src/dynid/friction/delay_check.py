@@ -1,0 +1,83 @@
+"""The torques' lag behind the positions, read from a model's prediction of prepared logs.
+
+:func:`validations_delay` hands the pieces of a validation (each prepared on its own, so
+that no derivative spans a gap) to
+:func:`~dynid.identification.torque_delay.torque_delay`: the rigid-body prediction's time
+derivative, the residual with the model's friction, and, for an identified model, its own
+columns (:func:`~dynid.friction.heldout_torques.beside_columns`) fitted beside the delay's.
+:func:`logs_delay` prepares whole logs first, as the identification cut them (``identify``
+reads the fit's residual on its own recordings).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import DynidError
+from ..identification.log import TorqueLog
+from ..identification.model import IdentifiedModel
+from ..identification.pieces import split_at_gaps, unwrapped, wrappable
+from ..identification.serial import hac_lag
+from ..identification.torque_delay import TorqueDelay, torque_delay
+from ..model.robot import Robot
+from .heldout_torques import beside_columns
+from .validation import Validation, own_friction, validate_torques
+
+__all__ = ["logs_delay", "validations_delay"]
+
+
+def validations_delay(
+    model: IdentifiedModel | Robot, parts: Sequence[Validation]
+) -> TorqueDelay | None:
+    """The delay of the torques behind the positions in ``parts`` (one
+    :class:`~dynid.friction.validation.Validation` per prepared piece, of ``model``), or
+    None when it cannot be read (too few samples, no prediction that changes)."""
+    t, predicted, error, columns = [], [], [], []
+    for v in parts:
+        log = v.log
+        hat = v.tau_model if v.tau_friction is None else v.tau_model + v.tau_friction
+        t.append(log.t)
+        predicted.append(v.tau_model)
+        error.append(log.tau - hat)
+        if isinstance(model, IdentifiedModel):
+            beside = beside_columns(model, log)
+            if beside is not None:
+                columns.append(beside(np.arange(log.n_samples)))
+    if not t:
+        return None
+    cols: list[NDArray[np.float64]] | None = columns if len(columns) == len(t) else None
+    lag = _lag(model, parts)
+    return torque_delay(t, predicted, error, cols, lag)
+
+
+def logs_delay(model: IdentifiedModel, logs: Sequence[TorqueLog]) -> TorqueDelay | None:
+    """:func:`validations_delay` of ``logs`` (as read), each cut at the identification's
+    gaps, its wrapped joints unwrapped and every piece prepared as the model's validation
+    prepares it (:func:`~dynid.friction.validation.validate_torques`: the recorded
+    cut-off and delay); a piece too short to prepare left out."""
+    gap = None if model.info.log is None else model.info.log.max_gap_s
+    turns = wrappable(model.robot, model.drive)
+    friction = own_friction(model)
+    parts = []
+    for log in logs:
+        for piece in split_at_gaps(log, gap):
+            try:
+                parts.append(validate_torques(model, unwrapped(piece, turns)[0], friction=friction))
+            except DynidError:
+                continue
+    return validations_delay(model, parts)
+
+
+def _lag(model: IdentifiedModel | Robot, parts: Sequence[Validation]) -> int:
+    """The Newey-West window [samples]: two periods of the model's cut-off at the pieces'
+    rate (:func:`~dynid.identification.serial.hac_lag`)."""
+    cutoff = None
+    if isinstance(model, IdentifiedModel) and model.info.log is not None:
+        cutoff = model.info.log.cutoff_hz
+    dt = [float(np.median(np.diff(v.log.t))) for v in parts if v.log.n_samples > 1]
+    if not dt:
+        return 0
+    return hac_lag(cutoff if cutoff is not None else 0.25 / min(dt), 1.0 / min(dt))

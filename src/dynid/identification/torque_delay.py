@@ -1,0 +1,185 @@
+"""How far the torques of a log lag its positions, read from a fit's residual.
+
+Sensor filtering and bus latency put the measured torques a few milliseconds behind the
+positions they belong to: ``tau_measured(t) = tau(t - delta)``. To first order
+``tau(t - delta) = tau(t) - delta d(tau)/dt``, so the residual ``e = tau_measured -
+tau_model`` holds ``-delta d(tau_model)/dt``; the fit takes what of it its own columns can
+(a Panda's joint 2: ``delta dg2/dq2`` on the viscous column, +0.087 N m s/rad for 2 ms),
+the rest stays in the residual. :func:`torque_delay` fits the residual, each joint weighed by
+its RMS, with the column ``-d(tau_model)/dt`` beside the model's own columns (their share
+of the delay taken back: the coefficient is ``delta`` itself), the derivative taken
+within each prepared piece (never across a gap) of the rigid-body prediction (friction's
+steps at a reversal are no first-order term). One delay common to every joint (a bus)
+with its standard deviation over the pieces' serially correlated residual
+(:mod:`~dynid.identification.serial`: Newey-West), and each joint's alone for the report.
+
+The delay is named (:attr:`TorqueDelay.named`) when it stands :data:`SIGNIFICANT`
+standard deviations clear and explains at least :data:`SHARE` of the residual's weighted
+sum of squares; :meth:`TorqueDelay.sentence` then says it with the hint to
+``--torque-delay``, which reads the states that much earlier before filtering
+(:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .serial import SerialMeat, serial_of_pieces
+
+__all__ = ["SHARE", "SIGNIFICANT", "TorqueDelay", "torque_delay"]
+
+#: Smallest ratio of the delay to its standard deviation for the delay to be named.
+SIGNIFICANT = 3.0
+#: Smallest share of the residual's weighted sum of squares the delay must explain.
+SHARE = 0.01
+#: Fewest samples of a piece whose derivative is taken.
+_MIN_SAMPLES = 5
+
+
+@dataclass(frozen=True, slots=True)
+class TorqueDelay:
+    """The lag of the torques behind the positions a residual points to.
+
+    Attributes
+    ----------
+    delay_s : float
+        The delay common to every joint [s] (positive: the torques late).
+    std_s : float
+        Its standard deviation [s] (Newey-West within each piece).
+    share : float
+        The share of the residual's weighted sum of squares the common delay explains.
+    joints_s, joints_std_s : tuple of float
+        Each joint's own delay and its standard deviation [s] (nan where the joint's
+        prediction does not change).
+    """
+
+    delay_s: float
+    std_s: float
+    share: float
+    joints_s: tuple[float, ...]
+    joints_std_s: tuple[float, ...]
+
+    @property
+    def named(self) -> bool:
+        """Whether the delay stands :data:`SIGNIFICANT` standard deviations clear and
+        explains at least :data:`SHARE` of the residual."""
+        clear = abs(self.delay_s) > SIGNIFICANT * self.std_s
+        return bool(clear and self.share >= SHARE)
+
+    def sentence(self) -> str:
+        """The delay in words with the option that removes it."""
+        ms, sd = 1e3 * self.delay_s, 1e3 * self.std_s
+        late = "lag" if ms > 0 else "lead"
+        return (
+            f"the torques {late} the positions by {abs(ms):.2g} ms (+- {sd:.1g} ms; "
+            f"{100 * self.share:.2g} % of the residual; a filtered sensor or the bus): the fit "
+            f"bends to it (viscous friction first); hint: --torque-delay {ms:.2g} pairs the "
+            "torques with the positions they belong to before filtering"
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        """The record of ``identify``'s and ``validate``'s JSON: the delays in ms."""
+        return {
+            "delay_ms": 1e3 * self.delay_s,
+            "std_ms": 1e3 * self.std_s,
+            "share": self.share,
+            "named": self.named,
+            "joints_ms": [1e3 * x if np.isfinite(x) else None for x in self.joints_s],
+            "joints_std_ms": [1e3 * x if np.isfinite(x) else None for x in self.joints_std_s],
+        }
+
+
+def torque_delay(
+    t: Sequence[NDArray[np.float64]],
+    predicted: Sequence[NDArray[np.float64]],
+    error: Sequence[NDArray[np.float64]],
+    columns: Sequence[NDArray[np.float64]] | None = None,
+    lag: int = 0,
+) -> TorqueDelay | None:
+    """The delay of the torques behind the positions that the residual ``error`` points to
+    (module docstring).
+
+    Parameters
+    ----------
+    t : sequence of ndarray, each (N_k,)
+        The times of each prepared piece [s], increasing.
+    predicted : sequence of ndarray, each (N_k, n)
+        The model's rigid-body torques at those samples [N m] (friction left out).
+    error : sequence of ndarray, each (N_k, n)
+        Measured less predicted torques [N m].
+    columns : sequence of ndarray, each (N_k, n, p), optional
+        The model's own columns at those samples, fitted beside the delay's.
+    lag : int
+        The Newey-West window [samples] (:func:`~dynid.identification.serial.hac_lag`).
+
+    Returns
+    -------
+    TorqueDelay or None
+        None without a piece of at least 5 samples or a prediction that changes.
+    """
+    keep = [k for k, x in enumerate(t) if np.asarray(x).shape[0] >= _MIN_SAMPLES]
+    if not keep:
+        return None
+    E = [np.asarray(error[k], dtype=np.float64) for k in keep]
+    D = [
+        -np.gradient(np.asarray(predicted[k], float), np.asarray(t[k], float), axis=0) for k in keep
+    ]
+    C = None if columns is None else [np.asarray(columns[k], dtype=np.float64) for k in keep]
+    n = E[0].shape[1]
+    rms = np.sqrt(np.mean(np.concatenate(E) ** 2, axis=0))
+    w = np.where(rms > 0, 1.0 / np.where(rms > 0, rms, 1.0), 0.0)
+    sizes = [e.shape[0] for e in E]
+    common = _fit(D, E, C, w, sizes, lag, range(n))
+    if common is None:
+        return None
+    joints = [_fit(D, E, C, w, sizes, lag, [j]) for j in range(n)]
+    nan = (float("nan"), float("nan"), 0.0)
+    return TorqueDelay(
+        delay_s=common[0],
+        std_s=common[1],
+        share=common[2],
+        joints_s=tuple((j or nan)[0] for j in joints),
+        joints_std_s=tuple((j or nan)[1] for j in joints),
+    )
+
+
+def _fit(
+    D: list[NDArray[np.float64]],
+    E: list[NDArray[np.float64]],
+    C: list[NDArray[np.float64]] | None,
+    w: NDArray[np.float64],
+    sizes: list[int],
+    lag: int,
+    joints: Sequence[int],
+) -> tuple[float, float, float] | None:
+    """The delay [s], its Newey-West standard deviation [s] and the share of the weighted
+    residual it explains, from the rows of ``joints``: the delay's column ``D`` with the
+    columns ``C`` taken out of it and of the residual ``E`` (Frisch-Waugh-Lovell)."""
+    j = np.asarray(joints)
+    x = np.concatenate([d[:, j] * w[j] for d in D]).ravel()
+    y = np.concatenate([e[:, j] * w[j] for e in E]).ravel()
+    if C is not None:
+        A = np.concatenate([c[:, j, :] * w[j][None, :, None] for c in C])
+        A = A.reshape(-1, A.shape[-1])
+        A = A[:, np.any(A != 0, axis=0)]
+        if A.shape[1]:
+            scale = np.linalg.norm(A, axis=0)
+            A = A / scale
+            both = np.linalg.lstsq(A, np.stack([x, y], axis=1), rcond=1e-10)[0]
+            x, y = x - A @ both[:, 0], y - A @ both[:, 1]
+    xx = float(x @ x)
+    yy = float(y @ y)
+    if not xx > 0 or not yy > 0:
+        return None
+    delta = float(x @ y) / xx
+    r = y - delta * x
+    meat = SerialMeat(serial_of_pieces(sizes, len(j), [lag]), 1)
+    meat.add((x * r)[:, None])
+    m = x.shape[0]
+    var = float(meat.result()[0, 0]) / xx**2 * m / max(m - 1, 1)
+    return delta, float(np.sqrt(max(var, 0.0))), delta**2 * xx / yy
