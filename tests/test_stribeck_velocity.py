@@ -90,7 +90,7 @@ def test_a_stribeck_velocity_between_grid_points_is_refined(between):
     assert mine.score <= min(c.score for c in grid)
 
 
-def test_the_viscous_coefficient_is_unbiased_at_the_refined_shape(between):
+def test_the_viscous_coefficient_is_unbiased_at_the_refined_velocity(between):
     """Fitted at the refined velocity, every joint's viscous coefficient is within three
     standard deviations of the truth's (the simulated one)."""
     panda, logs, P, sel = between

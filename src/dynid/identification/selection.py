@@ -295,8 +295,7 @@ def select_structure(
 
     keys = sorted({regressor_group(c) for c in cands})
     for i, key in enumerate(keys):
-        arm = key[0]
-        mine = [c for c in cands if regressor_group(c) == key]
+        arm, mine = key[0], [c for c in cands if regressor_group(c) == key]
         for family, model, terms, held in fit(
             mine, f"structure search, regressor {i + 1} of {len(keys)}"
         ):  # a smooth width judged apart: its own key
@@ -324,8 +323,6 @@ def select_structure(
     }
     if per_joint:
         judged += _widths_per_joint(judged, by_group, robot.n, fit_rtol, where)
-    # the bumps from the grid's smooth laws: one without its bump is fitted at a width
-    # rounded to make up for it, a start of the bump's walk (bumps.py), not its answer
     judged += _smooth_bumps(judged, cands, fit, groups, by_group, where, skip, fit_rtol)
     judged += _refined_width(judged, fit, groups, by_group, where, skip, fit_rtol, notes)
     if per_joint:
@@ -612,7 +609,9 @@ def _refined_width(
     """The smooth Coulomb law of one width that predicts held-out data best, its width
     refined between its grid neighbours on the held-out error
     (:func:`~.shape_refinement.refined_shape`, from the scores of the same law at the
-    grid's widths), once the Stribeck bumps are judged: the candidates judged at the
+    grid's widths), once the Stribeck bumps are judged (from the grid's widths: a smooth
+    law without its bump is fitted at a width rounded to make up for it, the start of the
+    bump's walk, :mod:`~.bumps`, not its answer): the candidates judged at the
     new widths (each width's fitted in a regressor of its own, recorded in ``groups``,
     ``by_group`` and ``where``), said in ``notes`` when one predicts better than the
     grid's; none when no such law was judged, the best predicts no better than the laws
@@ -641,7 +640,8 @@ def _refined_width(
     scores = {
         c.structure.width: c.score
         for c in smooth
-        if isinstance(c.structure.width, float) and c.structure == replace(full, width=c.structure.width)
+        if isinstance(c.structure.width, float)
+        and c.structure == replace(full, width=c.structure.width)
     }
     new: list[Candidate] = []
 

@@ -749,6 +749,7 @@ def _structure_section(doc: dict) -> str:
         return ""
     chosen = sel.get("chosen")
     rows, marked = [], []
+
     def why(c: dict) -> str:
         if c.get("not_dissipative"):
             return "skipped: not dissipative"
