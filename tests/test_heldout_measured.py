@@ -3,6 +3,7 @@ have is chosen over a smooth one that only the low-passed torques favour."""
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import numpy as np
@@ -55,7 +56,8 @@ def test_a_sharp_coulomb_law_is_predicted_through_noisy_velocities_by_a_narrow_s
     2e-3 rad/s of noise. The model predicts from the velocities as prepared, whose sign
     near a reversal is noise: the standstill band switched 1-3 N m off around every
     reversal, a sharp sign flips it. The expected sign given the noise is a smooth one
-    about as wide as the noise; the narrowest smooth candidate (0.3 bands) is chosen, and
+    about as wide as the noise; the narrowest smooth candidate (0.3 bands), its width
+    refined between the grid's 0.3 and 1 bands on the held-out error, is chosen, and
     ``validate`` on a new recording finds a lower error than with the banded law fitted on
     the same data (2.0-2.2 times the sensors' noise on joints 1-4), and about the true
     law's on the same prepared velocities."""
@@ -70,7 +72,9 @@ def test_a_sharp_coulomb_law_is_predicted_through_noisy_velocities_by_a_narrow_s
             validate_torques(m, test, friction=own_friction(m)).with_friction
             for m in (chosen, banded)
         ]
-    assert "smooth:0.3" in chosen.info.selection["chosen"], chosen.info.selection["chosen"]
+    name = chosen.info.selection["chosen"]
+    width = float(name.split("smooth:")[1].split()[0]) if "smooth:" in name else math.inf
+    assert 0.3 <= width < 1.0, name
     assert errors[0] is not None and errors[1] is not None
     assert errors[0].relative_error_percent < 0.9 * errors[1].relative_error_percent
     # the true arm and law, predicted from the same prepared velocities

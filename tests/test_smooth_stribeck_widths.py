@@ -30,7 +30,7 @@ WIDTHS = (0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0)  # bands
 def _cand(width: float, score: float, unphysical: tuple[str, ...] = ()) -> SimpleNamespace:
     """A judged candidate as the walk reads it: its width, score and dissipation."""
     return SimpleNamespace(
-        structure=SimpleNamespace(width=width), score=score, unphysical=unphysical
+        structure=SimpleNamespace(width=width), score=score, skipped=bool(unphysical)
     )
 
 

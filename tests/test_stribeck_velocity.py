@@ -1,5 +1,5 @@
 """The Stribeck velocity refined between the grid's points on held-out data
-(:mod:`dynid.identification.stribeck_velocity`).
+(:mod:`dynid.identification.shape_refinement`).
 
 References: closed forms (a parabola's vertex); a simulated Panda whose Stribeck velocity
 lies between two of the grid's, with sensor noise, judged on recordings the fit did not see.
@@ -19,7 +19,7 @@ from dynid.friction.laws import LAWS
 from dynid.friction.model import LawFriction
 from dynid.identification.recordings import prepare_recordings
 from dynid.identification.selection import identify_recordings, select_structure
-from dynid.identification.stribeck_velocity import refined_velocity
+from dynid.identification.shape_refinement import refined_shape
 from dynid.identification.structure import STRIBECK_VELOCITIES, Structure
 from dynid.simulation.measurement import SensorNoise
 
@@ -44,7 +44,7 @@ def test_the_search_reaches_a_parabola_s_vertex_in_few_fits():
         return error(v)
 
     grid = {v: error(v) for v in STRIBECK_VELOCITIES}
-    tried = refined_velocity(grid, 0.07, judged)
+    tried = refined_shape(grid, 0.07, judged)
     assert tried == tuple(calls) and 1 <= len(tried) <= 3
     assert all(0.05 < v < 0.1 for v in tried)
     assert abs(math.log(min(tried, key=error)) - x0) < 0.01
@@ -54,7 +54,7 @@ def test_the_search_stops_where_the_grid_point_is_the_minimum():
     """Held-out errors whose minimum is the grid point itself (a parabola centred on
     0.1 rad/s): no fit is spent, or those spent score no better than the grid's."""
     grid = {v: 1.0 + math.log(v / 0.1) ** 2 for v in STRIBECK_VELOCITIES}
-    tried = refined_velocity(grid, 0.1, lambda v: 1.0 + math.log(v / 0.1) ** 2)
+    tried = refined_shape(grid, 0.1, lambda v: 1.0 + math.log(v / 0.1) ** 2)
     assert all(abs(math.log(v / 0.1)) < 0.02 for v in tried)
 
 

@@ -20,9 +20,11 @@ Model structure. Beside the links' base parameters a torque log may need an arma
 ddq per joint; with a drive file, the rotor inertias at the motors), viscous and Coulomb
 friction (sign(dq) off inside each joint's velocity noise band, or a smooth tanh(dq/w) at
 seven widths w from 0.3 to 300 bands, the narrowest about the velocity noise, then chosen
-per joint), a Stribeck bump exp(-(dq/vst)^2) at seven Stribeck velocities from 0.02 to 0.2
+per joint, the best single width refined between its grid neighbours on the held-out
+error), a Stribeck bump exp(-(dq/vst)^2) at seven Stribeck velocities from 0.02 to 0.2
 rad/s (on the banded sign or on the narrowest smooth one; the chosen velocity then refined
-between its grid neighbours on the same held-out error, a few fits more), and torque
+between its grid neighbours on the same held-out error, a few fits more; a bump fitted
+below zero, static friction under Coulomb, is skipped: marked x), and torque
 offsets, each
 identified with the links. By default every combination is fitted and judged on data it
 was not fitted to (one recording left out at a time when there are several, else --folds

@@ -18,7 +18,8 @@ def text_width(header: str, cells: Any, least: int = 0) -> int:
 
 def selection_lines(selection: Any) -> list[str]:
     """The model structures judged on held-out data, the one kept marked ``*``, those
-    skipped because their friction is not dissipative ``x`` (one note says why)."""
+    skipped because their friction is not dissipative or their Stribeck bump is below zero
+    ``x`` (one note says why)."""
     if not selection:
         return []
     # a per-joint structure's coefficients left out go last ("- fo1 - fc4"), so that the
@@ -35,9 +36,9 @@ def selection_lines(selection: Any) -> list[str]:
     white = any(c.get("heldout_whitened_percent") is not None for c in selection["candidates"])
     cands = selection["candidates"]
     # skipped (not dissipative within the velocity limits) unless every candidate is
-    skip = not all(c.get("not_dissipative") for c in cands)
+    skip = not all(_skipped(c) for c in cands)
     # every candidate skipped is shown, marked x, as the selection's note says
-    marked = {str(c["name"]) for c in cands if skip and c.get("not_dissipative")}
+    marked = {str(c["name"]) for c in cands if skip and _skipped(c)}
     shown, hidden = _best_of_shapes(cands, selection["chosen"], marked)
     # the column of the coefficients left out, when a row shown holds some
     left = any(d for c, (_, _, d) in zip(cands, split, strict=True) if c["name"] in shown)
@@ -54,7 +55,7 @@ def selection_lines(selection: Any) -> list[str]:
         if c["name"] not in shown:
             continue
         mark = "*" if c["name"] == selection["chosen"] else " "
-        mark = "x" if skip and c.get("not_dissipative") else mark
+        mark = "x" if skip and _skipped(c) else mark
         out.append(
             f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g}"
@@ -139,3 +140,9 @@ def _compact(labels: list[str]) -> str:
         for r in runs:
             out += [f"{stem}{r[0]}-{r[-1]}"] if len(r) > 2 else [f"{stem}{j}" for j in r]
     return " ".join(out)
+
+
+def _skipped(candidate: dict) -> bool:
+    """Whether the choice skips a candidate: friction not dissipative, or a Stribeck bump
+    below zero."""
+    return bool(candidate.get("not_dissipative") or candidate.get("negative_bump"))

@@ -74,6 +74,6 @@ def bump_widths(
 
 
 def _best(cands: Sequence[Candidate]) -> Candidate | None:
-    """The candidate of lowest held-out error whose friction is dissipative (None when
-    none is)."""
-    return min((c for c in cands if not c.unphysical), key=lambda c: c.score, default=None)
+    """The candidate of lowest held-out error not skipped (friction dissipative, no bump
+    below zero: :attr:`~.candidates.Candidate.skipped`; None when every one is)."""
+    return min((c for c in cands if not c.skipped), key=lambda c: c.score, default=None)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
@@ -102,6 +103,11 @@ class Candidate:
         when the noise is not known.
     fold_whitened_percent : tuple of float
         The same per fold.
+    negative_bump : tuple of str
+        The Stribeck coefficients (``fsp1``) fitted below zero on all data: static friction
+        below the Coulomb level, no Stribeck effect but a correction of the sign's shape
+        (a smooth Coulomb narrower or wider than the data's); the candidate is skipped, and
+        the search falls back to the law without the bump on those joints.
     relative_std : tuple of (str, float)
         Each coefficient it holds that a per-joint structure may leave out (``Ia5``,
         ``fv3``) and its relative standard deviation [%] in its fit on all data (as the
@@ -120,6 +126,13 @@ class Candidate:
     whitened_error_percent: float | None = None
     fold_whitened_percent: tuple[float, ...] = ()
     relative_std: tuple[tuple[str, float], ...] = ()
+    negative_bump: tuple[str, ...] = ()
+
+    @property
+    def skipped(self) -> bool:
+        """Whether the choice skips it: friction not dissipative (:attr:`unphysical`) or
+        a Stribeck bump below zero (:attr:`negative_bump`)."""
+        return bool(self.unphysical or self.negative_bump)
 
     def determined(self) -> dict[str, float]:
         """The coefficients of :attr:`relative_std` that the data determine (at most
@@ -154,6 +167,7 @@ class Candidate:
             "heldout_se_vs_best_percent": self.se_vs_best_percent,
             "heldout_per_fold_percent": list(self.fold_errors_percent),
             "not_dissipative": [str(v) for v in self.unphysical],
+            "negative_bump": list(self.negative_bump),
             "left_out": list(self.left_out),
             "heldout_whitened_percent": self.whitened_error_percent,
         }
@@ -276,12 +290,14 @@ def candidate_judged(
     whole, whole_std = sub.whole.solve_with_std(rtol, std=check is not None)
     unphysical: tuple[Violation, ...] = ()
     relative: tuple[tuple[str, float], ...] = ()
+    negative: tuple[str, ...] = ()
     if check is not None:
         assert whole_std is not None  # asked for with the check
         x, sd = np.zeros(use.size), np.zeros(use.size)
         x[idx], sd[idx] = whole, whole_std * std_inflation(model, rtol)[idx]
         unphysical = check(x, sd)
         relative = relative_stds(x, sd, use, labels)
+        negative = negative_bumps(x, use, labels)
     return Candidate(
         structure=structure,
         n_params=int(use.sum()),
@@ -293,7 +309,21 @@ def candidate_judged(
         whitened_error_percent=sub.heldout_error_percent(xs, whitened=True) if white else None,
         fold_whitened_percent=tuple(white),
         relative_std=relative,
+        negative_bump=negative,
     )
+
+
+#: A Stribeck coefficient of one joint (motor): ``fsp3``, ``jfsp7``.
+_BUMP = re.compile(r"j?fsp[0-9]+")
+
+
+def negative_bumps(
+    x: NDArray[np.float64], use: NDArray[np.bool_], labels: Sequence[str]
+) -> tuple[str, ...]:
+    """The labels of the Stribeck coefficients ``fsp = fs - fc`` [N m] among the columns
+    ``use`` whose value in ``x`` is below zero (static friction below Coulomb)."""
+    found = (lab for lab, v, u in zip(labels, x, use, strict=False) if u and v < 0)
+    return tuple(dict.fromkeys(lab for lab in found if _BUMP.fullmatch(lab)))
 
 
 def relative_stds(

@@ -27,7 +27,7 @@ determined to 3 %, kept ``M(q)`` of the wrist right;
 width is then chosen per joint (:mod:`dynid.identification.widths`), and the Stribeck
 bump on the smooth sign judged at the width of the best smooth law
 (:mod:`dynid.identification.bumps`); the chosen Stribeck velocity is refined between its
-grid neighbours on the same held-out error (:mod:`dynid.identification.stribeck_velocity`).
+grid neighbours on the same held-out error (:mod:`dynid.identification.shape_refinement`).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
@@ -92,7 +92,7 @@ from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded, sign_confirmed
 from .recordings import Recordings, prepare_recordings
-from .stribeck_velocity import refined_velocity
+from .shape_refinement import refined_shape
 from .structural import absorbed_by
 from .structure import (
     ERROR_FLOOR_PERCENT,
@@ -108,6 +108,7 @@ from .structure import (
     regressor_group,
     smooth_stribeck_candidates,
     structure_terms,
+    width_text,
 )
 from .widths import per_joint_widths, regressor_widths
 
@@ -182,9 +183,10 @@ def _heldout_record(model: IdentifiedModel, data: Recordings) -> Any:
 
 
 def _physical(candidates: Sequence[Candidate]) -> list[Candidate]:
-    """The candidates whose friction is dissipative within the velocity limits (all of
-    them when none is)."""
-    return [c for c in candidates if not c.unphysical] or list(candidates)
+    """The candidates not skipped: friction dissipative within the velocity limits and no
+    Stribeck bump below zero (:attr:`~.candidates.Candidate.skipped`; all of them when
+    every one is)."""
+    return [c for c in candidates if not c.skipped] or list(candidates)
 
 
 def _within(c: Candidate, best: Candidate) -> bool:
@@ -293,8 +295,7 @@ def select_structure(
 
     keys = sorted({regressor_group(c) for c in cands})
     for i, key in enumerate(keys):
-        arm = key[0]
-        mine = [c for c in cands if regressor_group(c) == key]
+        arm, mine = key[0], [c for c in cands if regressor_group(c) == key]
         for family, model, terms, held in fit(
             mine, f"structure search, regressor {i + 1} of {len(keys)}"
         ):  # a smooth width judged apart: its own key
@@ -323,6 +324,7 @@ def select_structure(
     if per_joint:
         judged += _widths_per_joint(judged, by_group, robot.n, fit_rtol, where)
     judged += _smooth_bumps(judged, cands, fit, groups, by_group, where, skip, fit_rtol)
+    judged += _refined_width(judged, fit, groups, by_group, where, skip, fit_rtol, notes)
     if per_joint:
         judged += _per_joint(judged, by_group, robot.n, fit_rtol, where)
     chosen = _refined_stribeck(judged, fit, groups, by_group, where, skip, fit_rtol, notes)
@@ -409,7 +411,17 @@ def _candidate_notes(judged: Sequence[Candidate]) -> list[str]:
             "hardly excite their columns (a Stribeck term whose velocities the held-out data "
             "reach and the others seldom do), so their fits on those folds extrapolate"
         )
-    skipped = [c for c in judged if c.unphysical] if len(_physical(judged)) < len(judged) else []
+    some = len(_physical(judged)) < len(judged)
+    skipped = [c for c in judged if c.unphysical] if some else []
+    bumps = [c for c in judged if c.negative_bump and not c.unphysical] if some else []
+    if bumps:
+        joints = sorted({lab for c in bumps for lab in c.negative_bump}, key=_label_key)
+        notes.append(
+            f"{len(bumps)} candidate(s) marked x skipped: their Stribeck bump is below zero "
+            f"(static friction under Coulomb: {', '.join(joints)}), no Stribeck effect but a "
+            "correction of the sign's shape; on those joints the law without the bump is "
+            "judged instead (where: metadata.selection.candidates[].negative_bump)"
+        )
     if skipped:  # one line: the table marks each (metadata.selection names the joints)
         notes.append(
             f"{len(skipped)} candidate(s) marked x skipped: their friction is not dissipative "
@@ -584,6 +596,86 @@ def _smooth_bumps(
     return new
 
 
+def _refined_width(
+    judged: Sequence[Candidate],
+    fit: Callable[[list[Structure], str], list[Fitted]],
+    groups: _Groups,
+    by_group: _Folds,
+    where: dict[Structure, _Key],
+    skip: tuple[int, ...],
+    rtol: float,
+    notes: list[str],
+) -> list[Candidate]:
+    """The smooth Coulomb law of one width that predicts held-out data best, its width
+    refined between its grid neighbours on the held-out error
+    (:func:`~.shape_refinement.refined_shape`, from the scores of the same law at the
+    grid's widths), once the Stribeck bumps are judged (from the grid's widths: a smooth
+    law without its bump is fitted at a width rounded to make up for it, the start of the
+    bump's walk, :mod:`~.bumps`, not its answer): the candidates judged at the
+    new widths (each width's fitted in a regressor of its own, recorded in ``groups``,
+    ``by_group`` and ``where``), said in ``notes`` when one predicts better than the
+    grid's; none when no such law was judged, the best predicts no better than the laws
+    without a Coulomb term (beyond one standard error: no Coulomb friction in the data) or
+    a law of the banded sign predicts better than it (beyond one standard error)."""
+    smooth = [
+        c
+        for c in _physical(judged)
+        if _plain_smooth(c.structure)
+        and isinstance(c.structure.width, float)
+        and not c.structure.drop
+        and not c.skipped
+    ]
+    if not smooth:
+        return []
+    start = min(smooth, key=lambda c: c.score)
+    signless = [
+        c for c in _physical(judged) if not {"coulomb", "smooth"} & set(c.structure.friction)
+    ]
+    if signless and not _better(start, min(signless, key=lambda c: c.score)):
+        return []  # no Coulomb friction in the data: no width to refine
+    banded = [c for c in _physical(judged) if "coulomb" in c.structure.friction]
+    if banded and _better(min(banded, key=lambda c: c.score), start):
+        return []  # a sharp sign predicts better: the smooth law is not in the running
+    full = start.structure
+    scores = {
+        c.structure.width: c.score
+        for c in smooth
+        if isinstance(c.structure.width, float)
+        and c.structure == replace(full, width=c.structure.width)
+    }
+    new: list[Candidate] = []
+
+    def at(w: float) -> float | None:
+        mine = replace(full, width=w)
+        for family, model, terms, held in fit([mine], "structure search, the smooth width"):
+            own = (full.armature, full.at, f"{family} {w:g}")
+            groups[own] = (model, terms)
+            folds = without_recordings(model, skip) if skip else heldout_of(model)
+            by_group[own] = (model, terms, folds)
+            for c in held:
+                where[c] = own
+                new.append(
+                    _judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol)
+                )
+        return next((c.score for c in new if c.structure == mine and not c.skipped), None)
+
+    assert isinstance(full.width, float)  # one width: the smooth laws of the grid
+    tried = refined_shape(scores, full.width, at)
+    best = min([start, *(c for c in new if not c.skipped)], key=lambda c: c.score)
+    if best is not start:
+        grid = sorted(scores)
+        k = grid.index(full.width)
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+        notes.append(
+            f"smooth Coulomb width refined on held-out data between the grid's {lo:g} and "
+            f"{hi:g} bands ({len(tried)} more fit(s), at {', '.join(f'{w:g}' for w in tried)}): "
+            f"smooth:{width_text(best.structure.width)}, held-out error "
+            f"{best.heldout_error_percent:.4g} % (at the grid's {full.width:g}: "
+            f"{start.heldout_error_percent:.4g} %)"
+        )
+    return new
+
+
 def _refined_stribeck(
     judged: list[Candidate],
     fit: Callable[[list[Structure], str], list[Fitted]],
@@ -595,7 +687,7 @@ def _refined_stribeck(
     notes: list[str],
 ) -> Structure:
     """The structure chosen (:func:`_chosen`) with its Stribeck velocity refined between
-    its grid neighbours on the held-out error (:func:`~.stribeck_velocity.refined_velocity`,
+    its grid neighbours on the held-out error (:func:`~.shape_refinement.refined_shape`,
     driven by the scores of the chosen law without its coefficients left out at the grid's
     velocities): the candidates judged at the new velocities appended to ``judged`` (each
     velocity's fitted in a regressor of its own, recorded in ``groups``, ``by_group`` and
@@ -627,10 +719,10 @@ def _refined_stribeck(
                 )
         return next((c.score for c in new if c.structure == mine[0]), None)
 
-    tried = refined_velocity(scores, chosen.vst, at)
+    tried = refined_shape(scores, chosen.vst, at)
     here = [c for c in judged if c.structure == chosen]
     judged += new
-    same = [c for c in new if c.structure.drop == chosen.drop and not c.unphysical]
+    same = [c for c in new if c.structure.drop == chosen.drop and not c.skipped]
     best = min(here + same, key=lambda c: c.score, default=None)
     if best is None or not here or not tried:
         return chosen
@@ -687,9 +779,9 @@ def _per_joint(
     best_any = min(judged, key=lambda c: c.score)
     best = min(_physical(judged), key=lambda c: c.score)
     repaired = None
-    if best_any.unphysical and not best.unphysical:
+    if best_any.skipped and not best.skipped:
         group = groups[where[best_any.structure]]
-        repaired = _repaired(best_any, *group, n, rtol)
+        repaired = _repaired(_without_bumps(best_any, *group, rtol), *group, n, rtol)
         if repaired is not None:
             where[repaired.structure] = where[best_any.structure]
     starts = [best, *([] if repaired is None else [repaired])]
@@ -706,7 +798,7 @@ def _per_joint(
             trials = [
                 c
                 for c in _dropped(here, model, terms, held, n, rtol, keep=here.determined())
-                if not c.unphysical or here.unphysical
+                if not c.skipped or here.skipped
             ]
             step = min(trials, key=lambda c: c.score, default=None)
             if step is None or not _within(step, best):
@@ -745,6 +837,30 @@ def _dropped(
     ]
 
 
+def _without_bumps(
+    here: Candidate,
+    model: IdentifiedModel,
+    terms: list[tuple[ModelTerm, Any]],
+    held: HeldOut,
+    rtol: float,
+) -> Candidate:
+    """``here`` without its Stribeck coefficients below zero
+    (:attr:`~.candidates.Candidate.negative_bump`): on those joints the law without the
+    bump, judged; ``here`` itself when it has none, and :func:`_repaired`'s input."""
+    for _ in range(len(here.structure.drop) + 8):  # a joint's bump at a time turns negative
+        if not here.negative_bump:
+            break
+        s = replace(here.structure, drop=here.structure.drop + here.negative_bump)
+        here = _judged(s, candidate_columns(s, model, terms), model, terms, held, rtol)
+    return here
+
+
+def _label_key(label: str) -> tuple[str, int]:
+    """A coefficient's label in joint order: ``fsp2`` before ``fsp10``."""
+    head = label.rstrip("0123456789")
+    return head, int(label[len(head) :] or 0)
+
+
 def _repaired(
     here: Candidate,
     model: IdentifiedModel,
@@ -765,6 +881,9 @@ def _repaired(
 
     def left(c: Candidate) -> tuple[int, int]:
         return len(c.unphysical), sum(len(v.labels) for v in c.unphysical)
+
+    if here.negative_bump:  # new bumps below zero: the bump has no place there either
+        return None
 
     while here.unphysical:
         parts = [p for p in here.structure.friction if p != "offset"]  # no friction of motion

@@ -74,7 +74,7 @@ def per_joint_widths(
                 continue
             now = here.structure.widths(n)[j]
             trials = [judged(here.structure.with_width(j, w, n)) for w in widths if w != now]
-            trials = [c for c in trials if not c.unphysical or here.unphysical]
+            trials = [c for c in trials if not c.skipped or here.skipped]
             step = min(trials, key=lambda c: c.score, default=None)
             if step is not None and better(step, here):
                 here, moved = step, True

@@ -749,14 +749,20 @@ def _structure_section(doc: dict) -> str:
         return ""
     chosen = sel.get("chosen")
     rows, marked = [], []
-    skip = not all(c.get("not_dissipative") for c in sel["candidates"])
+
+    def why(c: dict) -> str:
+        if c.get("not_dissipative"):
+            return "skipped: not dissipative"
+        return "skipped: Stribeck bump below zero" if c.get("negative_bump") else ""
+
+    skip = not all(why(c) for c in sel["candidates"])
     left = any(c.get("left_out") for c in sel["candidates"])
     for c in sel["candidates"]:
         mark = c.get("name") == chosen
-        skipped = skip and bool(c.get("not_dissipative"))
+        skipped = why(c) if skip else ""
         rows.append(
             [
-                "&#10003; chosen" if mark else "skipped: not dissipative" if skipped else "",
+                "&#10003; chosen" if mark else skipped,
                 esc(c.get("name", "")),
                 cell(c.get("terms") or []),
                 cell(c.get("n_params")),
