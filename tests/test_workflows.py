@@ -137,7 +137,7 @@ def test_log_cleaning_through_a_column_map_is_strict_alike(files, tmp_path, caps
     np.savetxt(path, table, delimiter=",", header=",".join(cols), comments="")
     spec = ("t=time,q=pos{i0},dq=vel{i0},tau=eff{i0}", None)
     cmap = column_map(*spec)
-    with pytest.raises(DataError, match=r"1 row\(s\) of \d+ hold NaN or inf") as api:
+    with pytest.raises(DataError, match=r"1 row\(s\) of \d+ holding NaN, inf") as api:
         read_torque_log(path, n, columns=cmap)
     assert read_torque_log(path, n, columns=cmap, drop_invalid=True).n_samples == len(log.t) - 1
     line = _refusal(
