@@ -4,7 +4,8 @@
 that no derivative spans a gap) to
 :func:`~dynid.identification.torque_delay.torque_delay`: the rigid-body prediction's time
 derivative, the residual with the model's friction, and, for an identified model, its own
-columns (:func:`~dynid.friction.heldout_torques.beside_columns`) fitted beside the delay's.
+columns (:func:`~dynid.friction.heldout_torques.beside_columns`) fitted beside the delay's,
+on at most :data:`ROWS` rows.
 :func:`logs_delay` prepares whole logs first, as the identification cut them (``identify``
 reads the fit's residual on its own recordings).
 """
@@ -26,7 +27,12 @@ from ..model.robot import Robot
 from .heldout_torques import beside_columns
 from .validation import Validation, own_friction, validate_torques
 
-__all__ = ["logs_delay", "validations_delay"]
+__all__ = ["ROWS", "logs_delay", "validations_delay"]
+
+#: The most rows the delay is fitted on: a longer log gives every k-th sample (its
+#: derivative taken at the full rate first), so that the check's columns stay a few tens
+#: of MB beside a streamed fit of any length.
+ROWS = 10_000
 
 
 def validations_delay(
@@ -36,6 +42,7 @@ def validations_delay(
     :class:`~dynid.friction.validation.Validation` per prepared piece, of ``model``), or
     None when it cannot be read (too few samples, no prediction that changes)."""
     t, predicted, error, columns = [], [], [], []
+    every = -(-sum(v.log.n_samples for v in parts) // ROWS)  # every k-th row fitted
     for v in parts:
         log = v.log
         hat = v.tau_model if v.tau_friction is None else v.tau_model + v.tau_friction
@@ -45,12 +52,12 @@ def validations_delay(
         if isinstance(model, IdentifiedModel):
             beside = beside_columns(model, log)
             if beside is not None:
-                columns.append(beside(np.arange(log.n_samples)))
+                columns.append(beside(np.arange(0, log.n_samples, max(every, 1))))
     if not t:
         return None
     cols: list[NDArray[np.float64]] | None = columns if len(columns) == len(t) else None
     lag = _lag(model, parts)
-    return torque_delay(t, predicted, error, cols, lag)
+    return torque_delay(t, predicted, error, cols, lag, every=max(every, 1))
 
 
 def logs_delay(model: IdentifiedModel, logs: Sequence[TorqueLog]) -> TorqueDelay | None:

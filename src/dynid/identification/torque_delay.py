@@ -100,6 +100,7 @@ def torque_delay(
     error: Sequence[NDArray[np.float64]],
     columns: Sequence[NDArray[np.float64]] | None = None,
     lag: int = 0,
+    every: int = 1,
 ) -> TorqueDelay | None:
     """The delay of the torques behind the positions that the residual ``error`` points to
     (module docstring).
@@ -112,10 +113,13 @@ def torque_delay(
         The model's rigid-body torques at those samples [N m] (friction left out).
     error : sequence of ndarray, each (N_k, n)
         Measured less predicted torques [N m].
-    columns : sequence of ndarray, each (N_k, n, p), optional
-        The model's own columns at those samples, fitted beside the delay's.
+    columns : sequence of ndarray, each (ceil(N_k / every), n, p), optional
+        The model's own columns at every ``every``-th sample, fitted beside the delay's.
     lag : int
         The Newey-West window [samples] (:func:`~dynid.identification.serial.hac_lag`).
+    every : int
+        Fit every ``every``-th sample of each piece (the derivative taken at the full
+        rate first): a long log's check in bounded memory.
 
     Returns
     -------
@@ -125,10 +129,12 @@ def torque_delay(
     keep = [k for k, x in enumerate(t) if np.asarray(x).shape[0] >= _MIN_SAMPLES]
     if not keep:
         return None
-    E = [np.asarray(error[k], dtype=np.float64) for k in keep]
+    E = [np.asarray(error[k], dtype=np.float64)[::every] for k in keep]
     D = [
-        -np.gradient(np.asarray(predicted[k], float), np.asarray(t[k], float), axis=0) for k in keep
+        -np.gradient(np.asarray(predicted[k], float), np.asarray(t[k], float), axis=0)[::every]
+        for k in keep
     ]
+    lag = -(-lag // every)  # in the rows kept
     C = None if columns is None else [np.asarray(columns[k], dtype=np.float64) for k in keep]
     n = E[0].shape[1]
     rms = np.sqrt(np.mean(np.concatenate(E) ** 2, axis=0))
