@@ -12,17 +12,40 @@ another, and a wrong column silently read is a wrong answer.
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
-__all__ = ["ALIASES", "column_hint", "joint_families", "position_count"]
+__all__ = [
+    "ALIASES",
+    "CURRENT_ALIASES",
+    "column_hint",
+    "guessed_map",
+    "holdings",
+    "joint_families",
+    "no_torques",
+    "position_count",
+    "time_column",
+]
 
 #: Names other tools give a torque log's joint signals (lower case, without separators),
 #: by dynid's name of the signal.
 ALIASES: dict[str, tuple[str, ...]] = {
-    "q": ("position", "pos", "jointposition", "q"),
-    "dq": ("velocity", "vel", "jointvelocity", "qd", "qdot", "dq"),
-    "tau": ("effort", "torque", "jointtorque", "jointeffort", "tau", "taumeasured", "tauj"),
+    "q": ("position", "pos", "jointposition", "jointpos", "angle", "jointangle", "q"),
+    "dq": ("velocity", "vel", "jointvelocity", "jointvel", "qd", "qdot", "dq"),
+    "tau": (
+        "effort",
+        "eff",
+        "torque",
+        "trq",
+        "jointtorque",
+        "jointeffort",
+        "tau",
+        "taumeasured",
+        "tauj",
+    ),
 }
+#: Names of motor currents' columns (lower case, without separators): read as ``tau`` in
+#: amperes (``--units tau=A``) through a drive whose effort is current.
+CURRENT_ALIASES = ("current", "cur", "i", "motorcurrent", "amps")
 #: How many unused columns a message names (families count as one).
 SHOWN = 6
 
@@ -89,16 +112,19 @@ def column_hint(
         )
     if not missing:
         return text
-    found = {}
-    for signal in (*missing, *optional):
-        fits = [t for t in families if _root(t) in ALIASES.get(signal, ())]
-        if len(fits) == 1:
-            found[signal] = fits[0]
+    found = _found(list(families), (*missing, *optional))
+    current = "tau" in found and _root(found["tau"]) in CURRENT_ALIASES
     if all(s in found for s in missing):
         spec = ",".join(f"{s}={found[s]}" for s in ("q", "dq", "tau") if s in found)
+        if current:
+            spec += "' --units 'tau=A"
         caveat = (
-            " (check that they hold joint torques in N m: motor currents need --units "
-            "tau=A and a --drive whose effort is current)"
+            (
+                " with a --drive whose effort is current (motor currents in A)"
+                if current
+                else " (check that they hold joint torques in N m: motor currents need "
+                "--units tau=A and a --drive whose effort is current)"
+            )
             if "tau" in found
             else ""
         )
@@ -109,6 +135,127 @@ def column_hint(
         f"{text}; hint: name the columns {spans} (the torque-log format of the docs), or "
         f"map yours with --columns ('tau=effort{{i}}': {{i}} counts joints from 1, {{i0}} "
         "from 0)"
+    )
+
+
+def _found(families: Sequence[str], signals: Sequence[str]) -> dict[str, str]:
+    """Signal -> the one family whose name is one of its :data:`ALIASES` (torques: else
+    the one family of :data:`CURRENT_ALIASES`); a signal of none or several is left out."""
+    found = {}
+    for signal in signals:
+        for names in (ALIASES.get(signal, ()), CURRENT_ALIASES if signal == "tau" else ()):
+            fits = [t for t in families if _root(t) in names]
+            if len(fits) == 1:
+                found[signal] = fits[0]
+                break
+    return found
+
+
+def time_column(names: Sequence[str]) -> str | None:
+    """The one column of a header whose name reads as time (``time``, ``timestamp``,
+    ``time_ms``, ``stamp_s``, ``Time``), or None (none, or several)."""
+    found = [
+        c
+        for c in names
+        if re.fullmatch(
+            r"(t|time|timestamp|stamp|sec|secs|seconds)([_ ]?(s|ms|us|ns))?", c.strip().lower()
+        )
+    ]
+    return found[0] if len(found) == 1 else None
+
+
+def guessed_map(names: Sequence[str], given: Mapping[str, str] | None = None) -> str:
+    """The options that read a torque log of header ``names``, guessed from it:
+    ``--columns 'q=pos{i},tau=eff{i},t=time'`` (and ``--units`` for a time in ms or
+    motor currents), keeping the templates ``given`` that name columns of the file; empty
+    when the time, the positions or the torques cannot be told (none, or several
+    candidates).
+
+    A family is one column per joint numbered ``1..n`` or ``0..n-1`` whose name is one of
+    :data:`ALIASES` (``pos``, ``Effort_``; case and separators aside); the time is
+    :func:`time_column`.
+    """
+    given = dict(given or {})
+    have = set(names)
+
+    def present(tpl: str) -> bool:
+        return (tpl.format(i=1, i0=0) if "{" in tpl else tpl) in have
+
+    cols: dict[str, str] = {k: v for k, v in given.items() if present(v)}
+    if "t" not in cols and "t" not in have:
+        if (time := time_column(names)) is None:
+            return ""
+        cols["t"] = time
+    n = _count(names, cols.get("q", "q{i}")) or position_count(names)
+    if not n:
+        return ""
+    families = [t for t in joint_families(names, n) if t not in cols.values()]
+    default = {"q": "q{i}", "dq": "dq{i}", "tau": "tau{i}"}
+    wanted = [s for s in ("q", "dq", "tau") if s not in cols and not present(default[s])]
+    cols.update(_found(families, wanted))
+    if any(s not in cols and not present(default[s]) for s in ("q", "tau")):
+        return ""
+    order = [k for k in given if k in cols] + [k for k in ("t", "q", "dq", "tau") if k in cols]
+    spec = ",".join(f"{k}={cols[k]}" for k in dict.fromkeys(order))
+    units = []
+    if "t" in cols and (unit := re.search(r"(ms|us|ns)$", cols["t"].lower())):
+        units.append(f"t={unit[1]}")
+    if "tau" in cols and _root(cols["tau"]) in CURRENT_ALIASES:
+        units.append("tau=A")
+    return f"--columns '{spec}'" + (f" --units '{','.join(units)}'" if units else "")
+
+
+def _count(names: Sequence[str], tpl: str) -> int:
+    """How many joints' columns ``tpl`` names in ``names`` (from joint 1 on)."""
+    if "{" not in tpl:
+        return 0
+    have, k = set(names), 0
+    while tpl.format(i=k + 1, i0=k) in have:
+        k += 1
+    return k
+
+
+def holdings(names: Sequence[str]) -> str:
+    """A header for a message, each run of numbered columns as one span (``t, q1..q7``)."""
+    groups: dict[str, list[int]] = {}
+    order: list[tuple[str, bool]] = []  # (name or prefix, whether a prefix)
+    for c in names:
+        m = re.fullmatch(r"(.*?\D)?(\d+)", c)
+        if m is None:
+            order.append((c, False))
+            continue
+        prefix = m.group(1) or ""
+        if prefix not in groups:
+            order.append((prefix, True))
+        groups.setdefault(prefix, []).append(int(m.group(2)))
+    spans = []
+    for c, numbered in order:
+        idx = groups.get(c, []) if numbered else []
+        if not numbered:
+            spans.append(c)
+        elif len(idx) > 2 and idx == list(range(idx[0], idx[0] + len(idx))):
+            spans.append(f"{c}{idx[0]}..{c}{idx[-1]}")
+        else:
+            spans += [f"{c}{i}" for i in idx]
+    more = len(spans) - 12
+    return ", ".join(spans[:12]) + (f" and {more} more" if more > 0 else "")
+
+
+def no_torques(names: Sequence[str], n: int, used: set[str]) -> str:
+    """What to say of a log of ``n`` joints whose header ``names`` holds no joint torques
+    and nothing that could be them (no unused family of ``n`` columns, no column whose
+    name has a torque's or current's word in it: ``tau``, ``torq``, ``eff``, ``cur``, ...):
+    what the commands reading it need and what the file holds; empty when some column
+    might be the torques (then naming or mapping them is the hint)."""
+    unused = [c for c in names if c not in used and not re.fullmatch(r"tau_ext\d*", c)]
+    like = re.compile(r"tau|torq|trq|eff|cur|amp|nm\b", re.IGNORECASE)  # a unit's name too
+    if joint_families(unused, n) or any(like.search(c) for c in unused):
+        return ""
+    return (
+        f"the file holds no joint torques, only {holdings(names)}; identification and the "
+        f"observers need measured joint torques (tau1..tau{n} in N m), or motor currents "
+        "(--units tau=A with a --drive whose effort is current); hint: record the joint "
+        "torques (a JointState's effort, the controller's measured torque) with the positions"
     )
 
 

@@ -52,6 +52,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
+from .column_hint import guessed_map, no_torques
 from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .joint_state_csv import import_hint
@@ -565,12 +566,35 @@ def _need(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArr
     if a is None:
         tpl = cmap.template(quantity)
         first = _fill(tpl, 0) if "{" in tpl else tpl
+        none = ""
+        if quantity == "tau" and n and table.name.lower().endswith(".csv"):
+            used = {*_names(cmap, "t", 1), *_names(cmap, "q", n), *_names(cmap, "dq", n)}
+            none = no_torques(table.header, n, used | _names(cmap, "ddq", n))
+        if none:
+            raise DataError(f"no column {first!r} for 'tau' ({tpl!r}): {none}", file=table.name)
         raise DataError(
             f"no column {first!r} for {quantity!r} (template {tpl!r}); {table.has()}"
-            + (import_hint(table.header, table.name) or "; hint: map it with --columns"),
+            + _map_hint(table, cmap, "; hint: map it with --columns"),
             file=table.name,
         )
     return a
+
+
+def _names(cmap: ColumnMap, quantity: str, n: int) -> set[str]:
+    """The columns ``cmap`` names for ``quantity`` of ``n`` joints."""
+    tpl = cmap.template(quantity)
+    return {_fill(tpl, i) for i in range(n)} if "{" in tpl else {tpl}
+
+
+def _map_hint(table: _Table, cmap: ColumnMap, otherwise: str) -> str:
+    """``; hint: ...`` for a torque log ``cmap`` does not read: the import a header of
+    another tool needs, else the whole ``--columns`` map guessed from a CSV's header (the
+    templates given kept, :func:`~dynid.io.column_hint.guessed_map`), else ``otherwise``."""
+    if hint := import_hint(table.header, table.name):
+        return hint
+    guess = guessed_map(table.header, cmap.columns) if table.name.lower().endswith(".csv") else ""
+    units = " and the --units given" if cmap.names else ""
+    return f"; hint: {guess}{units} reads the file" if guess else otherwise
 
 
 @dataclass(frozen=True, slots=True)
@@ -629,7 +653,7 @@ def load_mapped_torque_log(
     if t is None:
         raise DataError(
             f"no time column {columns.template('t')!r}; {table.has()}"
-            + (import_hint(table.header, path.name) or "; hint: map it with --columns t=NAME"),
+            + _map_hint(table, columns, "; hint: map it with --columns t=NAME"),
             file=path.name,
         )
     t = t if columns.factor("t") == 1.0 else _checks.frozen(t * columns.factor("t"))

@@ -39,7 +39,7 @@ from __future__ import annotations
 import logging
 import re
 import zipfile
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import numpy as np
@@ -54,7 +54,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from .atomic import open_atomic
-from .column_hint import column_hint, position_count
+from .column_hint import column_hint, no_torques, position_count, time_column
 from .csv_tables import ROWS_PREFIX, csv_table
 from .joint_state_csv import import_hint
 from .npz_files import check_npz
@@ -441,17 +441,6 @@ def _annotated_hint(names: list[str]) -> str:
     return f"; hint: names with units are read by --columns '{spec}' (and --units if not SI)"
 
 
-def _time_column(names: Sequence[str]) -> str | None:
-    """The one column of a header whose name reads as time (``time``, ``timestamp``,
-    ``time_ms``, ``stamp_s``), or None (none, or several)."""
-    found = [
-        c
-        for c in names
-        if re.fullmatch(r"(t|time|timestamp|stamp|sec|secs|seconds)([_ ]?(s|ms|us|ns))?", c.lower())
-    ]
-    return found[0] if len(found) == 1 else None
-
-
 def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     """Check the header; return the joint count n and whether ddq columns are present."""
     at = f"line {line}"
@@ -466,7 +455,7 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     n = len(qs)
     if "t" not in names or n == 0:
         hint = _annotated_hint(names) or import_hint(names, path.name)
-        time = "t" if "t" in names else _time_column(names)
+        time = "t" if "t" in names else time_column(names)
         if not hint and time is not None and (k := position_count(names)):
             signals = [s for s in ("q", "tau") if f"{s}1" not in names]
             optional = ["dq"] if "dq1" not in names else []
@@ -480,11 +469,10 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
                 )
             elif time != "t" and "--columns '" in hint:  # the time column mapped too
                 hint = hint.replace("--columns '", f"--columns 't={time},", 1)
-                hint = hint.replace(
-                    "' reads them",
-                    "'" + (f" --units t={unit[1]}" if unit else "") + " reads them",
-                    1,
-                )
+                if unit and "--units '" in hint:  # one --units (currents: tau=A)
+                    hint = hint.replace("--units '", f"--units 't={unit[1]},", 1)
+                elif unit:
+                    hint = hint.replace("' reads them", f"' --units t={unit[1]} reads them", 1)
             hint = f"; hint: {hint}"
         raise DataError(
             f"header must name columns t, q1..qn, dq1..dqn, tau1..taun; "
@@ -504,9 +492,10 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
     if missing:
         gone = [s for s in _SIGNALS[1:3] if all(f"{s}{j}" in missing for j in range(1, n + 1))]
         used = {"t", *need, *(f"ddq{j}" for j in range(1, n + 1))}
+        none = no_torques(names, n, used) if "tau" in gone else ""
         raise DataError(
             f"missing column(s) {_span(missing)} (n = {n} from q1..q{n})"
-            + column_hint(names, n, gone, used),
+            + (f": {none}" if none else column_hint(names, n, gone, used)),
             file=path.name,
         )
     ddq = [f"ddq{j}" for j in range(1, n + 1)]
