@@ -536,7 +536,8 @@ def save_observation(
         check = result.check
         moving = None if check is None else check.detectable
         rest = undetected_at_rest(result.model, result.thresholds, moving)
-        if result.thresholds.standstill and np.any(rest > result.thresholds.contact):
+        level = result.thresholds.contact if moving is None else moving
+        if result.thresholds.standstill and np.any(rest > level):
             cal["at_rest"] = rest.tolist()  # the thresholds of a joint standing still
         if (check := result.check) is not None:  # is the observer good enough
             cal |= {
