@@ -488,10 +488,12 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     fingerprint = model_fingerprint(opts)
     if given is not None and given.model is not None and given.model.sha256 != fingerprint.sha256:
         assert opts.thresholds is not None
+        said = friction_difference(opts.thresholds.name, given.model, fingerprint)
         warnings.warn(
-            f"{opts.thresholds.name} was calibrated with {given.model}, not with this model "
-            f"({fingerprint}): thresholds fit the residual of their own model; calibrate "
-            "again with this one",
+            said
+            or f"{opts.thresholds.name} was calibrated with {given.model}, not with this "
+            f"model ({fingerprint}): thresholds fit the residual of their own model; "
+            "calibrate again with this one",
             DynidWarning,
             stacklevel=2,
         )
@@ -567,7 +569,7 @@ def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
     ``tip``): a built-in robot's name stands for its file, a :class:`Drive` given as one
     for its arrays."""
     h = hashlib.sha256()
-    files = []
+    files, roles = [], []
     for what, src in (
         ("model", opts.model),
         ("params", opts.params),
@@ -577,6 +579,7 @@ def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
         if src is None:
             continue
         h.update(f"\0{what}\0".encode())
+        roles.append(what)
         if isinstance(src, Drive):
             for f in dataclasses.fields(src):
                 h.update(f"{f.name}={getattr(src, f.name)!r};".encode())
@@ -590,7 +593,35 @@ def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
             h.update(str(src).encode())
             files.append(str(src))
     h.update(f"\0base={opts.base}\0tip={opts.tip}".encode())
-    return ModelFingerprint(tuple(files), h.hexdigest())
+    return ModelFingerprint(tuple(files), h.hexdigest(), tuple(roles))
+
+
+def friction_difference(
+    name: str, calibrated: ModelFingerprint, now: ModelFingerprint
+) -> str | None:
+    """The warning when the thresholds ``name`` were calibrated with another ``--friction``
+    file than ``now`` runs with (one given and not the other, or two names), or None:
+    the same friction by name, or the roles not recorded (a file of an earlier version)."""
+    if not calibrated.roles or not now.roles:
+        return None
+    then, here = calibrated.given_as("friction"), now.given_as("friction")
+    if then == here:
+        return None
+    tail = "thresholds fit the residual of the model they were calibrated with"
+    if here is None:
+        return (
+            f"{name} was calibrated with --friction {then}, and this run has no --friction: "
+            f"give --friction {then} as then, or calibrate again without it ({tail})"
+        )
+    if then is None:
+        return (
+            f"{name} was calibrated without --friction, and this run gives --friction {here}: "
+            f"leave it out as then, or calibrate again with it ({tail})"
+        )
+    return (
+        f"{name} was calibrated with --friction {then}, this run gives --friction {here}: "
+        f"give {then} as then, or calibrate again with {here} ({tail})"
+    )
 
 
 def friction_source(opts: ObserveOptions) -> str | None:
