@@ -215,6 +215,11 @@ class ObserveOptions:
     snap_angles : bool
         Read a ``params`` URDF's joint angles rounded near multiples of pi/2 as those
         multiples (:func:`dynid.io.robot.urdf.load_urdf`).
+    torque_delay_s : float, optional
+        How far the torques lag the positions [s]: each log's states are read that much
+        earlier (:func:`~dynid.identification.prepare.states_in_step`, as identify,
+        validate and friction read them); default: the delay the model was identified
+        with (``identification.json``'s ``metadata.torque_delay_s``), 0 for a robot file.
     q_start : tuple of float, optional
         The joint positions [rad] at the first sample of one motor-side log whose motor
         encoders wrap every turn (:func:`~dynid.workflows.recordings.given_start`).
@@ -262,6 +267,7 @@ class ObserveOptions:
     tip: str | None = None
     snap_angles: bool = False
     q_start: tuple[float, ...] | None = None
+    torque_delay_s: float | None = None
     keep_series: bool = True
     figure_points: int | None = None
     label_tolerance_s: float = DEFAULT_TOLERANCE_S
@@ -534,7 +540,9 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         if sink is not None:
             table = sink.table(paths, k, rows, model.n, opts.frame, kind)
         with about_file(path.name):
-            prep = prepared_log(path, log, model, opts.max_gap, read.joint_side[k])
+            prep = prepared_log(
+                path, log, model, opts.max_gap, read.joint_side[k], _delay(opts, model)
+            )
             labels = contact_labels(prep, cmap)
         logs.append(
             detected_log(
@@ -594,6 +602,12 @@ def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
             files.append(str(src))
     h.update(f"\0base={opts.base}\0tip={opts.tip}".encode())
     return ModelFingerprint(tuple(files), h.hexdigest(), tuple(roles))
+
+
+def _delay(opts: ObserveOptions, model: ObserverModel) -> float:
+    """The torques' delay [s] the logs are prepared with: ``--torque-delay``, else the
+    model's own (:attr:`~dynid.observer.model.ObserverModel.torque_delay_s`)."""
+    return model.torque_delay_s if opts.torque_delay_s is None else float(opts.torque_delay_s)
 
 
 def friction_difference(
@@ -706,7 +720,7 @@ def _calibrated(
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
-            prep = prepared_log(Path(path), log, model, opts.max_gap, side)
+            prep = prepared_log(Path(path), log, model, opts.max_gap, side, _delay(opts, model))
             if again is not None:
                 again.append(prep)
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
@@ -814,6 +828,7 @@ def _model_check(opts: ObserveOptions, model: ObserverModel, read: Recorded) -> 
         max_gap_s=opts.max_gap,
         drive=model.drive,
         q_start=opts.q_start,
+        torque_delay_s=_delay(opts, model),
     )
     feasible = None
     try:
