@@ -448,7 +448,9 @@ def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_ba
     assert col["contact level, moving (smallest torque detected) [N m]"] == [
         number(x) for x in moving
     ]
-    assert col["contact --no-uncertainty (fixed, not applied here) [N m]"] == [number(x) for x in doc["contact"]]
+    assert col["contact --no-uncertainty (fixed, not applied here) [N m]"] == [
+        number(x) for x in doc["contact"]
+    ]
     assert col["collision --no-uncertainty (fixed, not applied here) [N m]"] == [
         number(x) for x in doc["collision"]
     ]

@@ -111,13 +111,13 @@ from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.wrench import WRENCH_KINDS
 from ..workflows.observe import ObserveOptions, observe_files
 from .common import (
-    add_torque_delay,
     add_column_options,
     add_drive_option,
     add_drop_invalid,
     add_q_start_option,
     add_snap_angles_option,
     add_subcommand,
+    add_torque_delay,
     nonnegative_type,
     output_path,
     parse_vector,

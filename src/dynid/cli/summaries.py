@@ -894,9 +894,10 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if calibrating:
         what = "largest" if th.quantile == 1.0 else f"{th.quantile:g} quantile of the"
         rows.append(
-            f"contact{fixed} = {th.margin:g} x the {what} |r| of the calibration"
+            f"contact{' --no-uncertainty' if th.uses_uncertainty else ''} = {th.margin:g} x "
+            f"the {what} |r| of the calibration"
             + (" after the standstill margin (left out)" if th.standstill else "")
-            + (": the fixed level, applied only with --no-uncertainty" if fixed else "")
+            + (": the fixed level, applied only then" if th.uses_uncertainty else "")
         )
     if at_rest:
         rows.append(

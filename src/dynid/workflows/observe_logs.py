@@ -26,8 +26,8 @@ from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
-from ..identification.prepare import states_in_step
 from ..identification.pieces import unwrapped, with_start_turns, wrappable, wrapped_finding
+from ..identification.prepare import states_in_step
 from ..observer.detection import residual_std_blocks, standstill_blocks
 from ..observer.friction import (
     DERIVED_CUTOFF_HZ,
