@@ -201,7 +201,8 @@ def test_command_line_reads_milliseconds() -> None:
 def test_observe_takes_the_model_s_delay_out_of_a_free_log(tmp_path, panda, fits) -> None:
     """``observe`` prepares a log with the delay its model was identified with (2 ms):
     on a collision-free log, torques 2 ms late, the residual (the truth's external torque
-    0) is smaller than with ``--torque-delay 0``; ``--torque-delay 2`` reads 0.002 s and gives the same."""
+    0) is smaller than with ``--torque-delay 0``; ``--torque-delay 2`` reads 0.002 s and
+    gives the same."""
     from dynid.cli.__main__ import build_parser
     from dynid.io.torque_log import save_torque_log
     from dynid.workflows.observe import ObserveOptions, observe_files
