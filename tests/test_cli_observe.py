@@ -433,7 +433,11 @@ def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_ba
     assert not np.allclose(collision, doc["collision"])  # two quantities, told apart
     said = ", ".join(f"{v:.3g}" for v in collision)
     assert f"collision level while moving: {said} N m" in printed
-    assert "the base levels apply without it (--no-uncertainty)" in printed
+    assert "it replaces the fixed level and may lie below it" in printed
+    head = next(x for x in printed.splitlines() if "contact, moving [N m]" in x)
+    assert "contact --no-uncertainty [N m]" in head and "base" not in head
+    row = next(x for x in printed.splitlines() if x.startswith(doc["joints"][0] + " "))
+    assert f"{moving[0]:.4g}" in row or f"{moving[0]:.4f}" in row
     page = (out / "report.html").read_text()
     box = page[page.index('<table class="calibration">') :]
     box = box[: box.index("</table>")]
@@ -444,7 +448,9 @@ def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_ba
     assert col["contact level, moving (smallest torque detected) [N m]"] == [
         number(x) for x in moving
     ]
-    assert col["contact base, without the uncertainty [N m]"] == [number(x) for x in doc["contact"]]
-    assert col["collision base, without the uncertainty [N m]"] == [
+    assert col["contact --no-uncertainty (fixed, not applied here) [N m]"] == [
+        number(x) for x in doc["contact"]
+    ]
+    assert col["collision --no-uncertainty (fixed, not applied here) [N m]"] == [
         number(x) for x in doc["collision"]
     ]

@@ -73,10 +73,36 @@ def test_thresholds_warn_when_used_with_another_model_than_their_own(files, tmp_
     th = tmp_path / "thresholds.json"
     _, said = _run(d, "same.urdf", thresholds=th)
     assert not [s for s in said if "calibrated with" in s]
-    _, said = _run(d, "arm.urdf", friction=d / "other.json", thresholds=th)
+    (d / "changed.urdf").write_text((d / "arm.urdf").read_text().replace("0.4", "0.41", 1))
+    _, said = _run(d, "changed.urdf", thresholds=th)
     (warned,) = [s for s in said if "calibrated with" in s]
     assert "thresholds.json was calibrated with arm.urdf (sha256 " in warned
-    assert "not with this model (arm.urdf + other.json (sha256 " in warned
+    assert "not with this model (changed.urdf (sha256 " in warned
+
+
+def test_thresholds_calibrated_with_another_friction_say_which_option_differs(files, tmp_path):
+    """A detection run without the --friction the thresholds were calibrated with (or with
+    one they were calibrated without) is told that --friction is missing (or added), not
+    that two hashes differ."""
+    d = files
+    _run(d, "arm.urdf", friction=d / "other.json", out=tmp_path)
+    rec = json.loads((tmp_path / "thresholds.json").read_text())["calibration"]
+    assert rec["model_roles"] == ["params", "friction"]
+    th = tmp_path / "thresholds.json"
+    _, said = _run(d, "arm.urdf", thresholds=th)
+    (warned,) = [s for s in said if "calibrated with" in s]
+    assert warned.startswith(
+        "thresholds.json was calibrated with --friction other.json, and this run has no "
+        "--friction: give --friction other.json as then"
+    )
+    assert "sha256" not in warned
+    _, said = _run(d, "arm.urdf", friction=d / "other.json", thresholds=th)
+    assert not [s for s in said if "calibrated with" in s]
+    cal2 = tmp_path / "without"
+    _run(d, "arm.urdf", out=cal2)
+    _, said = _run(d, "arm.urdf", friction=d / "other.json", thresholds=cal2 / "thresholds.json")
+    (warned,) = [s for s in said if "calibrated with" in s]
+    assert "calibrated without --friction, and this run gives --friction other.json" in warned
 
 
 def test_a_urdf_s_own_friction_is_named_in_a_note(files):

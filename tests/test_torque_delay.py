@@ -215,3 +215,42 @@ def test_every_k_th_row_reads_the_same_delay_as_every_row():
     assert abs(full.delay_s - 0.003) < 3 * full.std_s
     assert abs(sub.delay_s - 0.003) < 3 * sub.std_s
     assert abs(sub.delay_s - full.delay_s) < 2 * sub.std_s and sub.std_s < 3 * full.std_s
+
+
+def test_observe_takes_the_model_s_delay_out_of_a_free_log(tmp_path, panda, fits) -> None:
+    """``observe`` prepares a log with the delay its model was identified with (2 ms):
+    on a collision-free log, torques 2 ms late, the residual (the truth's external torque
+    0) is smaller than with ``--torque-delay 0``; ``--torque-delay 2`` reads 0.002 s and
+    gives the same."""
+    from dynid.cli.__main__ import build_parser
+    from dynid.io.torque_log import save_torque_log
+    from dynid.workflows.observe import ObserveOptions, observe_files
+
+    model = save_model_json(tmp_path / "identification.json", fits[1])
+    t = sample_times(6.0, 500.0)  # a log without noise: what is left is the model's error
+    traj = random_fourier(panda, np.random.default_rng(76))
+    fr = ClassicalFriction(VISCOUS, COULOMB, np.zeros(7))
+    quiet = SensorNoise(tau_std=0.0, q_std=0.0, dq_std=0.0)
+    rng = np.random.default_rng(76)
+    free = simulate_measurement(panda, traj(t), rng=rng, noise=quiet, friction=fr)
+    free = dataclasses.replace(free, tau=simulate_measurement(
+        panda, traj(t - DELAY), rng=rng, noise=quiet, friction=fr).tau)  # fmt: skip
+    data = save_torque_log(tmp_path / "free.csv", free)
+    args = build_parser().parse_args(
+        ["observe", "--model", "m.json", "--data", "x.csv", "--calibrate", "--out", "o",
+         "--torque-delay", "2"]
+    )  # fmt: skip
+    assert args.torque_delay == pytest.approx(DELAY)
+
+    def rms(delay: float | None) -> np.ndarray:
+        opts = ObserveOptions(data=(data,), model=model, calibrate=True, uncertainty=False,
+                              torque_delay_s=delay)  # fmt: skip
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DynidWarning)
+            (log,) = observe_files(opts).logs
+        assert log.r is not None
+        return np.sqrt(np.nanmean(np.square(log.r), axis=0))
+
+    recorded, given, none = rms(None), rms(DELAY), rms(0.0)
+    np.testing.assert_array_equal(recorded, given)
+    assert np.sqrt(np.mean(recorded**2)) < 0.5 * np.sqrt(np.mean(none**2))

@@ -117,6 +117,7 @@ from .common import (
     add_q_start_option,
     add_snap_angles_option,
     add_subcommand,
+    add_torque_delay,
     nonnegative_type,
     output_path,
     parse_vector,
@@ -231,6 +232,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "longer ones and the observer starts again (default: 2.5 median steps, at least "
         "0.02 s)",
     )
+    add_torque_delay(p, recorded=True)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     return p
@@ -253,7 +255,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         merge_s=args.merge, min_duration_s=args.min_duration,
         columns=(args.columns, args.units), drop_invalid=args.drop_invalid,
         max_gap=args.max_gap, base=args.base, tip=args.tip, snap_angles=args.snap_angles,
-        q_start=args.q_start,
+        q_start=args.q_start, torque_delay_s=args.torque_delay,
         # the series serve the figures only: a calibration's whole, a detection's strided
         keep_series=args.calibrate and not args.no_figures,
         figure_points=None if args.no_figures else FIGURE_POINTS,

@@ -806,6 +806,19 @@ def _gain_noise_line(noise: GainNoise | None, names: Sequence[str]) -> list[str]
     ]
 
 
+def uncertainty_words(k_sigma: float | None, noise: NDArray[np.float64], margin: float) -> str:
+    """What the contact threshold is when it holds the model's uncertainty: ``k sigma(t)``
+    plus a noise floor, not the fixed level plus something, so that while moving it can
+    lie below the fixed (``--no-uncertainty``) level."""
+    return (
+        f"contact threshold applied: {k_sigma:g} sigma(t) + a noise floor of "
+        f"{', '.join(f'{v:.3g}' for v in noise)} N m (sigma: the model's uncertainty at "
+        f"each sample; the floor: {margin:g} x the largest |r| - {k_sigma:g} sigma of the "
+        "calibration), its largest along the motion the 'contact, moving' column; it "
+        "replaces the fixed level and may lie below it"
+    )
+
+
 def _check_lines(check: CalibrationCheck | None) -> list[str]:
     """Whether the calibrated observer is good enough: its false alarms on its own logs
     and the smallest external torque it detects per joint while moving."""
@@ -856,11 +869,17 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         ratios = [x.peak_ratio for x in result.logs if x.peak_ratio is not None]
         if ratios:  # what decides: the threshold at each sample, not its base value
             cols["max |r|/contact"] = np.nanmax(ratios, axis=0)
-    base = " base" if th.uses_uncertainty or th.standstill else ""
-    cols |= {f"contact{base} [N m]": th.contact, f"collision{base} [N m]": th.collision}
     moving = None if result.check is None else result.check.detectable
+    if th.uses_uncertainty and moving is not None:  # the levels applied, then the fixed
+        assert result.check is not None
+        cols["contact, moving [N m]"] = moving
+        if result.check.collision is not None:
+            cols["collision, moving [N m]"] = result.check.collision
+    fixed = " --no-uncertainty" if th.uses_uncertainty else " base" if th.standstill else ""
+    cols |= {f"contact{fixed} [N m]": th.contact, f"collision{fixed} [N m]": th.collision}
     rest = undetected_at_rest(result.model, th, moving)
-    at_rest = calibrating and th.standstill and np.any(rest > th.contact)
+    level = th.contact if moving is None else moving
+    at_rest = calibrating and th.standstill and np.any(rest > level)
     if at_rest:
         cols["at rest [N m]"] = rest
     truth = [err for x in result.logs if (err := x.truth_error()) is not None]
@@ -875,8 +894,10 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if calibrating:
         what = "largest" if th.quantile == 1.0 else f"{th.quantile:g} quantile of the"
         rows.append(
-            f"contact = {th.margin:g} x the {what} |r| of the calibration"
+            f"contact{' --no-uncertainty' if th.uses_uncertainty else ''} = {th.margin:g} x "
+            f"the {what} |r| of the calibration"
             + (" after the standstill margin (left out)" if th.standstill else "")
+            + (": the fixed level, applied only then" if th.uses_uncertainty else "")
         )
     if at_rest:
         rows.append(
@@ -885,11 +906,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             "plus the contact level while moving)"
         )
     if th.uses_uncertainty and th.noise is not None:
-        rows.append(
-            f"thresholds grow with the model's uncertainty: {th.k_sigma:g} sigma + noise "
-            f"({', '.join(f'{v:.3g}' for v in th.noise)} N m); the base levels apply "
-            "without it (--no-uncertainty)"
-        )
+        rows.append(uncertainty_words(th.k_sigma, th.noise, th.margin))
     margins = [m for x in result.logs if (m := _margin_peak(x)) is not None]
     if th.standstill and margins and np.any(margins):
         top = np.max(margins, axis=0)

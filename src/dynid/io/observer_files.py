@@ -299,7 +299,8 @@ def _fingerprint(model: ModelFingerprint | None) -> dict[str, Any]:
     """The keys a model's fingerprint is written as (none without one)."""
     if model is None:
         return {}
-    return {"model_files": list(model.files), "model_sha256": model.sha256}
+    roles = {"model_roles": list(model.roles)} if model.roles else {}
+    return {"model_files": list(model.files), "model_sha256": model.sha256, **roles}
 
 
 def load_thresholds(path: str | Path) -> Thresholds:
@@ -317,7 +318,11 @@ def load_thresholds(path: str | Path) -> Thresholds:
     files, sha = cal.get("model_files"), cal.get("model_sha256")
     model = None
     if isinstance(sha, str) and isinstance(files, list):
-        model = ModelFingerprint(tuple(str(f) for f in files), sha)
+        roles = cal.get("model_roles")
+        ok = isinstance(roles, list) and len(roles) == len(files)
+        model = ModelFingerprint(
+            tuple(str(f) for f in files), sha, tuple(str(r) for r in roles) if ok else ()
+        )
     try:
         return Thresholds(
             contact=np.array(d["contact"], dtype=float),
@@ -536,7 +541,8 @@ def save_observation(
         check = result.check
         moving = None if check is None else check.detectable
         rest = undetected_at_rest(result.model, result.thresholds, moving)
-        if result.thresholds.standstill and np.any(rest > result.thresholds.contact):
+        level = result.thresholds.contact if moving is None else moving
+        if result.thresholds.standstill and np.any(rest > level):
             cal["at_rest"] = rest.tolist()  # the thresholds of a joint standing still
         if (check := result.check) is not None:  # is the observer good enough
             cal |= {

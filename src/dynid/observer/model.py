@@ -72,6 +72,10 @@ class ObserverModel:
         them and the base parameters: taken as uncorrelated). The residual's uncertainty
         adds it to the base parameters' (:mod:`dynid.observer.detection`); None: no
         position term, or a robot's own (no uncertainty).
+    torque_delay_s : float
+        How far the torques lag the positions [s] as the model was identified
+        (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`): the logs it
+        observes are prepared with it by default; 0 for a robot's own.
     """
 
     robot: Robot
@@ -85,6 +89,7 @@ class ObserverModel:
     base_terms: tuple[ModelTerm, ...] = ()
     position_terms: tuple[tuple[ModelTerm, NDArray[np.float64]], ...] = ()
     position_covariance: NDArray[np.float64] | None = None
+    torque_delay_s: float = 0.0
 
     def __post_init__(self) -> None:
         n = self.robot.n
@@ -185,6 +190,7 @@ def from_identified(
         base_terms=tuple(t.term for t in in_base),
         position_terms=tuple((t.term, np.asarray(t.values, dtype=np.float64)) for t in held),
         position_covariance=None if not held else np.diag(_variances(held)),
+        torque_delay_s=0.0 if model.info.log is None else float(model.info.log.torque_delay_s),
     )
 
 

@@ -33,10 +33,19 @@ class ModelFingerprint:
         ``friction.json``, ``drive.toml``), or a built-in robot's name.
     sha256 : str
         Hex digest: equal for the same content, whatever the files are called.
+    roles : tuple of str
+        What each of ``files`` was given as (``model``, ``params``, ``friction``,
+        ``drive``); empty: not recorded (a file of an earlier version).
     """
 
     files: tuple[str, ...]
     sha256: str
+    roles: tuple[str, ...] = ()
+
+    def given_as(self, role: str) -> str | None:
+        """The file given as ``role`` (``friction``), or None: none given, or the roles
+        not recorded (:attr:`roles`)."""
+        return next((f for f, r in zip(self.files, self.roles, strict=False) if r == role), None)
 
     def __str__(self) -> str:
         return f"{' + '.join(self.files)} (sha256 {self.sha256[:12]})"

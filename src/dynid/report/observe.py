@@ -102,8 +102,14 @@ def _joint_table(doc: dict, cal: dict) -> str:
         ("contact level, moving (smallest torque detected) [N m]", moving),
         ("at rest [N m]", cal.get("at_rest")),
         ("collision level, moving [N m]", cal.get("collision_moving")),
-        ("contact base, without the uncertainty [N m]", doc.get("contact") if fixed else None),
-        ("collision base, without the uncertainty [N m]", doc.get("collision") if fixed else None),
+        (
+            "contact --no-uncertainty (fixed, not applied here) [N m]",
+            doc.get("contact") if fixed else None,
+        ),
+        (
+            "collision --no-uncertainty (fixed, not applied here) [N m]",
+            doc.get("collision") if fixed else None,
+        ),
         ("largest |r| read [N m]", cal.get("peak")),
     ]
     columns = [(h, v) for h, v in given if isinstance(v, list) and _numbers(v)]

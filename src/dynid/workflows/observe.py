@@ -215,6 +215,11 @@ class ObserveOptions:
     snap_angles : bool
         Read a ``params`` URDF's joint angles rounded near multiples of pi/2 as those
         multiples (:func:`dynid.io.robot.urdf.load_urdf`).
+    torque_delay_s : float, optional
+        How far the torques lag the positions [s]: each log's states are read that much
+        earlier (:func:`~dynid.identification.prepare.states_in_step`, as identify,
+        validate and friction read them); default: the delay the model was identified
+        with (``identification.json``'s ``metadata.torque_delay_s``), 0 for a robot file.
     q_start : tuple of float, optional
         The joint positions [rad] at the first sample of one motor-side log whose motor
         encoders wrap every turn (:func:`~dynid.workflows.recordings.given_start`).
@@ -262,6 +267,7 @@ class ObserveOptions:
     tip: str | None = None
     snap_angles: bool = False
     q_start: tuple[float, ...] | None = None
+    torque_delay_s: float | None = None
     keep_series: bool = True
     figure_points: int | None = None
     label_tolerance_s: float = DEFAULT_TOLERANCE_S
@@ -488,10 +494,12 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     fingerprint = model_fingerprint(opts)
     if given is not None and given.model is not None and given.model.sha256 != fingerprint.sha256:
         assert opts.thresholds is not None
+        said = friction_difference(opts.thresholds.name, given.model, fingerprint)
         warnings.warn(
-            f"{opts.thresholds.name} was calibrated with {given.model}, not with this model "
-            f"({fingerprint}): thresholds fit the residual of their own model; calibrate "
-            "again with this one",
+            said
+            or f"{opts.thresholds.name} was calibrated with {given.model}, not with this "
+            f"model ({fingerprint}): thresholds fit the residual of their own model; "
+            "calibrate again with this one",
             DynidWarning,
             stacklevel=2,
         )
@@ -532,7 +540,9 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         if sink is not None:
             table = sink.table(paths, k, rows, model.n, opts.frame, kind)
         with about_file(path.name):
-            prep = prepared_log(path, log, model, opts.max_gap, read.joint_side[k])
+            prep = prepared_log(
+                path, log, model, opts.max_gap, read.joint_side[k], _delay(opts, model)
+            )
             labels = contact_labels(prep, cmap)
         logs.append(
             detected_log(
@@ -567,7 +577,7 @@ def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
     ``tip``): a built-in robot's name stands for its file, a :class:`Drive` given as one
     for its arrays."""
     h = hashlib.sha256()
-    files = []
+    files, roles = [], []
     for what, src in (
         ("model", opts.model),
         ("params", opts.params),
@@ -577,6 +587,7 @@ def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
         if src is None:
             continue
         h.update(f"\0{what}\0".encode())
+        roles.append(what)
         if isinstance(src, Drive):
             for f in dataclasses.fields(src):
                 h.update(f"{f.name}={getattr(src, f.name)!r};".encode())
@@ -590,7 +601,41 @@ def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
             h.update(str(src).encode())
             files.append(str(src))
     h.update(f"\0base={opts.base}\0tip={opts.tip}".encode())
-    return ModelFingerprint(tuple(files), h.hexdigest())
+    return ModelFingerprint(tuple(files), h.hexdigest(), tuple(roles))
+
+
+def _delay(opts: ObserveOptions, model: ObserverModel) -> float:
+    """The torques' delay [s] the logs are prepared with: ``--torque-delay``, else the
+    model's own (:attr:`~dynid.observer.model.ObserverModel.torque_delay_s`)."""
+    return model.torque_delay_s if opts.torque_delay_s is None else float(opts.torque_delay_s)
+
+
+def friction_difference(
+    name: str, calibrated: ModelFingerprint, now: ModelFingerprint
+) -> str | None:
+    """The warning when the thresholds ``name`` were calibrated with another ``--friction``
+    file than ``now`` runs with (one given and not the other, or two names), or None:
+    the same friction by name, or the roles not recorded (a file of an earlier version)."""
+    if not calibrated.roles or not now.roles:
+        return None
+    then, here = calibrated.given_as("friction"), now.given_as("friction")
+    if then == here:
+        return None
+    tail = "thresholds fit the residual of the model they were calibrated with"
+    if here is None:
+        return (
+            f"{name} was calibrated with --friction {then}, and this run has no --friction: "
+            f"give --friction {then} as then, or calibrate again without it ({tail})"
+        )
+    if then is None:
+        return (
+            f"{name} was calibrated without --friction, and this run gives --friction {here}: "
+            f"leave it out as then, or calibrate again with it ({tail})"
+        )
+    return (
+        f"{name} was calibrated with --friction {then}, this run gives --friction {here}: "
+        f"give {then} as then, or calibrate again with {here} ({tail})"
+    )
 
 
 def friction_source(opts: ObserveOptions) -> str | None:
@@ -675,7 +720,7 @@ def _calibrated(
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
-            prep = prepared_log(Path(path), log, model, opts.max_gap, side)
+            prep = prepared_log(Path(path), log, model, opts.max_gap, side, _delay(opts, model))
             if again is not None:
                 again.append(prep)
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
@@ -783,6 +828,7 @@ def _model_check(opts: ObserveOptions, model: ObserverModel, read: Recorded) -> 
         max_gap_s=opts.max_gap,
         drive=model.drive,
         q_start=opts.q_start,
+        torque_delay_s=_delay(opts, model),
     )
     feasible = None
     try:

@@ -27,6 +27,7 @@ from ..exceptions import in_file as about_file
 from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
 from ..identification.pieces import unwrapped, with_start_turns, wrappable, wrapped_finding
+from ..identification.prepare import states_in_step
 from ..observer.detection import residual_std_blocks, standstill_blocks
 from ..observer.friction import (
     DERIVED_CUTOFF_HZ,
@@ -108,11 +109,14 @@ def prepared_log(
     model: ObserverModel,
     max_gap: float | None,
     side: TorqueLog | None = None,
+    torque_delay_s: float = 0.0,
 ) -> PreparedLog:
     """The log at the joints, unwrapped, cut at its gaps and jumps, with the velocities
     and the spans the observer runs on (warnings name the file). ``side``: ``log`` already
     on the joint side (the checks' :attr:`~dynid.workflows.recordings.Recorded.sides`),
-    used unless its motors' whole turns change it."""
+    used unless its motors' whole turns change it. ``torque_delay_s`` [s]: how far the
+    torques lag the positions; the states are read that much earlier, as identify reads
+    them (:func:`~dynid.identification.prepare.states_in_step`)."""
     # motors recorded wrapped given their whole turns (refused when the limits leave several)
     whole = with_start_turns(path.name, log, model.robot, model.drive, max_gap_s=max_gap)
     if side is None or whole is not log:
@@ -122,12 +126,13 @@ def prepared_log(
     if turned:
         said = wrapped_finding(sorted(turned), robot=model.robot, log=side)
         warnings.warn(f"{path.name}: {said}", DynidWarning, stacklevel=4)
+    log = states_in_step(log, torque_delay_s)  # the torques paired with their states
     starts = _pieces(path, log, max_gap)
     dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
     cut = _cut_at_jumps(path, log, dq, starts)
     if cut != starts and log.dq_derived:  # derived again, never across a jump
         dq = _piece_velocities(log, cut)
-    return PreparedLog(path, log, dq, _observed_spans(path, log, cut))
+    return PreparedLog(path, log, dq, _observed_spans(path, log, cut, abs(torque_delay_s)))
 
 
 def observed_blocks(
@@ -254,20 +259,26 @@ def _piece_velocities(log: TorqueLog, starts: list[int]) -> NDArray[np.float64]:
     return dq
 
 
-def _observed_spans(path: Path, log: TorqueLog, starts: list[int]) -> list[tuple[int, int]]:
-    """The samples ``[a, b)`` the observer runs on: every piece; for a log of positions
-    only, each piece without the first and last ``2 / cut-off`` seconds, where the derived
-    velocities carry the low-pass's transient (a note says so; their residual is NaN)."""
+def _observed_spans(
+    path: Path, log: TorqueLog, starts: list[int], trim_s: float = 0.0
+) -> list[tuple[int, int]]:
+    """The samples ``[a, b)`` the observer runs on: every piece without its first and
+    last ``trim_s`` seconds (the torques' delay: states read that much earlier there are
+    extrapolated, as identify drops them); for a log of positions only, also without the
+    first and last ``2 / cut-off`` seconds, where the derived velocities carry the
+    low-pass's transient (a note says so; their residual is NaN)."""
     ends = [*starts[1:], log.t.shape[0]]
-    if not log.dq_derived:
+    if not log.dq_derived and trim_s == 0.0:
         return list(zip(starts, ends, strict=True))
-    edge = edge_seconds(DERIVED_CUTOFF_HZ)
+    edge = trim_s + (edge_seconds(DERIVED_CUTOFF_HZ) if log.dq_derived else 0.0)
     spans = []
     for a, b in zip(starts, ends, strict=True):
         t = log.t[a:b]
         inside = np.flatnonzero((t >= t[0] + edge) & (t <= t[-1] - edge))
         if inside.size > 1:
             spans.append((a + int(inside[0]), a + int(inside[-1]) + 1))
+    if not log.dq_derived:
+        return spans
     warnings.warn(
         f"{path.name}: velocities derived from the positions of each piece: the first and "
         f"last {edge:g} s of each piece (the low-pass's transient) are not observed (NaN "
