@@ -105,7 +105,8 @@ def test_the_named_spring_is_shown_with_the_stiffness_its_file_holds(spring_runs
 
 def test_the_identify_headline_gives_the_verdicts_numbers_and_labels_each_error(spring_runs):
     """The headline's error, floor, ratio and level are heldout.json's verdict; the pooled
-    least-squares held-out error is said as such, the verdict's as every sample."""
+    least-squares held-out error is said as such beside its own floor, the verdict's as
+    every sample."""
     folder = spring_runs[0]
     held = json.loads((folder / "heldout.json").read_text())
     ident = json.loads((folder / "identification.json").read_text())
@@ -122,9 +123,11 @@ def test_the_identify_headline_gives_the_verdicts_numbers_and_labels_each_error(
     pooled = ident["metadata"]["heldout"]["heldout_error_percent"]
     assert _text(percent(pooled)) not in headline
     box = _box(page)
+    own = ident["metadata"]["heldout"]["noise_floor_percent"]  # the pooled error's own floor
     assert (
         f"Held-out error of least squares {_text(percent(pooled))} over 5 contiguous time "
-        "blocks (filtered, decimated samples, pooled over the folds)"
+        "blocks (filtered, decimated samples, pooled over the folds; the measured torques' "
+        f"noise there {_text(percent(own))})"
     ) in box, box
     assert "Held-out verdict on the last of 5 time blocks" in box
     assert "(every sample, torques as measured): error " + _text(err) in box

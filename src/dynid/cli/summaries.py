@@ -460,7 +460,9 @@ def heldout_line(ho: dict[str, Any], effort: str = "torque", *, verdict_below: b
     states', each sample against its own noise) the line gives no ratio of its own and
     points to the verdict, the judged figure: beside it, the pooled error over the
     torques' noise alone was a second ratio for the same fit, of another error (every
-    fold's) over another floor (the torques' noise alone). Without, how many times the
+    fold's) over another floor (the torques' noise alone). Its own floor
+    (``noise_floor_percent``, that of identification.json) is given beside it, so that
+    each held-out figure stands next to its own floor. Without, how many times the
     noise of the measured torques (``effort="current"``: of the motor currents the
     torques were read from) the held-out error is."""
     measured = "motor currents'" if effort == "current" else "measured torques'"
@@ -469,8 +471,11 @@ def heldout_line(ho: dict[str, Any], effort: str = "torque", *, verdict_below: b
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
     }.get(str(ho.get("scheme")), f"over {ho.get('folds')} contiguous time blocks")
     floor = ho.get("noise_floor_percent")
+    own = (  # the figure beside its own floor: no ratio, the verdict below judges
+        f", the {measured} noise there {floor:.4g} %" if floor is not None and floor > 0 else ""
+    )
     said = (
-        "; judged against the noise floor in the held-out verdict below"
+        f"{own}; the held-out verdict below judges its unfiltered samples against their own floor"
         if verdict_below
         else ""
         if floor is None
@@ -479,8 +484,13 @@ def heldout_line(ho: dict[str, Any], effort: str = "torque", *, verdict_below: b
         if floor > 0
         else ""
     )
+    if verdict_below:
+        how += ", filtered and decimated samples"
     return (
         f"least squares: training error {ho['training_error_percent']:.4g} %, held-out "
+        f"error {ho['heldout_error_percent']:.4g} % ({how}{said})"
+        if verdict_below
+        else f"least squares: training error {ho['training_error_percent']:.4g} %, held-out "
         f"error {ho['heldout_error_percent']:.4g} % ({how}){said}"
     )
 

@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -53,6 +53,7 @@ from ..identification.residual_dependence import (
     Dependence,
     held_terms,
     judged_springs,
+    offsets_of,
     residual_dependence,
     round_off,
     with_dependence_hint,
@@ -120,6 +121,11 @@ class HeldOutTorques:
     springs : ResidualSpring or None
         The stiffness per joint the held-out residual points to
         (:func:`residual_springs`); the verdict gives a named joint's.
+    offsets : mapping of int to (str, bool)
+        The model's offset per joint, its label and whether the model holds it
+        (:func:`~dynid.identification.residual_dependence.offsets_of`): a constant
+        held-out residual where the structure chosen on held-out data left the offset out
+        is said so, not called an offset.
     """
 
     validation: Validation
@@ -134,6 +140,7 @@ class HeldOutTorques:
     terms: frozenset[str] = frozenset()
     tilt: GravityTilt | None = None
     springs: ResidualSpring | None = None
+    offsets: Mapping[int, tuple[str, bool]] = field(default_factory=dict)
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -189,6 +196,7 @@ class HeldOutTorques:
             fl.joint_ratios,
             self.springs,
             [v.log.tau],
+            self.offsets,
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -430,8 +438,9 @@ def _held_out(
     names = tuple(model.robot.joint_names)
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
     held = HeldOutTorques(
-        v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model)
-    )
+        v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model),
+        offsets=offsets_of(model),
+    )  # fmt: skip
     verdict, floor = held._judged()
     total = floor.total_rms
     springs = None  # said only above the floor: a good verdict takes no hint

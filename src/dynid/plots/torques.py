@@ -64,8 +64,10 @@ def plot_torque_validation(
     Returns
     -------
     matplotlib.figure.Figure
-        ``n`` rows of two axes; time [s] on x, torque [N m] on y. Each error panel gives
-        the RMS of each prediction.
+        ``n`` rows of two axes; the samples' own times [s] on x (the log's clock: a
+        held-out block's at its place in the log), the lines broken where the times jump
+        (pieces between gaps), torque [N m] on y. Each error panel gives the RMS of each
+        prediction.
     """
     import matplotlib.pyplot as plt
 
@@ -78,7 +80,7 @@ def plot_torque_validation(
         fig.clear()
     axes = fig.subplots(n, 2, sharex=True, squeeze=False, gridspec_kw={"width_ratios": [3, 2]})
     s = _stride(log.n_samples, max_points)
-    t = log.t[s] - log.t[0]
+    t = np.asarray(log.t[s], dtype=np.float64)  # the samples' own times, not from 0
     cut = _gaps(t)
     e0 = log.tau - validation.tau_model
     e1 = None if validation.tau_friction is None else e0 - validation.tau_friction

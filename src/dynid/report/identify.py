@@ -267,7 +267,9 @@ def _overfit_fact(
     the ratio is then a check of extrapolation to the data left out, which an effect
     outside the model that changes over time (a spring, a drift) fails as over-fitting
     does: it is said as that check and leaves the level to the verdict, which has already
-    weighed the held-out error, over-fitting or not (one story on the page)."""
+    weighed the held-out error, over-fitting or not (one story on the page). The error is
+    given beside its own floor, the measured torques' noise over the same samples
+    (``noise_floor_percent``), as the command's summary gives it."""
     scheme = {
         "blocks": f"over {ho.get('folds')} contiguous time blocks",
         "recordings": f"leaving out each of {ho.get('folds')} recordings in turn",
@@ -297,9 +299,15 @@ def _overfit_fact(
         )
     else:
         why = "the fit over-fits"
+    floor = ho.get("noise_floor_percent")
+    own = (  # its own floor, beside it: not the verdict's (another error, other samples)
+        f"; the measured torques' noise there {percent(floor)}"
+        if is_number(floor) and floor > 0
+        else ""
+    )
     fact = (
         f"Held-out error of least squares <b>{percent(test)}</b> {esc(scheme)} "
-        f"({esc(pooled_label(ho))}), training error {percent(train)} on the same (ratio "
+        f"({esc(pooled_label(ho))}{esc(own)}), training error {percent(train)} on the same (ratio "
         f"{ratio:.2f}: {esc(why)})"
     )
     if few or at_floor or judged:

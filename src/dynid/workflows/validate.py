@@ -39,7 +39,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -69,7 +69,11 @@ from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
 from ..identification.pieces import check_below_nyquist
 from ..identification.recorded_signs import SignFinding
-from ..identification.residual_dependence import held_terms, with_dependence_hint
+from ..identification.residual_dependence import (
+    held_terms,
+    offsets_of,
+    with_dependence_hint,
+)
 from ..identification.residual_spring import ResidualSpring
 from ..identification.spikes import SPIKES_BEFORE_JUDGING
 from ..identification.torque_delay import TorqueDelay
@@ -386,8 +390,9 @@ def validate_files(
     # explains: what the residual follows is not diagnosed (it read as an offset)
     dependence = not beyond and not opposite
     verdict, springs = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model)
-    )
+        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model),
+        offsets=offsets_of(model),
+    )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay = _with_delay(model, verdict, val)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
@@ -445,11 +450,13 @@ def _with_hints(
     *,
     dependence: bool = True,
     terms: frozenset[str] = frozenset(),
+    offsets: Mapping[int, tuple[str, bool]] | None = None,
 ) -> tuple[Verdict, ResidualSpring | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
     any residual follows the motion; ``terms`` the model's, which its remedies leave out;
+    ``offsets`` its offset per joint, with which a constant residual is told;
     first the tilt of the gravity vector the residual points to, when it explains it:
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
     with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`), the
@@ -466,8 +473,9 @@ def _with_hints(
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
         verdict = with_dependence_hint(
-            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau
-        )
+            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau,
+            offsets,
+        )  # fmt: skip
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
     if verdict.level == "good" and high is not None and noise.inputs is not None:
