@@ -22,6 +22,7 @@ sum of squares; :meth:`TorqueDelay.sentence` then says it with the hint to
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -55,7 +56,8 @@ class TorqueDelay:
         The share of the residual's weighted sum of squares the common delay explains.
     joints_s, joints_std_s : tuple of float
         Each joint's own delay and its standard deviation [s] (nan where the joint's
-        prediction does not change).
+        prediction does not change, and every joint's when the common delay is not
+        named: they are read for the report of a named delay only).
     """
 
     delay_s: float
@@ -143,14 +145,13 @@ def torque_delay(
     common = _fit(D, E, C, w, sizes, lag, range(n))
     if common is None:
         return None
-    joints = [_fit(D, E, C, w, sizes, lag, [j]) for j in range(n)]
-    nan = (float("nan"), float("nan"), 0.0)
-    return TorqueDelay(
-        delay_s=common[0],
-        std_s=common[1],
-        share=common[2],
-        joints_s=tuple((j or nan)[0] for j in joints),
-        joints_std_s=tuple((j or nan)[1] for j in joints),
+    nan = (float("nan"),) * n
+    delay = TorqueDelay(common[0], common[1], common[2], nan, nan)
+    if not delay.named:
+        return delay
+    joints = [_fit(D, E, C, w, sizes, lag, [j]) or (nan[0], nan[0], 0.0) for j in range(n)]
+    return dataclasses.replace(
+        delay, joints_s=tuple(x[0] for x in joints), joints_std_s=tuple(x[1] for x in joints)
     )
 
 
