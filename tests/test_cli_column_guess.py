@@ -64,8 +64,9 @@ def test_the_hint_of_pos_eff_columns_is_a_map_that_reads_the_file(tmp_path, caps
     log = load_mapped_torque_log(path, parse_column_map(pasted[1])).log
     np.testing.assert_array_equal(log.q, body[:, 1 : 1 + N])
     np.testing.assert_array_equal(log.tau, body[:, 1 + N :])
-    assert main([*base, *pasted, "--out", str(tmp_path / "o"), "-q"]) == 0
-    assert (tmp_path / "o" / "identification.json").is_file()
+    if not given:  # the same map each time: identify run once with it pasted
+        assert main([*base, *pasted, "--out", str(tmp_path / "o"), "-q"]) == 0
+        assert (tmp_path / "o" / "identification.json").is_file()
 
 
 def test_motor_currents_and_a_time_in_ms_are_guessed_with_their_units(tmp_path, capsys):
