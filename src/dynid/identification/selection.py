@@ -647,16 +647,11 @@ def _refined_width(
 
     def at(w: float) -> float | None:
         mine = replace(full, width=w)
-        for family, model, terms, held in fit([mine], "structure search, the smooth width"):
-            own = (full.armature, full.at, f"{family} {w:g}")
-            groups[own] = (model, terms)
-            folds = without_recordings(model, skip) if skip else heldout_of(model)
-            by_group[own] = (model, terms, folds)
-            for c in held:
-                where[c] = own
-                new.append(
-                    _judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol)
-                )
+        new.extend(
+            _judged_apart(
+                [mine], f"{w:g}", "smooth width", fit, groups, by_group, where, skip, rtol
+            )
+        )
         return next((c.score for c in new if c.structure == mine and not c.skipped), None)
 
     assert isinstance(full.width, float)  # one width: the smooth laws of the grid
@@ -707,16 +702,11 @@ def _refined_stribeck(
 
     def at(v: float) -> float | None:
         mine = [replace(full, vst=v), *([replace(chosen, vst=v)] if chosen.drop else [])]
-        for family, model, terms, held in fit(mine, "structure search, the Stribeck velocity"):
-            own = (full.armature, full.at, f"{family} {v:g}")
-            groups[own] = (model, terms)
-            folds = without_recordings(model, skip) if skip else heldout_of(model)
-            by_group[own] = (model, terms, folds)
-            for c in held:
-                where[c] = own
-                new.append(
-                    _judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol)
-                )
+        new.extend(
+            _judged_apart(
+                mine, f"{v:g}", "Stribeck velocity", fit, groups, by_group, where, skip, rtol
+            )
+        )
         return next((c.score for c in new if c.structure == mine[0]), None)
 
     tried = refined_shape(scores, chosen.vst, at)
@@ -736,6 +726,33 @@ def _refined_stribeck(
         f"(at the grid's {chosen.vst:g}: {here[0].heldout_error_percent:.4g} %)"
     )
     return best.structure
+
+
+def _judged_apart(
+    structures: list[Structure],
+    value: str,
+    what: str,
+    fit: Callable[[list[Structure], str], list[Fitted]],
+    groups: _Groups,
+    by_group: _Folds,
+    where: dict[Structure, _Key],
+    skip: tuple[int, ...],
+    rtol: float,
+) -> list[Candidate]:
+    """``structures`` (one shape parameter, ``what``, at a ``value`` off the grid) fitted
+    in a regressor of their own and judged on its folds (recordings ``skip`` left out),
+    the regressor recorded in ``groups``, ``by_group`` and ``where``, as the grid's are."""
+    out: list[Candidate] = []
+    first = structures[0]
+    for family, model, terms, held in fit(structures, f"structure search, the {what}"):
+        own = (first.armature, first.at, f"{family} {value}")
+        groups[own] = (model, terms)
+        folds = without_recordings(model, skip) if skip else heldout_of(model)
+        by_group[own] = (model, terms, folds)
+        for c in held:
+            where[c] = own
+            out.append(_judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol))
+    return out
 
 
 def _plain_smooth(c: Structure) -> bool:
