@@ -126,11 +126,13 @@ def prepared_log(
     if turned:
         said = wrapped_finding(sorted(turned), robot=model.robot, log=side)
         warnings.warn(f"{path.name}: {said}", DynidWarning, stacklevel=4)
-    log = states_in_step(log, torque_delay_s)  # the torques paired with their states
     starts = _pieces(path, log, max_gap)
     dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
-    cut = _cut_at_jumps(path, log, dq, starts)
-    if cut != starts and log.dq_derived:  # derived again, never across a jump
+    cut = _cut_at_jumps(path, log, dq, starts)  # jumps of the log as recorded
+    if torque_delay_s:  # the torques paired with their states (its extrapolated ends
+        log = states_in_step(log, torque_delay_s)  # are left unobserved)
+        dq = _piece_velocities(log, cut)
+    elif cut != starts and log.dq_derived:  # derived again, never across a jump
         dq = _piece_velocities(log, cut)
     return PreparedLog(path, log, dq, _observed_spans(path, log, cut, abs(torque_delay_s)))
 
