@@ -21,6 +21,7 @@ __all__ = [
     "guessed_map",
     "holdings",
     "joint_families",
+    "missing_joints",
     "no_torques",
     "position_count",
     "time_column",
@@ -136,6 +137,43 @@ def column_hint(
         f"map yours with --columns ('tau=effort{{i}}': {{i}} counts joints from 1, {{i0}} "
         "from 0)"
     )
+
+
+def missing_joints(names: Sequence[str], n_log: int, n: int) -> str:
+    """What a header read as a log of ``n_log`` joints lacks for a robot of ``n``: ``missing
+    column(s) q2..q7, tau2..tau7 (the file has q1, tau1)``, of each signal whose first
+    column is there (``q1``, ``dq1``, ``tau1``), and, when the header holds other columns,
+    those and the ``--columns`` map that reads them (:func:`column_hint`); empty when
+    ``n_log >= n`` or the header names no such column.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The header.
+    n_log : int
+        The joints the log was read with (its ``q1..qn``).
+    n : int
+        The robot's joints.
+    """
+    if not 0 < n_log < n:
+        return ""
+    have = set(names)
+    signals = [s for s in ("q", "dq", "tau") if f"{s}1" in have]
+    gone = {s: [j for j in range(n_log + 1, n + 1) if f"{s}{j}" not in have] for s in signals}
+    if not any(gone.values()):
+        return ""
+    spans = ", ".join(_span(s, js) for s, js in gone.items() if js)
+    kept = ", ".join(_span(s, list(range(1, n_log + 1))) for s in signals)
+    used = {"t", *(f"{s}{j}" for s in signals for j in range(1, n_log + 1))}
+    hint = column_hint(names, n, [s for s in ("q", "tau") if s in signals], used)
+    return f"missing column(s) {spans} (the file has {kept}){hint}"
+
+
+def _span(signal: str, joints: Sequence[int]) -> str:
+    """``q2..q7`` (consecutive joints), ``q3`` or ``q2, q5`` (else)."""
+    if len(joints) > 1 and list(joints) == list(range(joints[0], joints[-1] + 1)):
+        return f"{signal}{joints[0]}..{signal}{joints[-1]}"
+    return ", ".join(f"{signal}{j}" for j in joints)
 
 
 def _found(families: Sequence[str], signals: Sequence[str]) -> dict[str, str]:

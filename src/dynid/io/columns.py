@@ -66,6 +66,7 @@ __all__ = [
     "MappedLog",
     "MappedStatic",
     "conversion_notes",
+    "header_names",
     "load_column_map",
     "parse_column_map",
     "load_mapped_static_data",
@@ -794,8 +795,19 @@ def load_label_column(
 
 
 def _header(path: Path) -> list[str]:
+    """:func:`header_names`."""
+    return header_names(path)
+
+
+def header_names(path: Path) -> list[str]:
     """The column names of a CSV (its first line that is not a comment) or the array
-    names of an NPZ file."""
+    names of an NPZ file.
+
+    Raises
+    ------
+    DataError
+        Not a regular file; an NPZ file that cannot be read.
+    """
     regular_file(path)
     if path.suffix.lower() == ".npz":
         check_npz(path)

@@ -29,8 +29,10 @@ from ..exceptions import DataError, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
+from ..io.column_hint import missing_joints
 from ..io.columns import (
     ColumnMap,
+    header_names,
     load_column_map,
     load_mapped_static_data,
     load_mapped_torque_log,
@@ -303,9 +305,23 @@ def read_torque_log(
                 _log.warning("%s: dropped %s", path.name, what)
         log = mapped.log
     if n is not None and log.n != n:
+        chain = robot if robot is not None and robot.n == n else None
+        missing = "" if columns is not None else missing_joints(header_names(path), log.n, n)
+        if missing:  # the robot's joints whose columns the file lacks, and how to map others
+            raise DataError(
+                f"the log has {log.n} joints; {owner or 'the robot'} has {n}: {missing}; or "
+                "pass the robot the log was recorded with"
+                + (
+                    ""
+                    if chain is None
+                    else f" (a URDF's chain ends before "
+                    f"{chain.joint_names[log.n]} with --tip {chain.link_names[log.n]})"
+                ),
+                file=path.name,
+            )
         raise DataError(
             f"the log has {log.n} joints; {owner or 'the robot'} has {n}; "
-            + _joint_count_hint(log.n, robot if robot is not None and robot.n == n else None),
+            + _joint_count_hint(log.n, chain),
             file=path.name,
         )
     return log
