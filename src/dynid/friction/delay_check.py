@@ -7,7 +7,8 @@ derivative, the residual with the model's friction, and, for an identified model
 columns (:func:`~dynid.friction.heldout_torques.beside_columns`) fitted beside the delay's,
 on at most :data:`ROWS` rows.
 :func:`logs_delay` prepares whole logs first, as the identification cut them (``identify``
-reads the fit's residual on its own recordings).
+reads the fit's residual on its own recordings), or takes them as its held-out prediction
+of each recording prepared them.
 """
 
 from __future__ import annotations
@@ -24,8 +25,9 @@ from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.serial import hac_lag
 from ..identification.torque_delay import TorqueDelay, torque_delay
 from ..model.robot import Robot
+from .fit import model_drive
 from .heldout_torques import beside_columns
-from .validation import Validation, own_friction, validate_torques
+from .validation import Validation, own_friction, validate_torques, validated
 
 __all__ = ["ROWS", "logs_delay", "validations_delay"]
 
@@ -60,14 +62,26 @@ def validations_delay(
     return torque_delay(t, predicted, error, cols, lag, every=max(every, 1))
 
 
-def logs_delay(model: IdentifiedModel, logs: Sequence[TorqueLog]) -> TorqueDelay | None:
+def logs_delay(
+    model: IdentifiedModel,
+    logs: Sequence[TorqueLog],
+    prepared: Sequence[TorqueLog] = (),
+) -> TorqueDelay | None:
     """:func:`validations_delay` of ``logs`` (as read), each cut at the identification's
     gaps, its wrapped joints unwrapped and every piece prepared as the model's validation
     prepares it (:func:`~dynid.friction.validation.validate_torques`: the recorded
-    cut-off and delay); a piece too short to prepare left out."""
+    cut-off and delay); a piece too short to prepare left out.
+
+    ``prepared``: those pieces already prepared so (joint side, every sample: the
+    held-out prediction's, :attr:`~dynid.friction.heldout_torques.HeldOutTorques.
+    prepared`), predicted without preparing ``logs`` again; the same delay.
+    """
+    friction = own_friction(model)
+    if prepared:
+        drive = model_drive(model, None)
+        return validations_delay(model, [validated(model, p, friction, drive) for p in prepared])
     gap = None if model.info.log is None else model.info.log.max_gap_s
     turns = wrappable(model.robot, model.drive)
-    friction = own_friction(model)
     parts = []
     for log in logs:
         for piece in split_at_gaps(log, gap):

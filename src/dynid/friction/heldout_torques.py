@@ -66,7 +66,7 @@ from ..model.robot import Robot
 from ..regressors.terms import LinearFriction
 from .fit import model_drive, torques_through
 from .pooled import joined_validation
-from .validation import Validation, own_friction, validate_torques
+from .validation import KEPT_SAMPLES, Validation, own_friction, validate_torques
 
 __all__ = [
     "HeldOutTorques",
@@ -126,6 +126,13 @@ class HeldOutTorques:
         (:func:`~dynid.identification.residual_dependence.offsets_of`): a constant
         held-out residual where the structure chosen on held-out data left the offset out
         is said so, not called an offset.
+    prepared : tuple of TorqueLog
+        Every piece of every recording the fit used, prepared (joint side, every sample),
+        in the fit's order, when the held-out data are those recordings (each predicted by
+        the fit of the others), none of their torques replaced as spikes and at most
+        :data:`~dynid.friction.validation.KEPT_SAMPLES` samples in all: the model's
+        residual on them is read (:func:`~dynid.friction.delay_check.logs_delay`) without
+        preparing them again; empty otherwise.
     """
 
     validation: Validation
@@ -141,6 +148,7 @@ class HeldOutTorques:
     tilt: GravityTilt | None = None
     springs: ResidualSpring | None = None
     offsets: Mapping[int, tuple[str, bool]] = field(default_factory=dict)
+    prepared: tuple[TorqueLog, ...] = ()
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -368,7 +376,7 @@ def _predicted(
     else:
         return None
     pieces = _pieces(model, held, turns)
-    v, said = _pieces_validation(fitted, pieces)
+    v, said, _ = _pieces_validation(fitted, pieces)
     read = (held if model.holdout.scheme == "file" else log,)  # the motion of a whole log
     caveat = (model.info.heldout or {}).get("caveat") if model.holdout.scheme == "blocks" else None
     whole = None  # a time block too short to fit the springs with the model's columns
@@ -389,6 +397,7 @@ def _each_recording(
     prediction: the folds' coefficients barely move it)."""
     parts: list[Validation] = []
     pieces: list[TorqueLog] = []
+    prepared: list[TorqueLog] | None = []  # every piece whole, for the delay's check
     spikes = 0
     for fold, rec in enumerate(logs):
         fitted = _fold_model(model, fold)
@@ -396,15 +405,21 @@ def _each_recording(
             return None
         held, replaced = _despiked_from(rec)
         mine = _pieces(model, held, turns)
-        parts.append(_pieces_validation(fitted, mine)[0])  # pooled one after another
+        v, _, each = _pieces_validation(fitted, mine)
+        parts.append(v)  # pooled one after another
         pieces += mine
         spikes += replaced
+        whole = replaced == 0 and all(p.step == 1 for p in each)
+        prepared = prepared + [p.log for p in each] if whole and prepared is not None else None
     v = joined_validation(parts)
     k = len(logs)
     block = f"each of the {k} recordings, predicted by the fit of the other {k - 1}"
     if len(pieces) > k:
         block += f" ({len(pieces)} pieces between gaps)"
-    return _held_out(model, v, block, logs, None, spikes, _input_noise(model, v, pieces))
+    held_out = _held_out(model, v, block, logs, None, spikes, _input_noise(model, v, pieces))
+    if prepared is None or sum(p.n_samples for p in prepared) > KEPT_SAMPLES:
+        return held_out
+    return dataclasses.replace(held_out, prepared=tuple(prepared))
 
 
 def _pieces(model: IdentifiedModel, held: TorqueLog, turns: NDArray[np.bool_]) -> list[TorqueLog]:
@@ -590,10 +605,12 @@ def _recorded_noise(model: IdentifiedModel) -> NDArray[np.float64] | None:
     return np.asarray(noise, dtype=np.float64)
 
 
-def _pieces_validation(model: IdentifiedModel, pieces: list[TorqueLog]) -> tuple[Validation, str]:
+def _pieces_validation(
+    model: IdentifiedModel, pieces: list[TorqueLog]
+) -> tuple[Validation, str, list[Validation]]:
     """``model`` on the pieces of a log cut at its gaps, each prepared on its own as the
-    identification prepared them (one too short to filter is left out), pooled; and what
-    to add to the block's description.
+    identification prepared them (one too short to filter is left out), pooled; what
+    to add to the block's description; and each piece's validation.
 
     Raises
     ------
@@ -613,4 +630,4 @@ def _pieces_validation(model: IdentifiedModel, pieces: list[TorqueLog]) -> tuple
     said = "" if len(pieces) == 1 else f" ({len(pieces)} pieces between gaps"
     if len(parts) < len(pieces):
         said += f", {len(pieces) - len(parts)} too short to filter left out"
-    return joined_validation(parts), said + (")" if said else "")
+    return joined_validation(parts), said + (")" if said else ""), parts

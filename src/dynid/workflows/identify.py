@@ -446,7 +446,7 @@ def _identify(
         model = in_file(path, fit) if len(paths) == 1 else fit()
         held = _predicted_heldout(model, logs, heldout.get("validate_on"))
         _say_gravity_scale(robot, model, logs, opt.drive)
-        model, delay = _with_torque_delay(model, logs)
+        model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
     else:
         held = delay = None
         _one_static_file(paths, opt)
@@ -473,12 +473,13 @@ def _identify(
 
 
 def _with_torque_delay(
-    model: IdentifiedModel, logs: Sequence[TorqueLog]
+    model: IdentifiedModel, logs: Sequence[TorqueLog], prepared: Sequence[TorqueLog] = ()
 ) -> tuple[IdentifiedModel, TorqueDelay | None]:
     """``model`` and the torques' delay its residual on ``logs`` points to
-    (:func:`~dynid.friction.delay_check.logs_delay`), said in the model's notes and
+    (:func:`~dynid.friction.delay_check.logs_delay`; from ``prepared``, the held-out
+    prediction's pieces of them, when it kept them), said in the model's notes and
     recorded in its metadata when named."""
-    delay = logs_delay(model, logs)
+    delay = logs_delay(model, logs, prepared)
     if delay is None or not delay.named:
         return model, delay
     info = dataclasses.replace(
