@@ -18,6 +18,7 @@ import numpy as np
 from .. import _checks, spatial
 from .._checks import text as as_text
 from ..exceptions import DataError, OptionError, ShapeError, in_file
+from ..identification.torque_delay import AppliedDelay
 from ..io.drive_file import drive_of_robot_file, load_drive, with_file_rotors
 from ..io.robot_file import load_robot as load_robot_file
 from ..kinematics.inverse import default_q0
@@ -259,11 +260,26 @@ def add_torque_delay(p: argparse.ArgumentParser, *, recorded: bool = False) -> N
         default=None,
         metavar="MS",
         help="how far the torques lag the positions [ms] (a filtered sensor, bus latency; "
-        "positive: the torques late): each piece's torques are read that much later, by "
-        "interpolation, before filtering, and the samples at its ends that fall outside "
-        f"are dropped; identify and validate estimate it from the residual and say it when "
-        f"it matters (default: {default})",
+        "positive: the torques late): each piece's states are read that much earlier, by "
+        "a spline, before filtering (the torques as measured), and the samples at its ends "
+        "that this reads beyond are dropped; identify and validate estimate it from the "
+        f"residual and say it when it matters (default: {default}"
+        + (
+            "; the summary and the report say which, --torque-delay 0 turns it off)"
+            if recorded
+            else ")"
+        ),
     )
+
+
+def say_torque_delay(console: Console, applied: AppliedDelay | None) -> None:
+    """Print the torques' delay a run prepared its logs with (``torque delay 3.0 ms (from
+    the model's identification.json)``) and show it as ``--torque-delay``'s value in the
+    report; nothing when none was given or recorded."""
+    if applied is None:
+        return
+    console.print(applied.sentence())
+    console.option_used("torque_delay", applied.text())
 
 
 def add_drop_invalid(p: argparse.ArgumentParser) -> None:

@@ -75,6 +75,13 @@ class Console:
         with ``-q``."""
         self._write("".join(f"{line}\n" for line in lines), stdout=True)
 
+    def option_used(self, dest: str, text: str) -> None:
+        """Show ``text`` as the value of the option ``dest`` in the report's options (a
+        default the run resolved, such as the delay a model was identified with, or a
+        value in the unit it was typed in)."""
+        if self._record is not None:
+            self._record.options_used[dest] = text
+
     def wrote(self, *paths: Any) -> None:
         """``wrote A, B`` on stdout; nothing with ``-q``."""
         self.print("wrote " + ", ".join(str(p) for p in paths))

@@ -52,6 +52,7 @@ from pathlib import Path
 from ..exceptions import DynidError
 from ..friction.laws import LAWS
 from ..identification.model import IdentifiedModel
+from ..identification.torque_delay import applied_delay
 from ..io.friction_json import save_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
@@ -71,6 +72,7 @@ from .common import (
     load_robot,
     options_from,
     output_path,
+    say_torque_delay,
     shown,
 )
 from .console import Console
@@ -160,5 +162,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
     console.print(format_friction_rms(names, fit, result.noise_std, result.decimate))
     if result.pieces is not None:
         console.print(result.pieces.describe())
+    own = model.info.log if isinstance(model, IdentifiedModel) else None
+    say_torque_delay(console, applied_delay(args.torque_delay, own.torque_delay_s if own else 0.0))
     console.wrote(args.out / "friction.json")
     return 0

@@ -101,6 +101,8 @@ from pathlib import Path
 
 from ..identification.estimators import ESTIMATORS
 from ..identification.least_squares import STD_METHODS
+from ..identification.torque_delay import TorqueDelay, applied_delay
+from ..identification.verdict import Verdict
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.json_files import save_json
 from ..io.model_json import save_model_json
@@ -123,6 +125,7 @@ from .common import (
     output_path,
     parse_mass_band,
     positive_type,
+    say_torque_delay,
 )
 from .console import Console
 from .figures import save_heldout_figures, save_retrieval_figure
@@ -277,8 +280,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
         files.append(save_json(args.out / "heldout.json", doc, schema="dynid-heldout-torques/1"))
         files += [] if args.no_figures else save_heldout_figures(args.out, held)
         v = held.verdict
+        text += _delay_first(result.torque_delay, v)
         text.append(f"held-out verdict on {held.block}, every sample: {v.label}: {v.reason}")
-    if result.torque_delay is not None and result.torque_delay.named:
+    elif result.torque_delay is not None and result.torque_delay.named:
         text.append(f"note: {result.torque_delay.sentence()}")
     if result.consistent is not None:
         sources = [str(p) for p in args.data]  # every recording fitted, not the first alone
@@ -286,5 +290,16 @@ def run(args: argparse.Namespace, console: Console) -> int:
         files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)
         text += ["", format_consistent(result.consistent)]
     console.print(*text)
+    say_torque_delay(console, applied_delay(args.torque_delay, 0.0))
     console.wrote(*files)
     return 1 if result.consistent is not None and not result.consistent.feasible else 0
+
+
+def _delay_first(delay: TorqueDelay | None, verdict: Verdict) -> list[str]:
+    """The note of a named torque delay, said before the held-out verdict whose hints
+    (what the residual follows, friction at low speed, a spring) it may explain: the
+    lag's residual follows the joints' velocities and accelerations."""
+    if delay is None or not delay.named:
+        return []
+    may = " (it may explain the verdict's hints below)" if verdict.level != "good" else ""
+    return [f"note: {delay.sentence()}{may}"]

@@ -92,6 +92,10 @@ calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
 --collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused:
 the file fixes them; --frame, --wrench, --merge, --min-duration and --label-tolerance
 apply to detection only.
+A model identified with --torque-delay prepares the logs with that delay (their states
+read that much earlier): the summary, thresholds.json's calibration and events.json
+("torque_delay_used") and the report's options say the delay and whether it was given or
+the model's; --torque-delay 0 observes without it.
 
 Examples:
   dynid observe --model id/identification.json --data free.csv --calibrate --out cal
@@ -103,7 +107,9 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
+from ..identification.torque_delay import applied_delay
 from ..observer.events import DEFAULT_MERGE_S, DEFAULT_MIN_DURATION_S
 from ..observer.residual import DEFAULT_GAIN
 from ..observer.results import NO_FRICTION
@@ -122,6 +128,7 @@ from .common import (
     output_path,
     parse_vector,
     positive_type,
+    say_torque_delay,
 )
 from .console import Console
 from .figures import save_observer_figures
@@ -265,10 +272,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
     result = observe_files(opts, tables)
     names = list(result.model.robot.joint_names)
     console.print(format_observation(result, names, calibrating=args.calibrate))
+    applied = applied_delay(args.torque_delay, result.model.torque_delay_s)
+    say_torque_delay(console, applied)
     for note in result.notes:
         asks = note.startswith(NO_FRICTION) and note.endswith("--friction")
         console.note(note + (_friction_recipe(args) if asks else ""))
-    meta = {"model": str(args.model or args.params), "source": result.model.source}
+    meta: dict[str, Any] = {"model": str(args.model or args.params), "source": result.model.source}
+    if applied is not None:  # the delay the logs were prepared with, and its source
+        meta["torque_delay_used"] = applied.as_dict()
     saved = save_observation(
         args.out, result, joints=names, calibrating=args.calibrate, meta=meta, residuals=False
     )

@@ -71,6 +71,7 @@ class RunRecord:
         self.logged: list[str] = []
         self.logged_notes: list[str] = []
         self.tables: list[tuple[str, list[str], list[list[str]]]] = []
+        self.options_used: dict[str, str] = {}  # dest -> the value the run resolved
         self.started = time.time()
         self._saved: tuple[Any, Any] | None = None
         self._handler = _Collect(self.logged, self.logged_notes)
@@ -152,7 +153,8 @@ def save_run_report(
     record : RunRecord
         What the run printed, warned and noted, and the tables it added.
     args : argparse.Namespace
-        The parsed options (every option and its value is listed in the report).
+        The parsed options (every option and its value is listed in the report; one the
+        run resolved, ``record.options_used``, as the run said it).
     argv : sequence of str
         The command line after ``dynid``.
     code : int
@@ -164,7 +166,7 @@ def save_run_report(
         The report cannot be written.
     """
     options = tuple(
-        (f"--{k.replace('_', '-')}", option_text(v))
+        (f"--{k.replace('_', '-')}", record.options_used.get(k, option_text(v)))
         for k, v in sorted(vars(args).items())
         if not k.startswith("_") and k != "command"
     )

@@ -32,6 +32,13 @@ another. The errors are pooled over every sample of every recording (RMS per joi
 relative error over all), and given per recording; the torque figure shows the longest
 piece of the first recording, the RMS figure the pooled errors.
 
+--torque-delay MS reads each piece's states MS earlier (torques that lag the positions);
+a model identified with a delay is validated with it. The summary, validation.json
+("torque_delay_used") and the report's options say the delay applied and whether it was
+given or the model's; --torque-delay 0 validates without it. A delay the residual points
+to is said in the verdict: of an identified model, with the hint to identify it again
+with --torque-delay (its coefficients were fitted to the lagging torques).
+
 The verdict weighs the relative error against the sensor-noise floor read from the
 measured torques (the smallest error a model can reach on them): "at the noise floor"
 (at most 1.5 x the floor), "usable" (at most 3 x, or below 15 %), "poor" (below 50 %: the
@@ -87,6 +94,7 @@ from .common import (
     cutoff_type,
     load_drive_arg,
     output_path,
+    say_torque_delay,
     shown,
 )
 from .console import Console
@@ -184,6 +192,7 @@ def print_validation(
     if val.with_friction is not None:
         cols[f"RMS + {val.added} [N m]"] = val.with_friction.rms
     console.print(format_rms_table(names, cols), val.pieces.describe())
+    say_torque_delay(console, result.applied_delay)
     if len(val.recordings) > 1:
         console.print(
             *(

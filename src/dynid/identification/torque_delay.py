@@ -17,7 +17,10 @@ The delay is named (:attr:`TorqueDelay.named`) when it stands :data:`SIGNIFICANT
 standard deviations clear and explains at least :data:`SHARE` of the residual's weighted
 sum of squares; :meth:`TorqueDelay.sentence` then says it with the hint to
 ``--torque-delay``, which reads the states that much earlier before filtering
-(:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`).
+(:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); of a model's
+validation, :meth:`TorqueDelay.sentence` with ``refit`` says to identify again with the
+whole delay (the model's coefficients bent to it). :class:`AppliedDelay` is the delay a
+command prepared its logs with and where it came from (given, or the model's record).
 """
 
 from __future__ import annotations
@@ -25,14 +28,22 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .serial import SerialMeat, serial_of_pieces
 
-__all__ = ["SHARE", "SIGNIFICANT", "TorqueDelay", "torque_delay"]
+__all__ = [
+    "SHARE",
+    "SIGNIFICANT",
+    "AppliedDelay",
+    "TorqueDelay",
+    "applied_delay",
+    "ms_text",
+    "torque_delay",
+]
 
 #: Smallest ratio of the delay to its standard deviation for the delay to be named.
 SIGNIFICANT = 3.0
@@ -73,27 +84,107 @@ class TorqueDelay:
         clear = abs(self.delay_s) > SIGNIFICANT * self.std_s
         return bool(clear and self.share >= SHARE)
 
-    def sentence(self) -> str:
-        """The delay in words with the option that removes it."""
+    def sentence(self, applied_s: float = 0.0, *, refit: bool = False) -> str:
+        """The delay in words with the option that removes it: ``--torque-delay`` with the
+        whole delay, ``applied_s`` [s] (the one the logs were prepared with, to which the
+        residual's is added) and this one. ``refit``: of an identified model's
+        validation, whose coefficients were fitted to torques this late (viscous friction
+        bends to the lag), so that the remedy is to identify again with it."""
         ms, sd = 1e3 * self.delay_s, 1e3 * self.std_s
         late = "lag" if ms > 0 else "lead"
-        return (
+        whole = 1e3 * applied_s + ms
+        said = (
             f"the torques {late} the positions by {abs(ms):.2g} ms (+- {sd:.1g} ms; "
-            f"{100 * self.share:.2g} % of the residual; a filtered sensor or the bus): the fit "
-            f"bends to it (viscous friction first); hint: --torque-delay {ms:.2g} pairs the "
-            "torques with the positions they belong to before filtering"
+            f"{100 * self.share:.2g} % of the residual; a filtered sensor or the bus)"
+        )
+        if applied_s:
+            said += f" beyond the {ms_text(1e3 * applied_s)} ms the logs were prepared with"
+        if refit:
+            return (
+                f"{said}: the model's coefficients were fitted to torques this late (viscous "
+                f"friction first); hint: identify it again with --torque-delay {whole:.2g}, "
+                f"then validate the new model (validate --torque-delay {whole:.2g} only pairs "
+                "this log's torques with its positions)"
+            )
+        return (
+            f"{said}: the fit bends to it (viscous friction first); hint: --torque-delay "
+            f"{whole:.2g} pairs the torques with the positions they belong to before filtering"
+        )
+
+    @property
+    def joints_clear(self) -> tuple[bool, ...]:
+        """Per joint, whether its own delay stands :data:`SIGNIFICANT` standard deviations
+        clear (False where it was not read)."""
+        return tuple(
+            bool(np.isfinite(d) and np.isfinite(s) and abs(d) > SIGNIFICANT * s)
+            for d, s in zip(self.joints_s, self.joints_std_s, strict=True)
         )
 
     def as_dict(self) -> dict[str, Any]:
-        """The record of ``identify``'s and ``validate``'s JSON: the delays in ms."""
-        return {
+        """The record of ``identify``'s and ``validate``'s JSON: the delays in ms; each
+        joint's own only where it stands clear (:attr:`joints_clear`; ``null`` for the
+        others), the lists left out when no joint's does."""
+        rec: dict[str, Any] = {
             "delay_ms": 1e3 * self.delay_s,
             "std_ms": 1e3 * self.std_s,
             "share": self.share,
             "named": self.named,
-            "joints_ms": [1e3 * x if np.isfinite(x) else None for x in self.joints_s],
-            "joints_std_ms": [1e3 * x if np.isfinite(x) else None for x in self.joints_std_s],
         }
+        clear = self.joints_clear
+        if any(clear):
+            rec["joints_ms"] = [
+                1e3 * d if c else None for d, c in zip(self.joints_s, clear, strict=True)
+            ]
+            rec["joints_std_ms"] = [
+                1e3 * s if c else None for s, c in zip(self.joints_std_s, clear, strict=True)
+            ]
+        return rec
+
+
+def ms_text(ms: float) -> str:
+    """A delay in milliseconds as said: one decimal (``3.0``), more digits where it has
+    them (``2.25``)."""
+    return f"{ms:.1f}" if abs(10 * ms - round(10 * ms)) < 1e-6 else f"{ms:.3g}"
+
+
+@dataclass(frozen=True, slots=True)
+class AppliedDelay:
+    """The torques' delay a command prepared its logs with, and where it came from.
+
+    Attributes
+    ----------
+    delay_s : float
+        The delay [s] (positive: the torques late): the states read that much earlier.
+    source : "given" or "model"
+        ``--torque-delay`` as given, or the one the model was identified with
+        (``identification.json``'s ``metadata.torque_delay_s``).
+    """
+
+    delay_s: float
+    source: Literal["given", "model"]
+
+    def text(self) -> str:
+        """``3.0 ms (given)`` or ``3.0 ms (from the model's identification.json)``."""
+        where = "given" if self.source == "given" else "from the model's identification.json"
+        return f"{ms_text(1e3 * self.delay_s)} ms ({where})"
+
+    def sentence(self) -> str:
+        """``torque delay 3.0 ms (given)``: the line of a command's summary."""
+        return f"torque delay {self.text()}"
+
+    def as_dict(self) -> dict[str, Any]:
+        """The record of ``validation.json`` and ``observe``'s files: the delay in ms, its
+        source and the sentence."""
+        return {"delay_ms": 1e3 * self.delay_s, "source": self.source, "said": self.sentence()}
+
+
+def applied_delay(given_s: float | None, recorded_s: float) -> AppliedDelay | None:
+    """The delay a command applies: ``given_s`` [s] (``--torque-delay``, 0 included) when
+    given, else the model's ``recorded_s`` [s]; None when neither applies one (none given,
+    none recorded)."""
+    if given_s is not None:
+        return AppliedDelay(float(given_s), "given")
+    return AppliedDelay(float(recorded_s), "model") if recorded_s else None
 
 
 def torque_delay(

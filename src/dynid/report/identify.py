@@ -41,6 +41,7 @@ from ..identification.verdict import (
     with_caveat,
     worst,
 )
+from .delay import delay_facts, delay_section
 from .html import (
     bar,
     capitalised,
@@ -669,6 +670,7 @@ def answer(run: RunFiles) -> Answer | None:
             ]
             problems = more + problems
         facts += spring_facts(held)  # where the verdict names a spring: its stiffness
+        facts[:0] = delay_facts(doc)  # a named lag first: the hints after it may be the lag
     rank, p = _rank_fact(doc)
     facts.append(rank)
     problems += p
@@ -684,7 +686,8 @@ def answer(run: RunFiles) -> Answer | None:
         headline = "The identification's record holds no error to judge it by"
         level = "fair"
     shown = frozenset(f for f, _ in FIGURES if f in run.files)
-    sections = [_torques_section(run, held), springs_section(held), _structure_section(doc)]
+    sections = [_torques_section(run, held), delay_section(doc), springs_section(held)]
+    sections.append(_structure_section(doc))
     sections += [_coefficients_section(doc), *terms_sections(doc)]
     return Answer(
         verdict(level, esc(headline) + ".", facts, label),

@@ -28,6 +28,7 @@ from ..identification.verdict import (
     joint_levels,
     judge_prediction,
 )
+from .delay import delay_facts, delay_section
 from .html import capitalised, cell, esc, figure, is_number, percent, section, table, verdict
 from .run import Answer, RunFiles
 from .springs import spring_facts, springs_section
@@ -96,6 +97,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         "the opposite sign",
     ]
     facts[1:1] = spring_facts(doc)  # where the verdict names a spring: its stiffness
+    facts[:0] = delay_facts(doc)  # a named lag first: the hints after it may be the lag
     per = (with_ if isinstance(with_, dict) else without).get("relative_error_percent_per_joint")
     if isinstance(per, list) and per and all(is_number(p) for p in per):
         ratio = _noise_ratios(doc, len(per))
@@ -153,7 +155,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         ),
     )
     shown_label = label if level == judged_level else None  # a worse joint: the level's own
-    sections = (_joint_errors(doc), springs_section(doc), figs)
+    sections = (_joint_errors(doc), delay_section(doc), springs_section(doc), figs)
     return Answer(verdict(level, head, facts, shown_label), sections, shown)
 
 

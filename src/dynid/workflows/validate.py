@@ -76,7 +76,7 @@ from ..identification.residual_dependence import (
 )
 from ..identification.residual_spring import ResidualSpring
 from ..identification.spikes import SPIKES_BEFORE_JUDGING
-from ..identification.torque_delay import TorqueDelay
+from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_delay
 from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -231,6 +231,9 @@ class ValidateResult:
         The lag of the torques behind the positions the residual points to
         (:func:`~dynid.friction.delay_check.validations_delay`); said in ``verdict``'s
         reason when :attr:`~dynid.identification.torque_delay.TorqueDelay.named`.
+    applied_delay : AppliedDelay, optional
+        The delay the recordings were prepared with and where it came from (given, or the
+        model's record); None: none applied.
     """
 
     validation: RecordingsValidation
@@ -251,6 +254,7 @@ class ValidateResult:
     springs: ResidualSpring | None = None
     reversed_columns: tuple[tuple[str, str], ...] = ()
     torque_delay: TorqueDelay | None = None
+    applied_delay: AppliedDelay | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -267,7 +271,10 @@ class ValidateResult:
         ``springs`` (the stiffness per joint the residual points to, when judged:
         :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`) and
         ``torque_delay`` (the torques' lag behind the positions, when named:
-        :meth:`~dynid.identification.torque_delay.TorqueDelay.as_dict`)."""
+        :meth:`~dynid.identification.torque_delay.TorqueDelay.as_dict`) and
+        ``torque_delay_used`` (the delay the recordings were prepared with and its source,
+        when one was applied or given:
+        :meth:`~dynid.identification.torque_delay.AppliedDelay.as_dict`)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
         parts = {
@@ -295,6 +302,7 @@ class ValidateResult:
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
             **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
+            **({"torque_delay_used": a.as_dict()} if (a := self.applied_delay) else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
 
@@ -394,7 +402,7 @@ def validate_files(
         offsets=offsets_of(model),
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
-    verdict, delay = _with_delay(model, verdict, val)
+    verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
     verdict = _signs_first(verdict, opposite, sign_map)
@@ -416,20 +424,35 @@ def validate_files(
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=springs,
-        torque_delay=delay,
-    )
+        torque_delay=delay, applied_delay=applied,
+    )  # fmt: skip
+
+
+def _recorded_delay(model: IdentifiedModel | Robot) -> float:
+    """The delay [s] an identified model was identified with (0: a robot, static data)."""
+    own = model.info.log if isinstance(model, IdentifiedModel) else None
+    return 0.0 if own is None else float(own.torque_delay_s)
 
 
 def _with_delay(
-    model: IdentifiedModel | Robot, verdict: Verdict, val: RecordingsValidation
-) -> tuple[Verdict, TorqueDelay | None]:
+    model: IdentifiedModel | Robot,
+    verdict: Verdict,
+    val: RecordingsValidation,
+    given_s: float | None,
+) -> tuple[Verdict, TorqueDelay | None, AppliedDelay | None]:
     """``verdict`` with the torques' lag behind the positions the residual points to
-    (:func:`~dynid.friction.delay_check.validations_delay`) appended when it is named, and
-    the delay."""
+    (:func:`~dynid.friction.delay_check.validations_delay`) appended when it is named, the
+    delay, and the one the recordings were prepared with (``given_s`` [s], else the
+    model's). Of an identified model the hint is to identify it again with the whole
+    delay (the one applied and the residual's): its coefficients were fitted to the
+    lagging torques."""
+    applied = applied_delay(given_s, _recorded_delay(model))
     delay = validations_delay(model, val.parts)
     if delay is not None and delay.named:
-        verdict = with_hint(verdict, delay.sentence())
-    return verdict, delay
+        before = 0.0 if applied is None else applied.delay_s
+        refit = isinstance(model, IdentifiedModel) and model.info.log is not None
+        verdict = with_hint(verdict, delay.sentence(before, refit=refit))
+    return verdict, delay, applied
 
 
 def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
