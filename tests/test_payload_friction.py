@@ -16,11 +16,13 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.cli.__main__ import main
 from dynid.exceptions import DataError, DynidWarning
 from dynid.feasibility.payload import identify_payload
 from dynid.identification.log import TorqueLog
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
+from dynid.io.static_data import save_static_csv
 from dynid.simulation.trajectories import random_fourier, uniform_times
 
 MASS = 1.2
@@ -117,3 +119,12 @@ def test_terms_given_fix_the_friction_and_an_armature_is_refused(logs):
     assert est.friction_terms.endswith("+ offset") and "stribeck" in est.friction_terms
     with pytest.raises(dynid.OptionError, match="armature"):
         identify_payload(ARM, logs[:1], terms=Structure.parse("armature,viscous"))
+
+
+def test_cli_terms_apply_to_torque_logs_only(tmp_path, capsys):
+    """``payload --terms`` with static data is refused naming the flag, as identify's is."""
+    ctrl = dynid.SimulatedController(ARM, relative_noise=1e-4, rng=np.random.default_rng(5))
+    save_static_csv(tmp_path / "s.csv", dynid.acquire_static(ctrl, 30, np.random.default_rng(6)))
+    argv = ["payload", "--robot", "panda", "--data", str(tmp_path / "s.csv")]
+    assert main([*argv, "--terms", "viscous,offset", "--out", str(tmp_path / "p")]) == 2
+    assert "--terms" in capsys.readouterr().err

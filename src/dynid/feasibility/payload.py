@@ -20,9 +20,12 @@ or a robot's links with its drive's known rotor inertias and its own friction.
 * **torque logs** (one or more :class:`~dynid.identification.log.TorqueLog`): prepared as
   identification prepares them (:mod:`dynid.feasibility.payload_rows`: through the drive,
   each recording and each piece between gaps on its own; an identified model's recorded
-  cut-off and decimation by default), ``Y`` the torque regressor, and the classical
-  friction ``fv, fc, fo`` per joint estimated alongside (what the arm's own friction
-  leaves); the Coulomb columns and the arm's own friction low-passed as the torques were
+  cut-off and decimation by default), ``Y`` the torque regressor, and friction per joint
+  estimated alongside (what the arm's own friction leaves): the classical ``fv, fc, fo``,
+  or, when that leaves more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
+  the torque noise, the friction identification chooses on held-out data from the same
+  recordings (:mod:`dynid.feasibility.payload_friction`), or the one ``terms`` gives;
+  the Coulomb columns and the arm's own friction low-passed as the torques were
   (parallel filtering, as identification's rows); a joint whose measured velocity never
   leaves its noise band (:func:`~dynid.identification.velocity_noise.moving_joints`) does not
   move: its velocity and acceleration are zero in the regressor and its ``fv, fc`` are
