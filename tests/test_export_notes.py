@@ -13,6 +13,7 @@ import re
 import numpy as np
 
 import dynid
+from dynid.friction.laws import law_named
 from dynid.friction.model import ClassicalFriction
 from dynid.io.export import save_robot_files
 from dynid.io.feasible import save_feasible_json
@@ -59,8 +60,8 @@ def test_a_single_export_names_only_files_that_exist(tmp_path):
     for line in lines:
         assert all((tmp_path / name).exists() for name in _named(line)), line
     assert "feasible.json holds it exactly" in lines[0]
-    assert "not written: a TOML export (--out one.toml) would hold it exactly" in lines[0]
-    assert "an MJCF export (--out one.xml) would hold them as armature" in lines[1]
+    assert "a TOML export (--out one.toml, not written) would hold it exactly" in lines[0]
+    assert "an MJCF export (--out one.xml, not written) would hold them as armature" in lines[1]
     assert "a TOML export (--out one.toml) as its [drive] table" in lines[1]
     assert "feasible.json holds it exactly" in lines[2] and "--out one.toml" in lines[2]
 
@@ -88,3 +89,42 @@ def test_a_robot_toml_is_named_as_the_file_that_holds_its_own_friction(tmp_path)
     out = tmp_path / "arm2.urdf"
     lines = said_warnings(lambda: save_export(out, export_robot(toml, out)))[1]
     assert "arm.toml holds it exactly" in lines[0] and "TOML export" not in lines[0], lines
+
+
+def test_a_friction_urdf_cannot_hold_is_said_in_one_sentence(tmp_path):
+    """Regression (the URDF and MJCF warnings of a smooth Stribeck law repeated "smooth_stribeck
+    friction:" per item, MJCF's read "without smooth_stribeck friction: the Stribeck peak",
+    and ended "; feasible.json holds it exactly; not written: a TOML export ..."): how the
+    law is written, what is left out and where it is kept, each said once."""
+    params = _feasible(tmp_path / "feasible.json")
+    doc = json.loads(params.read_text())
+    law = law_named("smooth_stribeck").model(
+        np.column_stack(
+            [
+                np.full(7, 0.2),
+                np.full(7, 0.5),
+                np.full(7, 0.8),
+                np.full(7, 0.08),
+                np.linspace(-0.3, 0.8, 7),
+            ]
+        ),  # fmt: skip
+        np.full(7, 0.01),
+    )
+    doc["linear_friction"] = law_record(law)
+    params.write_text(json.dumps(doc))
+    lines = []
+    for out in ("s.urdf", "s.xml"):
+        lines += said_warnings(
+            lambda p, o: save_export(o, export_robot(p, o)), params, tmp_path / out
+        )[1]
+    said = [x for x in lines if "smooth_stribeck" in x]
+    assert len(said) == 2, lines
+    for line in said:
+        assert line.count("smooth_stribeck friction") == 1, line
+        assert "friction without smooth_stribeck" not in line and "; not written:" not in line
+        assert ", written as the nonnegative viscous and Coulomb friction closest" in line
+        assert ", without the Stribeck peak fs - fc at low speed (no per-joint term)" in line
+        assert " and the offsets fo (up to +0.8 N m at joint 7); feasible.json holds it " in line
+        assert line.endswith(
+            "exactly, and a TOML export (--out s.toml, not written) would hold it exactly"
+        )

@@ -36,6 +36,11 @@ the torques checked include the drive's known rotor inertias, reflected through 
 (K^T diag(I_a) K ddq: k^2 I_a ddq on an uncoupled joint of gear ratio k); a drive that
 leaves them to be identified is said to leave them out of the torque margins.
 
+A known load (a gripper, a tool) counts in the torque margins through --robot: the arm
+carrying it as a robot TOML, such as robot_with_payload.toml of `dynid payload`, or one
+written from known values with Robot.with_tool and toml_from_robot (fk's --tool is a
+frame's offset, not a load, and no command takes a load's mass by itself).
+
 --range qJ=LO:HI,... keeps joints within narrower ranges [rad] than their limits (qJ or J
 a joint's number from 1, or its name), the position margin kept inside them: an arm whose
 joints turn +-2 pi reaches the floor and itself in most of that range, and a motion over

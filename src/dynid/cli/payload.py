@@ -3,7 +3,10 @@
 The arm's model is known: --robot (built-in or a description with its parameters),
 --model identification.json (identified) or --params feasible.json (feasible). --data is
 recorded with the load: static data (q, M, g; --gravity-only uses g alone and gives the
-mass and CoM only) or torque logs (classical friction is estimated alongside; several
+mass and CoM only) or torque logs (friction is estimated alongside: the classical
+viscous, Coulomb and offset per joint, or, when that leaves more than 3 x the torque
+noise, the friction law identify chooses on held-out data from the same recordings (a
+smooth Coulomb, a Stribeck bump), or the one --terms names; several
 recordings, or a folder of them: each recording, and each piece of one cut at a gap
 longer than --max-gap, is filtered on its own and never joined to another; --model's
 recorded cut-off and decimation are reused unless --cutoff is given). The arm's torques
@@ -13,8 +16,10 @@ a feasible.json's drive and friction. With --unloaded DATA0 ... (the same kind o
 without the load) the arm is identified from DATA0 first (difference method), with the
 structure identify chooses (or --model's); it cancels the arm's model errors when DATA0
 repeats the loaded motion (the recordings --model was identified from give the model
-itself, which a note says). The estimate is physically consistent (pseudo-inertia LMI).
---columns/--units read files of other tools.
+itself, which a note says). Without --unloaded, recordings --model was identified from
+(the same samples, whatever the files are called) are refused: that model already holds
+the load. The estimate is physically consistent (pseudo-inertia LMI). --columns/--units
+read files of other tools.
 
 A mass less than 3 standard deviations above zero, a CoM farther from --frame than the
 arm is long, or (--robot, --params) measured torques more than 5 % and 3 standard
@@ -144,6 +149,17 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "its decimation, else the one identification reads from the logs' motion; static "
         "data are not filtered)" + CUTOFF_NONE_HELP,
     )
+    p.add_argument(
+        "--terms",
+        default=None,
+        metavar="TERMS",
+        help="torque logs: the friction estimated beside the load, as identify's --terms "
+        "names it (its friction parts: viscous, quadratic, coulomb, smooth[:W], "
+        "stribeck[:V], offset; an offset per joint always); default: auto, the classical "
+        "viscous,coulomb,offset, or, when that leaves more than 3 x the torque noise, the "
+        "friction identify chooses on held-out data from the same recordings if it leaves "
+        "less",
+    )
     add_drive_option(p)
     add_q_start_option(p)
     add_log_options(p)
@@ -195,6 +211,7 @@ def _options(args: argparse.Namespace, n: int, drive: Any) -> dict[str, Any]:
         drive=drive,
         feasible=args.params,
         q_start=args.q_start,
+        terms=args.terms,
     )
 
 

@@ -20,9 +20,12 @@ or a robot's links with its drive's known rotor inertias and its own friction.
 * **torque logs** (one or more :class:`~dynid.identification.log.TorqueLog`): prepared as
   identification prepares them (:mod:`dynid.feasibility.payload_rows`: through the drive,
   each recording and each piece between gaps on its own; an identified model's recorded
-  cut-off and decimation by default), ``Y`` the torque regressor, and the classical
-  friction ``fv, fc, fo`` per joint estimated alongside (what the arm's own friction
-  leaves); the Coulomb columns and the arm's own friction low-passed as the torques were
+  cut-off and decimation by default), ``Y`` the torque regressor, and friction per joint
+  estimated alongside (what the arm's own friction leaves): the classical ``fv, fc, fo``,
+  or, when that leaves more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
+  the torque noise, the friction identification chooses on held-out data from the same
+  recordings (:mod:`dynid.feasibility.payload_friction`), or the one ``terms`` gives;
+  the Coulomb columns and the arm's own friction low-passed as the torques were
   (parallel filtering, as identification's rows); a joint whose measured velocity never
   leaves its noise band (:func:`~dynid.identification.velocity_noise.moving_joints`) does not
   move: its velocity and acceleration are zero in the regressor and its ``fv, fc`` are
@@ -104,7 +107,14 @@ from ..model.drive import Drive
 from ..model.inertia import INERTIA_ORDER
 from ..model.robot import Robot
 from .lmi import phi_from_pseudo_inertia, pseudo_inertia
-from .payload_arm import ArmFriction, ArmModel, arm_model, model_structure, unloaded_arm
+from .payload_arm import (
+    ArmFriction,
+    ArmModel,
+    arm_model,
+    holds_the_load,
+    model_structure,
+    unloaded_arm,
+)
 from .payload_difference import JudgedResidual, arm_residual, judged_residual, piece_states
 from .payload_doubts import doubts_about, inertia_doubts, misfit_doubts, undetermined_inertia
 from .payload_fit import (
@@ -116,6 +126,14 @@ from .payload_fit import (
     misfit_covariance,
     serial_correlation_factor,
     summary,
+)
+from .payload_friction import (
+    CLASSICAL_NAME,
+    chosen_friction,
+    classical_parts,
+    friction_structure,
+    friction_term,
+    rows_rms,
 )
 from .payload_rows import (
     filtered_noise_rms,
@@ -196,7 +214,14 @@ class PayloadEstimate:
     n_rows : int
     friction : ndarray, shape (n, 3), or None
         ``fv, fc, fo`` per joint estimated alongside (torque logs): the friction beyond
-        the arm's own model's.
+        the arm's own model's (zero where :attr:`friction_terms` holds none; a smooth
+        Coulomb's coefficient is its ``fc``).
+    friction_terms : str
+        Torque logs: the friction estimated alongside, as ``dynid identify`` names a
+        structure (``"viscous + coulomb + offset"``: the classical, with the plain sign);
+        empty for static data.
+    friction_labels : tuple of str
+        Torque logs: the labels of its coefficients (``fv1, fc1, fsp1, fo1, ...``).
     notes : tuple of str
     doubts : tuple of str
         Why the estimate is not a load to trust (module docstring), a residual judged
@@ -266,6 +291,8 @@ class PayloadEstimate:
     noise_rms: float | None = None
     torque_scale: TorqueScale | None = None
     judged: JudgedResidual | None = None
+    friction_terms: str = ""
+    friction_labels: tuple[str, ...] = ()
 
     @property
     def plausible(self) -> bool:
@@ -301,6 +328,7 @@ def identify_payload(
     structure: Structure | Literal["auto"] | None = None,
     drive: Drive | None = None,
     friction: ArmFriction = "own",
+    terms: Structure | Literal["auto"] | None = "auto",
     margin: float = 1e-6,
     cutoff_hz: float | None | Literal["recorded"] = "recorded",
     decimate: int | None = None,
@@ -331,6 +359,9 @@ def identify_payload(
         ``unloaded``; default: an identified model's own, else chosen on held-out data.
     drive, friction
         As :func:`~dynid.feasibility.payload_arm.arm_model`.
+    terms : Structure, "auto" or None
+        Torque logs: the friction beside the load (:mod:`.payload_friction`): None the
+        classical, a structure's friction parts, or ``"auto"`` (default).
     margin : float
         LMI margin: ``lambda_min(J) >= margin tr(J)``.
     cutoff_hz : float, None or "recorded"
@@ -364,7 +395,8 @@ def identify_payload(
         The least-squares mass is not positive (no load, or a wrong model of the arm, or
         torques of another scale than the arm description's: then named with the load's
         mass over the factor; a fit over 3 x the torque noise: named with the ratio); a
-        drive other than the model's; a recording without a piece long enough to filter.
+        drive other than the model's; a recording without a piece long enough to filter;
+        without ``unloaded``, one an identified ``arm`` was identified from (it holds the load).
     SolverError
         The constrained problem failed.
 
@@ -377,15 +409,8 @@ def identify_payload(
     f = kin.frame(frame)
     if f.link == 0:
         raise ModelError(f"frame {frame!r} is on the base; a load there does not move")
-    n, k = kin.n, f.link
-    static = isinstance(data, StaticDataset)
-    items = _items(data, "data")
-    for one in items:
-        if one.q.shape[-1] != n:
-            raise ShapeError(f"data have {one.q.shape[-1]} joints; robot {kin.name!r} has {n}")
-    base = None if unloaded is None else _items(unloaded, "unloaded")
-    if base is not None and isinstance(unloaded, StaticDataset) != static:
-        raise ShapeError("unloaded must be the same kind of data as data (static or log)")
+    k = f.link
+    static, items, base = _checked_items(data, unloaded, kin)
     notes: list[str] = []
     A, cols = link_params_from_frame(f.T_link_frame), slice(10 * (k - 1), 10 * k)
     kept: NDArray[np.bool_] | None = None
@@ -399,7 +424,7 @@ def identify_payload(
         )
     else:
         opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
-        opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol)
+        opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol, terms=terms)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
         W, yv, route, kept, record, differenced, scale, against = _log_route(
@@ -409,6 +434,30 @@ def identify_payload(
     route += ", difference" if differenced else ""
     scaled = None if described is None else scale
     return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, against)
+
+
+#: One data set: static data or one recording.
+_Data = StaticDataset | TorqueLog
+
+
+def _checked_items(
+    data: StaticDataset | TorqueLog | Sequence[TorqueLog],
+    unloaded: StaticDataset | TorqueLog | Sequence[TorqueLog] | None,
+    kin: Robot,
+) -> tuple[
+    bool, tuple[StaticDataset | TorqueLog, ...], tuple[StaticDataset | TorqueLog, ...] | None
+]:
+    """Whether ``data`` are static, its data sets and ``unloaded``'s (None), checked: the
+    robot's joint count, and the same kind of data for both (a ShapeError otherwise)."""
+    static = isinstance(data, StaticDataset)
+    items = _items(data, "data")
+    for one in items:
+        if one.q.shape[-1] != kin.n:
+            raise ShapeError(f"data have {one.q.shape[-1]} joints; robot {kin.name!r} has {kin.n}")
+    base = None if unloaded is None else _items(unloaded, "unloaded")
+    if base is not None and isinstance(unloaded, StaticDataset) != static:
+        raise ShapeError("unloaded must be the same kind of data as data (static or log)")
+    return static, items, base
 
 
 def _static_route(
@@ -550,7 +599,7 @@ def _estimate(
         condition_number=fit.condition_number,
         residual_rms=fit.residual_rms,
         n_rows=fit.n_rows,
-        friction=None if static else est[10:].reshape(n, 3),
+        friction=None if static else classical_parts(est[10:], record["friction_labels"], n),
         notes=tuple(notes),
         doubts=doubts,
         undetermined=undetermined,
@@ -708,6 +757,8 @@ def _log_route(
     prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used}
     prep |= {"max_gap_s": gap, "sample_rate_hz": rec.pieces[0].sample_rate_hz}
     if base is None:
+        if isinstance(inner, IdentifiedModel) and (why := holds_the_load(inner, rec.summary())):
+            raise DataError(why)
         the_arm, differenced = arm_model(arm, drive=d, friction=opt["friction"]), False
     else:
         structure = opt["structure"]
@@ -727,17 +778,62 @@ def _log_route(
         )
         differenced = _difference_said(inner, the_arm, note, notes)
     still = still_joints(logs, d)
-    W, yv, route, kept, modelled = log_rows(the_arm, rec, still, cols, A, notes)
+    fr, rows = _friction_rows(the_arm, rec, still, cols, A, notes, opt["terms"], d)
+    W, yv, route, kept, modelled = rows
     scale: _ScaleRows = (yv, modelled, W, kept, 10)
     against = None
     if base is not None:
         rec0 = _prepared_base(kin, base, base_names, rec.cutoff_hz, used, opt)
-        against = _arm_on_base(the_arm, rec0, rec, still, cols, A)
+        against = _arm_on_base(the_arm, rec0, rec, still, cols, A, fr)
         if described is not None:
-            scale = _base_scale(described, rec0, base, cols, A, d)
+            scale = _base_scale(described, rec0, base, cols, A, d, fr)
     record: dict[str, Any] = {"preprocessing": prep, "recordings": rec.summary()}
+    name = CLASSICAL_NAME if fr is None else fr.name.removeprefix("links + ")
+    record |= {"friction_terms": name, "friction_labels": friction_term(fr, rec, kin.n).labels}
     record |= {"skipped": rec.skipped, "noise_rms": filtered_noise_rms(rec)}
     return W, yv, route, kept, record, differenced, scale, against
+
+
+def _friction_rows(
+    arm: ArmModel,
+    rec: Recordings,
+    still: NDArray[np.bool_],
+    cols: slice,
+    A: NDArray[np.float64],
+    notes: list[str],
+    terms: Structure | Literal["auto"] | None,
+    drive: Drive | None,
+) -> tuple[Structure | None, tuple[Any, ...]]:
+    """The friction beside the load (None: classical) and the rows of
+    :func:`~dynid.feasibility.payload_rows.log_rows` with it: ``terms`` given, or
+    (``"auto"``) the classical unless it leaves more than
+    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise and the
+    friction ``dynid identify`` chooses on these recordings
+    (:func:`~dynid.feasibility.payload_friction.chosen_friction`) leaves less; the choice
+    noted."""
+    start = len(notes)
+    given = friction_structure(terms) if isinstance(terms, Structure) else None
+    rows = log_rows(arm, rec, still, cols, A, notes, given)
+    noise = filtered_noise_rms(rec)
+    if terms != "auto" or not noise:
+        return given, rows
+    first = rows_rms(rows[0], rows[1], rows[3])
+    if first <= FLOOR_FAIR * noise or (chosen := chosen_friction(arm.robot, rec, drive)) is None:
+        return None, rows
+    mine: list[str] = []
+    other = log_rows(arm, rec, still, cols, A, mine, chosen)
+    second = rows_rms(other[0], other[1], other[3])
+    name = chosen.name.removeprefix("links + ")
+    said = (
+        f"the classical friction fv, fc, fo beside the load leaves {first / noise:.3g} x the "
+        f"torque noise; the friction dynid identify chooses on held-out data from these "
+        f"recordings, {name}, leaves {second / noise:.3g} x"
+    )
+    if second >= first:
+        notes.append(f"{said}: the classical kept")
+        return None, rows
+    notes[start:] = [*mine, f"{said}: estimated beside the load instead (--terms gives one)"]
+    return chosen, other
 
 
 def _prepared_base(
@@ -770,15 +866,16 @@ def _arm_on_base(
     still: NDArray[np.bool_],
     cols: slice,
     A: NDArray[np.float64],
+    friction: Structure | None = None,
 ) -> _Unloaded:
     """The arm's residual on the prepared recordings without the load ``rec0``
-    (:func:`~dynid.feasibility.payload_difference.arm_residual`: the classical friction
-    fitted as beside the load), the states of the loaded ``rec`` and unloaded samples
-    (``still`` joints zeroed in both), the unloaded samples' pieces and the noise the
-    torques leave in that residual."""
+    (:func:`~dynid.feasibility.payload_difference.arm_residual`: the friction
+    ``friction`` fitted as beside the load, None: classical), the states of the loaded
+    ``rec`` and unloaded samples (``still`` joints zeroed in both), the unloaded samples'
+    pieces and the noise the torques leave in that residual."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        W0, y0, _, kept0, _ = log_rows(arm, rec0, still, cols, A, [])
+        W0, y0, _, kept0, _ = log_rows(arm, rec0, still, cols, A, [], friction)
     x1, _ = piece_states(rec.pieces, still)
     x0, labels0 = piece_states(rec0.pieces, still)
     r0 = arm_residual(W0, y0, kept0, arm.robot.n)
@@ -792,13 +889,15 @@ def _base_scale(
     cols: slice,
     A: NDArray[np.float64],
     drive: Drive | None,
+    friction: Structure | None = None,
 ) -> _ScaleRows:
     """The rows of the torques' scale on the recordings without the load ``rec0``
     (:func:`_prepared_base`; ``base`` as read): the description's torques (its whole
-    model, ``described``) and the classical friction per joint."""
+    model, ``described``) and the friction ``friction`` per joint (None: classical)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        W, y, _, kept, own = log_rows(described, rec0, still_joints(base, drive), cols, A, [])
+        still = still_joints(base, drive)
+        W, y, _, kept, own = log_rows(described, rec0, still, cols, A, [], friction)
     return y, own, W[:, 10:], kept[10:], 0
 
 

@@ -24,9 +24,10 @@ or the one given, at the loaded data's cut-off and decimation.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Literal, Protocol
+from pathlib import Path
+from typing import Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,6 +51,7 @@ __all__ = [
     "ArmModel",
     "FrictionTorques",
     "arm_model",
+    "holds_the_load",
     "model_structure",
     "unloaded_arm",
 ]
@@ -195,6 +197,41 @@ def model_structure(model: IdentifiedModel) -> Structure | None:
     if terms is None:
         return None
     return Structure.parse(",".join(str(t) for t in terms))
+
+
+def holds_the_load(model: IdentifiedModel, recordings: Sequence[Mapping[str, Any]]) -> str | None:
+    """Why ``model`` already holds the load of the loaded ``recordings`` (their summary,
+    :meth:`~dynid.identification.recordings.Recordings.summary`), or None: one of them is
+    a recording the model was identified from, by the SHA-256 of its samples where both
+    records hold one (whatever the files are called), else (a model recorded without it)
+    by its file name and number of samples. The model's base parameters then hold the
+    load's, and the load left beside them is none."""
+    own = [dict(r) for r in model.info.recordings]
+    sums = {r["sha256"] for r in own if "sha256" in r}
+    same: list[str] = []
+    how = "the same samples"
+    for r in recordings:
+        name = Path(str(r.get("file", ""))).name
+        if "sha256" in r and sums:
+            if r["sha256"] in sums:
+                same.append(name)
+            continue
+        for m in own:  # a model recorded without digests: the name and sample count
+            if Path(str(m.get("file", ""))).name == name and m.get("recorded") == r.get(
+                "recorded", m.get("recorded")
+            ):
+                same.append(name)
+                how = "the same file name and number of samples"
+                break
+    if not same:
+        return None
+    which = "this recording" if len(same) == 1 else "these recordings"
+    return (
+        f"{', '.join(same)}: --model was identified from {which} ({how}), so its "
+        "base parameters already hold the load and none is left beside them; hint: --robot "
+        "(the arm's description), --model of the arm identified without the load, or "
+        "--unloaded recordings of the arm without the load (the difference method)"
+    )
 
 
 def unloaded_arm(

@@ -92,8 +92,10 @@ def doubts_about(
         out.append(
             f"the load's mass {m:.3g} kg is not significantly above zero (std {sm:.2g} kg, "
             f"{m / sm if sm > 0 else float('inf'):.1f} std; at least {MIN_MASS_SIGMAS:g} "
-            "needed): the data cannot tell this load from none (unloaded data, or a load too "
-            "light for them); its CoM and inertia are noise divided by that mass"
+            "needed): the data cannot tell this load from none (unloaded data, a load too "
+            "light for them, or an identified arm model that holds the load already: one "
+            "identified from loaded recordings); its CoM and inertia are noise divided by "
+            "that mass"
         )
     reach = arm_length(robot)
     dist = float(np.linalg.norm(c))

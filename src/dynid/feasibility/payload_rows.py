@@ -35,13 +35,14 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.log_rows import stepped_columns
 from ..identification.model import IdentifiedModel
 from ..identification.recordings import Recordings
+from ..identification.structure import Structure
 from ..identification.velocity_noise import moving_joints
 from ..model.drive import Drive
 from ..regressors.static import static_regressor_columns, static_rows, static_vector
-from ..regressors.terms import LinearFriction
 from ..regressors.torque import torque_regressor
 from ..signals import lowpass_noise_gain
 from .payload_arm import ArmModel, FrictionTorques
+from .payload_friction import friction_term
 
 __all__ = [
     "AS_WELL",
@@ -172,13 +173,15 @@ def log_rows(
     cols: slice,
     A: NDArray[np.float64],
     notes: list[str],
+    friction: Structure | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], str, NDArray[np.bool_], NDArray[np.float64]]:
-    """Regressor rows (the load's parameters, then classical friction per joint), targets
-    (measured torques minus the arm's) of prepared recordings, the columns fitted
-    (the viscous and Coulomb friction of ``still`` joints are not: their velocity is
-    noise, taken as zero), and the arm's torques subtracted [N m] (its friction included
-    when subtracted). The rows are held whole (``N n`` rows of ``10 + 3 n``
-    columns), not the ``10 n`` columns of every link.
+    """Regressor rows (the load's parameters, then the friction per joint: classical, or
+    that of ``friction``, :func:`~dynid.feasibility.payload_friction.friction_term`),
+    targets (measured torques minus the arm's) of prepared recordings, the columns fitted
+    (a ``still`` joint's friction is not, but for its offset: its velocity is noise, taken
+    as zero), and the arm's torques subtracted [N m] (its friction included when
+    subtracted). The rows are held whole (``N n`` rows of ``10 + 3 n`` columns for the
+    classical friction), not the ``10 n`` columns of every link.
 
     The arm's own friction is kept in its torques when the rows explain the targets with
     it better than without it (a smaller least-squares residual, the same columns
@@ -187,7 +190,12 @@ def log_rows(
     it, the classical friction fitted alongside is the arm's whole friction."""
     robot = arm.robot
     n = robot.n
-    classical = LinearFriction(Drive.identity(n))
+    classical = friction_term(friction, data, n)
+    alongside = (
+        "classical friction fv, fc, fo"
+        if friction is None
+        else f"friction {friction.name.removeprefix('links + ')}"
+    )
     own = None if arm.friction is None else _ArmFriction(arm.friction, still)
     Ws, ys, fs, taus = [], [], [], []
     for piece in data.pieces:
@@ -202,15 +210,12 @@ def log_rows(
         if own is not None:
             fs.append(stepped_columns(own, log, **piece.filtering).ravel())
     kept = np.ones(Ws[0].shape[-1], dtype=bool)
-    kept[10:] = ~(np.repeat(still, 3) & (np.arange(3 * n) % 3 != 2))
+    kept[10:] = [not (still[_joint(lab)] and not lab.startswith("fo")) for lab in classical.labels]
     W, y = np.concatenate(Ws), np.concatenate(ys)
     if fs:
-        y = _with_own_friction(W[:, kept], y, np.concatenate(fs), arm, notes)
+        y = _with_own_friction(W[:, kept], y, np.concatenate(fs), arm, notes, alongside)
     else:
-        notes.append(
-            "classical friction fv, fc, fo per joint estimated alongside (the arm's model "
-            "has no friction)"
-        )
+        notes.append(f"{alongside} per joint estimated alongside (the arm's model has no friction)")
     if len(data.pieces) > 1:
         notes.append(
             f"{data.source}: each recording and each piece between gaps filtered on its own"
@@ -224,6 +229,11 @@ def log_rows(
     k = len(data.names)
     route = "torque log" if k == 1 else f"{k} torque logs"
     return W, y, route, kept, np.concatenate(taus) - y
+
+
+def _joint(label: str) -> int:
+    """The 0-based joint of a friction coefficient's label (``fc3``: 2)."""
+    return int(label[len(label.rstrip("0123456789")) :]) - 1
 
 
 def filtered_noise_rms(data: Recordings) -> float | None:
@@ -251,9 +261,11 @@ def _with_own_friction(
     f: NDArray[np.float64],
     arm: ArmModel,
     notes: list[str],
+    alongside: str,
 ) -> NDArray[np.float64]:
     """The targets ``y`` [N m] less the arm's own friction ``f`` when that explains the
-    rows ``W`` better (:func:`log_rows`), else ``y``; the choice noted."""
+    rows ``W`` better (:func:`log_rows`), else ``y``; the choice noted (``alongside``:
+    the friction estimated beside the load, as :func:`own_friction_note` names it)."""
     scale = np.linalg.norm(W, axis=0)
     Ws = W / np.where(scale > 0, scale, 1.0)
 
@@ -263,7 +275,7 @@ def _with_own_friction(
 
     law = arm.friction.kind if arm.friction is not None else "?"
     own, bare = rms(y - f), rms(y)
-    notes.append(own_friction_note(law, own, bare))
+    notes.append(own_friction_note(law, own, bare, alongside))
     return y - f if own <= bare else y
 
 
@@ -271,23 +283,25 @@ def _with_own_friction(
 AS_WELL = 0.01
 
 
-def own_friction_note(law: str, own: float, bare: float) -> str:
+def own_friction_note(
+    law: str, own: float, bare: float, alongside: str = "classical friction fv, fc, fo"
+) -> str:
     """The note of the choice :func:`log_rows` makes: the arm's own friction (of law
     ``law``) subtracted when the residual RMS [N m] with it, ``own``, is not above the one
     without it, ``bare``; else left out, "better" only when ``bare`` is lower by more
     than :data:`AS_WELL`, "as well" otherwise. The two printed with the digits that tell
-    them apart."""
+    them apart; ``alongside`` names the friction estimated beside the load."""
     a, b = _apart(own, bare)
     if own <= bare:
         return (
-            f"the arm's own friction ({law}) subtracted, classical friction fv, fc, fo per "
+            f"the arm's own friction ({law}) subtracted, {alongside} per "
             f"joint estimated alongside as its correction (residual RMS {a} N m; "
             f"{b} without the arm's friction)"
         )
     how = "better" if own - bare > AS_WELL * own else "as well (within 1 %) as with it"
     return (
-        f"the arm's own friction ({law}) left out: the loaded data follow the classical "
-        f"friction fv, fc, fo estimated alongside {how} (residual RMS {b} N m; {a} with "
+        f"the arm's own friction ({law}) left out: the loaded data follow the "
+        f"{alongside} estimated alongside {how} (residual RMS {b} N m; {a} with "
         "the arm's friction)"
     )
 

@@ -36,6 +36,7 @@ stay aligned in time.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -53,12 +54,24 @@ __all__ = [
     "TorqueLog",
     "default_max_gap",
     "jitter_text",
+    "log_digest",
     "timing_notes",
     "joint_side_log",
     "recorded_side_log",
     "velocity_note",
     "with_derived_velocities",
 ]
+
+
+def log_digest(log: TorqueLog) -> str:
+    """The SHA-256 (hex) of a log's samples as read: its times [s], positions [rad],
+    velocities [rad/s] and torques [N m], float64 in order; the same recording read the
+    same way gives the same digest whatever its file is called."""
+    h = hashlib.sha256()
+    for a in (log.t, log.q, log.dq, log.tau):
+        h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+    return h.hexdigest()
+
 
 #: Default cutoff of the zero-phase low-pass for identification and validation [Hz].
 #: Gaz et al. 2019 filtered at 1 Hz; that attenuates the paper's own validation sinusoid

@@ -55,7 +55,7 @@ from .dataset import TorqueRoute
 from .derived_band import derived_velocity_band
 from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
-from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
+from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, log_digest
 from .log_rows import log_blocks, still_columns
 from .pieces import (
     WRAP_SPAN,
@@ -207,6 +207,9 @@ class Recordings(TorqueRoute):
         ``band_gain * band`` too.
     counts : tuple of SampleCounts
         Per recording, where its samples went (empty: not counted).
+    digests : tuple of str
+        Per recording, the SHA-256 of its samples as read
+        (:func:`~dynid.identification.log.log_digest`; empty: not taken).
     """
 
     pieces: tuple[PreparedLog, ...]
@@ -223,6 +226,7 @@ class Recordings(TorqueRoute):
     n_recorded: int = 0
     band_gain: float = 1.0
     counts: tuple[SampleCounts, ...] = ()
+    digests: tuple[str, ...] = ()
 
     @property
     def n(self) -> int:
@@ -347,8 +351,9 @@ class Recordings(TorqueRoute):
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
         ``decimate`` (every k-th sample kept: at its own rate, 10 times the cut-off or
-        more), the ``gaps`` it was cut at (``[t_before, length]`` [s] each, when any), and
-        where the others went (:meth:`SampleCounts.as_dict`) when counted."""
+        more), the ``gaps`` it was cut at (``[t_before, length]`` [s] each, when any),
+        where the others went (:meth:`SampleCounts.as_dict`) when counted, and the
+        ``sha256`` of its samples as read when taken (:attr:`digests`)."""
         out = []
         for r, name in enumerate(self.names):
             mine = [p for p, k in zip(self.pieces, self.recording, strict=True) if k == r]
@@ -363,6 +368,8 @@ class Recordings(TorqueRoute):
                 rec["gaps"] = [[t, length] for t, length in self.gaps[r]]
             if self.counts:
                 rec.update(self.counts[r].as_dict())
+            if r < len(self.digests):
+                rec["sha256"] = self.digests[r]
             out.append(rec)
         return tuple(out)
 
@@ -549,6 +556,7 @@ def prepare_recordings(
         gaps=tuple(gaps),
         n_recorded=sum(log.n_samples for log in logs),
         counts=_counts(logs, pieces, gone),
+        digests=tuple(log_digest(log) for log in logs),
     )
 
 

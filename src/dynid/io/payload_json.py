@@ -18,6 +18,7 @@
                       "data": "loaded"} | null,
      "preprocessing": {"cutoff_hz": ..., "cutoff_source": "model", "decimate": ...,
                        "max_gap_s": null} | null,
+     "friction_terms": "viscous + coulomb + offset" | null,
      "recordings": [{"file": ..., "pieces": ..., "samples": ..., "duration_s": ...}],
      "units": {...}, "conventions": {...}}
 
@@ -52,7 +53,11 @@ from 1 is a doubt; ``judged`` is false when the fit with the factor leaves more 
 load to trust).
 ``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
 ``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
-bridged [s], null for the default rule); null for static data. Floats use Python's
+bridged [s], null for the default rule); null for static data. ``friction_terms`` names
+the friction estimated beside the load from torque logs as ``dynid identify`` names a
+structure (the classical ``viscous + coulomb + offset``, or the one chosen on held-out
+data or given by ``--terms``: :mod:`dynid.feasibility.payload_friction`); null for static
+data. Floats use Python's
 shortest round-trip representation.
 """
 
@@ -132,6 +137,7 @@ def payload_to_dict(
             "undetermined_inertia": list(est.undetermined),
             "torque_scale": _scale(est),
             "preprocessing": dict(est.preprocessing) or None,
+            "friction_terms": est.friction_terms or None,
             "recordings": [dict(r) for r in est.recordings],
             "units": {
                 "mass": "kg",

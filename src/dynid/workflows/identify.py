@@ -86,7 +86,14 @@ from .recordings import (
     unwrapped_recorded,
 )
 
-__all__ = ["ColumnSpec", "IdentifyOptions", "IdentifyResult", "data_files", "identify_files"]
+__all__ = [
+    "ColumnSpec",
+    "IdentifyOptions",
+    "IdentifyResult",
+    "data_files",
+    "identify_files",
+    "parsed_terms",
+]
 
 
 def _columns(spec: ColumnSpec | None, cutoff_hz: Cutoff, drive: Drive | None) -> Any:
@@ -151,8 +158,15 @@ def _record(model: IdentifiedModel, spec: ColumnSpec | None) -> IdentifiedModel:
     return dataclasses.replace(model, info=info)
 
 
-def _terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
-    """``terms``: ``"auto"``/None (chosen on held-out data) or the terms named."""
+def parsed_terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
+    """``terms``: ``"auto"``/None (chosen on held-out data) or the terms named
+    (``"viscous,smooth:10,offset"``, :meth:`~dynid.identification.structure.Structure.parse`).
+
+    Raises
+    ------
+    OptionError
+        An empty list, a term named twice, or one unknown (``field`` ``terms``).
+    """
     if terms is None or terms == "auto":
         return "auto"
     if isinstance(terms, Structure):
@@ -301,7 +315,9 @@ class IdentifyOptions:
             "--consistent, then dynid retrieve",
         )
         if self.terms is not None and not isinstance(self.terms, Structure):
-            _terms(self.terms)  # parsed now: a misspelt term is refused before any file is read
+            parsed_terms(
+                self.terms
+            )  # parsed now: a misspelt term is refused before any file is read
 
     def sdp(self) -> SDPOptions:
         """The settings of the convex fit (``consistent``)."""
@@ -432,7 +448,7 @@ def _identify(
             robot,
             logs,
             [p.name for p in paths],
-            structure=_terms(opt.terms),
+            structure=parsed_terms(opt.terms),
             max_std_percent=opt.max_std_percent,
             rtol=opt.rtol,
             max_gap_s=opt.max_gap_s,
@@ -601,7 +617,7 @@ def _identify_consistent(
                 robot,
                 logs,
                 names=[p.name for p in paths],
-                structure=_terms(opt.terms),
+                structure=parsed_terms(opt.terms),
                 rtol=opt.rtol,
                 drive=opt.drive,
                 estimator=opt.estimator,

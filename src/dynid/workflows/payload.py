@@ -12,6 +12,9 @@ every policy the command applies, so that the Python API behaves as the command 
 * Torque logs are prepared as identification prepared the model's (its recorded cut-off
   and decimation unless ``cutoff_hz`` is given; each recording, and each piece of one cut
   at a gap longer than ``max_gap_s``, on its own); what was used is recorded.
+* Torque logs: the friction estimated beside the load is the classical, or the one
+  ``identify`` chooses from the same recordings when the classical leaves more than
+  3 x the torque noise, or ``terms`` (:mod:`dynid.feasibility.payload_friction`).
 * ``gravity_only`` applies to static data; ``unloaded`` (the difference method) is data
   of the same kind: one static file, or one or more torque logs.
 """
@@ -22,7 +25,7 @@ import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from ..exceptions import DataError, ModelError, OptionError
 from ..feasibility.payload import (
@@ -32,14 +35,16 @@ from ..feasibility.payload import (
     robot_with_payload,
 )
 from ..feasibility.payload_arm import ArmFriction
+from ..feasibility.payload_friction import friction_structure
 from ..identification.model import IdentifiedModel
 from ..identification.spikes import SPIKES_BEFORE_FIT
+from ..identification.structure import Structure
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .export import ExportRobotOptions, RobotExport, export_robot
-from .identify import data_files
+from .identify import data_files, parsed_terms
 from .options import Cutoff, library_cutoff, velocity_cutoff
 from .recordings import despiked_recordings, read_recordings
 
@@ -127,6 +132,7 @@ def identify_payload_files(
     drive: Drive | None = None,
     feasible: str | Path | None = None,
     q_start: tuple[float, ...] | None = None,
+    terms: str | Structure | None = None,
 ) -> PayloadFileResult:
     """The load fixed to ``frame`` from data recorded with it (module docstring).
 
@@ -164,6 +170,9 @@ def identify_payload_files(
         Torque logs: the joint positions [rad] at the first sample of the one motor-side
         log ``data`` whose motor encoders wrap every turn
         (:func:`~dynid.workflows.recordings.given_start`).
+    terms : str or Structure, optional
+        Torque logs: the friction beside the load, as ``identify``'s ``terms`` names it
+        (default ``"auto"``; :func:`~dynid.feasibility.payload.identify_payload`).
 
     Returns
     -------
@@ -175,8 +184,12 @@ def identify_payload_files(
         ``frame`` is not a frame of the arm.
     DataError
         A bad file; several static data files; ``gravity_only`` with torque logs; a
-        recording in other units or without a piece long enough to filter (each named).
+        recording in other units or without a piece long enough to filter (each named); one
+        ``arm`` was identified from, without ``unloaded``.
+    OptionError
+        ``terms`` with static data, or naming an unknown term, an armature or a spring.
     """
+    structure = _friction_terms(terms)
     kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
     kin.frame(frame)  # an unknown frame is the option's error, not a file's
     paths = data_files(data)
@@ -193,12 +206,7 @@ def identify_payload_files(
     kind = data_kind(paths[0], cmap)
     common: dict[str, Any] = dict(frame=frame, drive=drive, friction=friction)
     if kind != "torque_log":
-        if q_start is not None:
-            raise OptionError("applies to torque logs, not static data", field="q_start")
-        if cutoff_hz is not None:
-            raise DataError(
-                "--cutoff applies to torque logs (their low-pass); static data are not filtered"
-            )
+        _logs_only(q_start=q_start, terms=terms, cutoff_hz=cutoff_hz)
         return _static(arm, kin, paths, base, cmap, drop_invalid, gravity_only, common)
     if gravity_only:
         raise DataError("--gravity-only applies to static data (q, g), not to a torque log")
@@ -225,10 +233,32 @@ def identify_payload_files(
         unloaded_names=None if without_rec is None else without_rec.names,
         cutoff_hz=library_cutoff(cutoff_hz, "recorded"),
         max_gap_s=max_gap_s,
+        terms=structure,
         **common,
     )
     est = in_file(paths[0], fit) if len(paths) == 1 else fit()
     return PayloadFileResult(est, "torque_log")
+
+
+def _logs_only(**given: Any) -> None:
+    """Refuse the options of torque logs ``given`` (their values; None or ``"auto"``:
+    not given) with static data: ``cutoff_hz`` a DataError (as before), the others an
+    OptionError naming the field."""
+    for name, value in given.items():
+        if value is None or value == "auto":
+            continue
+        if name == "cutoff_hz":
+            raise DataError(
+                "--cutoff applies to torque logs (their low-pass); static data are not filtered"
+            )
+        raise OptionError("applies to torque logs, not static data", field=name)
+
+
+def _friction_terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
+    """``terms`` parsed as identify parses them, an armature or a spring refused
+    (:func:`~dynid.feasibility.payload_friction.friction_structure`) before a file is read."""
+    structure = parsed_terms(terms)
+    return friction_structure(structure) if isinstance(structure, Structure) else structure
 
 
 def _static(

@@ -19,7 +19,14 @@ from ...friction.model import Friction, FrictionSum
 from ...model.drive import Drive
 from ...model.robot import Robot
 
-__all__ = ["ExportOptions", "RobotFormat", "kept_elsewhere", "with_caveat", "xml_comment"]
+__all__ = [
+    "ExportOptions",
+    "RobotFormat",
+    "friction_losses",
+    "kept_elsewhere",
+    "with_caveat",
+    "xml_comment",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -122,8 +129,8 @@ def kept_elsewhere(
     -------
     str
         ``the MJCF export (robot.xml) holds them as armature, the TOML export (robot.toml)
-        as its [drive] table``; a format not written as ``a TOML export (--out r.toml)
-        would hold it exactly``.
+        as its [drive] table``; a format not written as ``a TOML export (--out r.toml, not
+        written) would hold it exactly``, after those written with ``, and``.
     """
     stem = Path(path).stem
     named = source and options.source is not None
@@ -150,13 +157,51 @@ def kept_elsewhere(
         if f not in options.beside and _EXPORT_NAMES[f][1] != own  # the source's own format
     ]
     others = [
-        f"{_article(_EXPORT_NAMES[f][0])} export (--out {stem}{_EXPORT_NAMES[f][1]})"
+        f"{_article(_EXPORT_NAMES[f][0])} export (--out {stem}{_EXPORT_NAMES[f][1]}"
+        + (", not written)" if k == 0 else ")")
         + (f" would hold {what} {how}" if k == 0 else f" {how}")
         for k, (f, how) in enumerate(unwritten)
     ]
     if others:
-        parts.append("not written: " + ", ".join(others))
-    return "; ".join(parts)
+        parts.append(", ".join(others))
+    return ", and ".join(parts)
+
+
+#: The statement a friction note makes of a part a per-joint file has no element for.
+_NO_TERM = " has no per-joint term"
+
+
+def friction_losses(kind: str, lost: Sequence[str]) -> tuple[str, str]:
+    """How a per-joint file (URDF ``<dynamics>``, MJCF ``damping`` and ``frictionloss``)
+    writes a friction law of kind ``kind`` and what it leaves out, from the notes ``lost``
+    (:func:`~dynid.friction.mujoco.joint_coulomb_viscous`,
+    :func:`~dynid.friction.mujoco.unheld_friction`), for one sentence: the notes' own
+    ``"<kind> friction: "`` is left off (the sentence names the law), ``"X has no per-joint
+    term"`` reads ``"X (no per-joint term)"``.
+
+    Returns
+    -------
+    (str, str)
+        ``written``: how the viscous and Coulomb coefficients were written (``"as the
+        nonnegative viscous and Coulomb friction closest to the law ..."``), empty when
+        they are the law's own; ``left``: what is left out, ``"A, B and C"`` (empty for
+        nothing).
+    """
+    written, left = "", []
+    for note in lost:
+        text = note
+        head = f"{kind} friction"
+        if text.startswith(head) and ": " in text:
+            said, _, text = text[len(head) :].partition(": ")
+            text = text + (f" {said.strip()}" if said.strip() else "")
+        if text.startswith("written "):
+            written = text.removeprefix("written ")
+            continue
+        if text.endswith(_NO_TERM):
+            text = text.removesuffix(_NO_TERM) + " (no per-joint term)"
+        left.append(text)
+    joined = ", ".join(left[:-1]) + " and " + left[-1] if len(left) > 1 else "".join(left)
+    return written, joined
 
 
 def _article(name: str) -> str:

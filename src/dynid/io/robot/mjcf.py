@@ -70,7 +70,13 @@ from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
-from .export_options import ExportOptions, kept_elsewhere, with_caveat, xml_comment
+from .export_options import (
+    ExportOptions,
+    friction_losses,
+    kept_elsewhere,
+    with_caveat,
+    xml_comment,
+)
 
 __all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf", "spring_held_offsets"]
 
@@ -123,10 +129,13 @@ def _law_terms(
     lost = jt.notes + unheld_friction(friction, vmax, held)
     if not lost:
         return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (), held
+    written, left = friction_losses(friction.kind, lost)
     note = (
         f"the joints' frictionloss and damping (Coulomb and viscous friction at the joints) "
-        f"hold the {friction.kind} friction without {', '.join(lost)}"
-        + (f": {kept}" if kept else "")
+        f"hold the {friction.kind} friction"
+        + (f", written {written}" if written else "")
+        + (f", without {left}" if left else "")
+        + (f"; {kept}" if kept else "")
     )
     return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (note,), held
 

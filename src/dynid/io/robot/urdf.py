@@ -58,7 +58,13 @@ from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Frame, Robot
 from ..atomic import write_text
 from ..input_files import file_text
-from .export_options import ExportOptions, kept_elsewhere, with_caveat, xml_comment
+from .export_options import (
+    ExportOptions,
+    friction_losses,
+    kept_elsewhere,
+    with_caveat,
+    xml_comment,
+)
 from .urdf_parse import load_urdf, robot_from_urdf_string
 from .urdf_patch import patch_urdf_dynamics, patch_urdf_inertials
 
@@ -394,10 +400,13 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         if lost:
             exact = () if isinstance(model, FrictionSum) else (("toml", "exactly"),)
             holds = kept_elsewhere(options, path, "it", exact, source="exactly")
+            written, left = friction_losses(model.kind, lost)
             notes = (
                 f"{Path(path).name} holds the {model.kind} friction as <dynamics damping "
-                f"friction> (viscous and sharp Coulomb friction at the joints), not as the "
-                f"law itself; {'; '.join(lost)}" + (f"; {holds}" if holds else ""),
+                f"friction>, viscous and sharp Coulomb friction at the joints"
+                + (f", written {written}" if written else "")
+                + (f", without {left}" if left else "")
+                + (f"; {holds}" if holds else ""),
             )
     replace = False
     if options.template is not None:
