@@ -91,7 +91,10 @@ def save_heldout_figures(out: Path, held: HeldOutTorques) -> list[Path]:
     paths = [
         save_figure(
             lambda: torque_plots.plot_torque_validation(
-                held.validation, joint_names=names, title=f"Held-out: {held.block}"
+                held.validation,
+                joint_names=names,
+                title=f"Held-out: {held.block}",
+                t0=float(held.logs[0].t[0]) if held.logs else None,
             ),
             Path(out) / "heldout_torques.png",
             dpi=100,

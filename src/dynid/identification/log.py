@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, signals
+from .._times import said_times
 from ..exceptions import DataError, ShapeError
 from ..model.drive import Drive
 
@@ -94,10 +95,11 @@ def jitter_text(jitter_s: float, period_s: float) -> str | None:
     return f"stamps jittered, std {jitter_s * 1e3:.2g} ms at a {period_s * 1e3:.3g} ms period"
 
 
-def timing_notes(c: LogCleaning) -> list[str]:
+def timing_notes(c: LogCleaning, t0: float | None = None) -> list[str]:
     """What a reader says of a log's timestamps: their jitter (its size, and the samples
     dropped or none) and the gaps that drop samples (count, the first :data:`GAPS_SAID`
-    start times [s], samples, longest [ms])."""
+    start times [s] with their offsets from the log's first stamp ``t0`` [s] when given,
+    samples, longest [ms])."""
     notes = []
     jitter = jitter_text(c.stamp_jitter_s, c.period_s)
     if jitter is not None:  # steps long by jitter alone are no gaps
@@ -107,10 +109,9 @@ def timing_notes(c: LogCleaning) -> list[str]:
             "uniform grid"
         )
     if c.gaps:
-        at = ", ".join(f"{a:.4g}" for a, _ in c.gaps[:GAPS_SAID])
-        more = ", ..." if len(c.gaps) > GAPS_SAID else ""
+        at = said_times([a for a, _ in c.gaps], t0, shown=GAPS_SAID)
         notes.append(
-            f"{len(c.gaps)} gap(s) in time of dropped samples at t = {at}{more} s "
+            f"{len(c.gaps)} gap(s) in time of dropped samples at {at} "
             f"({c.n_dropped} dropped; longest {max(b - a for a, b in c.gaps) * 1e3:.3g} ms)"
         )
     return notes
