@@ -48,6 +48,7 @@ from ..exceptions import DataError, ShapeError
 from ..model.drive import Drive
 
 __all__ = [
+    "MILLISECONDS_HINT",
     "DEFAULT_CUTOFF_HZ",
     "OBSERVER_CUTOFF_HZ",
     "LogCleaning",
@@ -384,6 +385,13 @@ class TorqueLog:
         )
 
 
+#: The hint of a positions-only log whose time steps look like milliseconds
+#: (:func:`with_derived_velocities`): a reader that can check the other units reads it
+#: again in ms and says every unit found at once
+#: (:func:`dynid.workflows.data_files.read_torque_log`).
+MILLISECONDS_HINT = "hint: --units t=ms"
+
+
 def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ) -> TorqueLog:
     """The log with ``dq`` from the zero-phase filtered derivative of ``q``
     (:func:`dynid.signals.filtered_derivative`, low-pass at ``cutoff_hz`` [Hz]); for logs that
@@ -399,7 +407,7 @@ def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ
         dt = float(np.median(np.diff(log.t)))
         if dt > 0 and cutoff_hz >= 0.5 / dt:
             ms = (
-                f"; its time steps of {dt:g} look like milliseconds; hint: --units t=ms"
+                f"; its time steps of {dt:g} look like milliseconds; {MILLISECONDS_HINT}"
                 if 0.5 <= dt <= 100
                 else ""
             )
