@@ -11,6 +11,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+from numpy.typing import NDArray
+
 __all__ = ["offset_text", "said_time", "said_times", "stamp_text"]
 
 #: Decimals of a stamp said in seconds: milliseconds, the resolution of a log's stamps
@@ -44,7 +47,11 @@ def said_time(t: float, t0: float | None = None, name: str | None = None) -> str
 
 
 def said_times(
-    times: Sequence[float], t0: float | None = None, name: str | None = None, *, shown: int = 3
+    times: Sequence[float] | NDArray[np.float64],
+    t0: float | None = None,
+    name: str | None = None,
+    *,
+    shown: int = 3,
 ) -> str:
     """``t = 86412.300, 86415.100 s and 2 more (11.3, 14.1 s into rec1.csv)``: the first
     ``shown`` stamps [s] as :func:`said_time` says one."""

@@ -192,8 +192,8 @@ def joined_unit_findings(findings: Sequence[str]) -> str:
             units.append(rest)
         elif hint:
             others.append(hint)
-    hint = ([f"--units {','.join(units)}"] if units else []) + others
-    return "; and ".join(whats) + (f"; hint: {'; '.join(hint)}" if hint else "")
+    hints = ([f"--units {','.join(units)}"] if units else []) + others
+    return "; and ".join(whats) + (f"; hint: {'; '.join(hints)}" if hints else "")
 
 
 def time_unit_finding(name: str, log: TorqueLog) -> str | None:
