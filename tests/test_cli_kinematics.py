@@ -234,3 +234,43 @@ def test_plot_ik_path_draws_one_line_per_joint_into_given_axes():
     assert len(ax.lines) == 7 + 14
     with pytest.raises(dynid.ShapeError, match="path must have shape"):
         plot_ik_path(np.zeros(7))
+
+
+_BAD_INERTIA_URDF = (
+    '<robot name="r"><link name="a"/><link name="b"><inertial><mass value="2"/>'
+    '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.09"/></inertial></link>'
+    '<link name="flange"/><link name="tool0"/>'
+    '<joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+    '<limit lower="-3" upper="3" velocity="2" effort="10"/></joint>'
+    '<joint name="f" type="fixed"><parent link="b"/><child link="flange"/>'
+    '<origin xyz="0.3 0 0"/></joint>'
+    '<joint name="t" type="fixed"><parent link="flange"/><child link="tool0"/>'
+    '<origin xyz="0 0 0.05"/></joint></robot>'
+)
+
+
+def test_a_warning_given_twice_in_a_run_is_printed_once(capsys):
+    """Regression: a URDF read as the robot and again as the prior (identify --consistent
+    --prior) printed its triangle-inequality warning twice; a run prints each text once."""
+    from dynid.cli.__main__ import _signals_and_warnings
+    from dynid.cli.console import Console
+    from dynid.io.robot.urdf import robot_from_urdf_string
+
+    with _signals_and_warnings(Console("identify")):
+        robot_from_urdf_string(_BAD_INERTIA_URDF)
+        robot_from_urdf_string(_BAD_INERTIA_URDF, tip_link="b")  # the prior's reading
+    err = capsys.readouterr().err
+    assert err.count("triangle inequality") == 1
+    assert "is not the tip link" not in err
+
+
+def test_fk_of_a_fixed_urdf_link_named_flange_is_its_own_pose(capsys, tmp_path):
+    """Regression: fk --frame flange of a URDF whose fixed link 'flange' carries the leaf
+    tool0 printed tool0's pose (0.05 m off) with a warning; now flange's own, a closed form."""
+    path = tmp_path / "r.urdf"
+    path.write_text(_BAD_INERTIA_URDF.replace('izz="0.09"', 'izz="0.025"'))
+    for frame, z in (("flange", 0.0), ("tool0", 0.05)):
+        argv = ["fk", "--robot", str(path), "--q", "0.5", "--frame", frame, "--json"]
+        out = _run_json(capsys, argv)
+        T = np.asarray(out["T"])
+        np.testing.assert_allclose(T[:3, 3], [0.3 * np.cos(0.5), 0.3 * np.sin(0.5), z], atol=1e-15)

@@ -39,7 +39,7 @@ def test_two_gaps_twelve_stamps_apart_are_two_gaps(seed):
     c = _log(t[kept]).cleaning
     assert c.gaps == ((t[999], t[1001]), (t[1012], t[1014])) and c.n_dropped == 2
     said = [s for s in timing_notes(c) if "gap" in s]
-    at = f"at t = {t[999]:.4g}, {t[1012]:.4g} s (2 dropped"
+    at = f"at t = {t[999]:.3f}, {t[1012]:.3f} s (2 dropped"
     assert said and said[0].startswith(f"2 gap(s) in time of dropped samples {at}"), said
 
 

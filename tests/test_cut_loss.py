@@ -52,7 +52,7 @@ def test_pieces_left_out_at_short_gaps_are_said_once_with_the_max_gap_that_keeps
     rec, said = _left_out(robot, [log])
     assert len(said) == 1, said
     (line,) = said
-    assert "a.csv: piece 2.03-2.6 s" in line and "a.csv: piece 5.03-5.5 s" in line
+    assert "a.csv: piece t = 2.030-2.600 s" in line and "a.csv: piece t = 5.030-5.500 s" in line
     assert "cut at 4 gap(s) of 0.03-0.03 s (3-3 sample steps of 0.01 s)" in line
     assert line.endswith("hint: --max-gap 0.035 bridges the 4 short one(s)")
     assert len(rec.skipped) == 2  # the record keeps a line per piece

@@ -49,13 +49,17 @@ def test_heldout_json_from_a_folder_and_without_figures(folder, tmp_path):
     assert _heldout(tmp_path / "c") == _heldout(tmp_path / "a")
 
 
-def _with_gap(src, dst, start: int, stop: int) -> None:
-    """``src`` without its data rows ``start:stop`` (a gap), its ``# rows:`` line fixed."""
+def _with_gap(src, dst, start: int, stop: int, t0: float = 0.0) -> None:
+    """``src`` without its data rows ``start:stop`` (a gap), its ``# rows:`` line fixed,
+    its time stamps moved by ``t0`` [s] (absolute stamps: seconds since midnight)."""
     lines = src.read_text().splitlines()
     head = [i for i, line in enumerate(lines) if line.startswith("#")]
     hdr = max(head) + 1
     rows = lines[hdr + 1 :]
     rows = rows[:start] + rows[stop:]
+    if t0:
+        cells = [r.split(",", 1) for r in rows]
+        rows = [f"{float(c[0]) + t0!r},{c[1]}" for c in cells]
     meta = [f"# rows: {len(rows)}" if m.startswith("# rows:") else m for m in lines[:hdr]]
     dst.write_text("\n".join([*meta, lines[hdr], *rows]) + "\n")
 
@@ -64,9 +68,11 @@ def _with_gap(src, dst, start: int, stop: int) -> None:
 def test_heldout_json_when_the_held_out_recording_has_a_gap(folder, tmp_path, capsys):
     """Several recordings, the last with a 1 s gap (cut into two pieces, as documented):
     heldout.json and both figures are written, over every piece of both recordings (the
-    first one piece, the last two; it was skipped with a note blaming the gap)."""
+    first one piece, the last two; it was skipped with a note blaming the gap). The last
+    log's stamps are absolute (from 86400 s): the gap is said at its stamp as in the
+    file, to the millisecond, and its offset from the log's start (it was "8.64e+04 s")."""
     gap = tmp_path / "gap.csv"
-    _with_gap(folder / "r2.csv", gap, 300, 550)
+    _with_gap(folder / "r2.csv", gap, 300, 550, t0=86400.0)
     base = ["identify", "--robot", "panda", "--terms", "viscous"]
     argv = [*base, "--data", str(folder / "r1.csv"), str(gap), "--out", str(tmp_path / "a")]
     assert main(argv) == 0
@@ -77,9 +83,11 @@ def test_heldout_json_when_the_held_out_recording_has_a_gap(folder, tmp_path, ca
     rec = json.loads((tmp_path / "a" / "identification.json").read_text())
     gaps = rec["metadata"]["recordings"][1]["gaps"]
     assert "gaps" not in rec["metadata"]["recordings"][0]
-    assert len(gaps) == 1 and gaps[0] == pytest.approx([299 / 250, 251 / 250], abs=1e-9)
-    assert "gap.csv: 2 piece(s)" in out and "cut at the gap(s) after 1.196 s (1 s long)" in out
-    assert "2 (gap after 1.196 s, 1 s long)" in (tmp_path / "a" / "report.html").read_text()
+    assert len(gaps) == 1 and gaps[0] == pytest.approx([86400 + 299 / 250, 251 / 250], abs=1e-9)
+    said = "after t = 86401.196 s (1.196 s into gap.csv; 1 s long)"
+    assert "gap.csv: 2 piece(s)" in out and f"cut at the gap(s) {said}" in out
+    html = (tmp_path / "a" / "report.html").read_text()
+    assert "2 (gap after t = 86401.196 s (1.196 s into gap.csv), 1 s long)" in html
     doc = _heldout(tmp_path / "a")
     assert "each of the 2 recordings" in doc["block"] and "(3 pieces between gaps)" in doc["block"]
     assert (tmp_path / "a" / "heldout_torques.png").is_file()

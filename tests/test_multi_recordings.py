@@ -297,7 +297,8 @@ def test_a_piece_too_short_to_filter_is_named_and_a_recording_without_one_refuse
     log = load_torque_log(files / "rec2.csv")
     keep = ~((log.t > 0.02) & (log.t < 0.5))  # samples 0..10, then a gap
     save_torque_log(tmp_path / "short.csv", log.select(keep))
-    with pytest.warns(DynidWarning, match=r"short.csv: piece 0-0.02 s \(11 samples\) left out"):
+    said = r"short.csv: piece t = 0.000-0.020 s \(11 samples\) left out"
+    with pytest.warns(DynidWarning, match=said):
         val = validate_files(panda, [files / "rec1.csv", tmp_path / "short.csv"]).validation
     assert val.pieces.skipped and val.pieces.summary()[1]["pieces"] == 2
     stub = log.select(np.arange(12))

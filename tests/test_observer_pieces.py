@@ -149,7 +149,7 @@ def test_a_gap_cuts_the_log_and_invents_no_event(folder, capsys):
     rc, events = _observe(folder, "gap.csv")
     assert rc == 0 and events == []
     (line,) = [x for x in capsys.readouterr().err.splitlines() if "warning" in x]
-    assert "gap.csv: cut at gaps longer than 0.02 s" in line and "at t = 3 s" in line
+    assert "gap.csv: cut at gaps longer than 0.02 s" in line and "at t = 3.000 s" in line
 
 
 def _with_nan(src, dst, rows) -> None:
@@ -220,7 +220,7 @@ def test_a_nan_row_inside_a_push_is_bridged_and_a_long_run_of_them_cuts(folder, 
         assert 1.99 < spans[0][0] < 2.4 and 3.99 < spans[1][0] < 4.5
     assert (
         "push_run.csv: cut at gaps longer than 0.02 s (some where rows were dropped for "
-        "NaN/inf): the observer starts again at t = 3.03 s"
+        "NaN/inf): the observer starts again at t = 3.030 s"
     ) in cuts[0]
     whole = np.loadtxt(d / "obs_push.csv" / "residuals.csv", delimiter=",", skiprows=3)
     holed = np.loadtxt(d / "obs_push_nan.csv" / "residuals.csv", delimiter=",", skiprows=3)
@@ -246,7 +246,7 @@ def test_a_position_jump_is_warned_about(folder, capsys):
     assert (
         "jump.csv: position jumps more than the recorded velocity explains (joint 2 by +0.05" in err
     )
-    assert "at t = 4 s" in err
+    assert "at t = 4.000 s" in err
 
 
 def test_samples_lost_in_one_short_step_cut_the_log_and_invent_no_event(folder, capsys):

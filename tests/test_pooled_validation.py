@@ -44,3 +44,20 @@ def test_the_torque_figure_breaks_its_lines_at_a_gap():
     x = fig.axes[0].lines[0].get_xdata()
     assert np.isnan(x).sum() == 1 and np.isnan(x[50])
     fig.clf()
+
+
+def test_the_torque_figure_draws_absolute_stamps_from_the_log_start():
+    """Regression: a log of absolute stamps (86401 s on) was drawn on an axis starting at
+    86400 s; the figure draws the times from the log's first stamp (or a given one) and
+    its axis says so."""
+    pytest.importorskip("matplotlib")
+    from dynid.plots.torques import plot_torque_validation
+
+    rng = np.random.default_rng(6)
+    part = _part(rng, 86401.0, 50)
+    for t0, first in ((None, 0.0), (86400.0, 1.0)):
+        fig = plot_torque_validation(part, t0=t0)
+        x = fig.axes[0].lines[0].get_xdata()
+        np.testing.assert_allclose(x, first + 0.01 * np.arange(50), atol=1e-9)
+        assert fig.axes[-1].get_xlabel() == "time from the log's start [s]"
+        fig.clf()

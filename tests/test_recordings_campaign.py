@@ -406,5 +406,5 @@ def test_a_stretch_lost_without_a_gap_in_the_stamps_makes_no_event(logs, tmp_pat
         assert main([*p, *th, "--data", str(tmp_path / "lost.csv"), "--out", str(out)]) == 0
     err = capsys.readouterr().err
     assert "lost.csv: position jumps more than the recorded velocity explains" in err
-    assert "at t = 2 s" in err and "the observer starts again after each jump" in err
+    assert "at t = 2.000 s" in err and "the observer starts again after each jump" in err
     assert json.loads((out / "events.json").read_text())["events"] == []

@@ -27,7 +27,7 @@ def pin_model(model, robot: dynid.Robot):
 def assert_matches_pinocchio(robot: dynid.Robot, model, data, n_states: int, seed: int) -> None:
     """FK and Jacobian of every frame, RNEA, M, g and c equal Pinocchio's on random states."""
     q, dq, ddq = random_states(robot, n_states, seed=seed)
-    frames = [k for k in robot.frames if k != "flange"]
+    frames = [k for k in robot.frames if k != "flange" or model.existFrame(k)]
     assert all(model.existFrame(k) for k in frames)
     T = {k: dynid.fk(robot, q, k) for k in frames}
     J = {k: dynid.jacobian(robot, q, k) for k in frames}
@@ -560,17 +560,85 @@ def test_cycle_of_joints_raises_model_error():
         robot_from_urdf_string(text, base_link="a")
 
 
-def test_urdf_link_named_flange_off_the_tip_warns():
-    """A URDF link 'flange' that is not the tip is shadowed by the tip's frame, with a warning."""
+def test_urdf_link_named_flange_off_the_tip_keeps_its_own_pose():
+    """A moving URDF link 'flange' above the tip is the frame 'flange' at its own pose (it
+    was shadowed by the tip's, with a warning), as Pinocchio places it."""
     text = (
-        '<robot name="r"><link name="a"/><link name="flange"/><link name="tcp"/>'
-        '<joint name="j" type="revolute"><parent link="a"/><child link="flange"/></joint>'
+        '<robot name="r"><link name="a"/><link name="b"/><link name="flange"/><link name="tcp"/>'
+        '<joint name="i" type="revolute"><parent link="a"/><child link="b"/>'
+        '<limit lower="-3" upper="3" velocity="2" effort="100"/></joint>'
+        '<joint name="j" type="revolute"><parent link="b"/><child link="flange"/>'
+        '<origin xyz="0 0 0.2"/><axis xyz="0 1 0"/>'
+        '<limit lower="-3" upper="3" velocity="2" effort="100"/></joint>'
         '<joint name="f" type="fixed"><parent link="flange"/><child link="tcp"/>'
         '<origin xyz="0 0 0.1"/></joint></robot>'
     )
-    with pytest.warns(dynid.DynidWarning, match="URDF link 'flange' is not the tip link 'tcp'"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", dynid.DynidWarning)
         robot = robot_from_urdf_string(text)
-    np.testing.assert_array_equal(robot.frames["flange"].T_link_frame[:3, 3], [0.0, 0.0, 0.1])
+    assert robot.frames["flange"].link == 2
+    np.testing.assert_array_equal(robot.frames["flange"].T_link_frame, np.eye(4))
+    model = pin.buildModelFromXML(text)
+    assert_matches_pinocchio(robot, *pin_model(model, robot), n_states=5, seed=41)
+
+
+# A UR5-like arm whose wrist carries a zero-mass link 'flange' and below it the leaf 'tool0'
+# (the first is turned about z, the second 0.05 m further and turned about x).
+_HALF_PI = np.pi / 2
+_LINKS6 = ("base_link", "l1", "l2", "l3", "l4", "l5", "wrist_3_link")
+_FLANGE_ARM = (
+    '<robot name="arm6">'
+    + "".join(
+        f'<link name="{name}"><inertial><mass value="{1.0 + i}"/><origin xyz="0 0.01 0.02"/>'
+        '<inertia ixx="0.03" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.02"/></inertial></link>'
+        for i, name in enumerate(_LINKS6)
+    )
+    + '<link name="flange"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" '
+    'iyy="0" iyz="0" izz="0"/></inertial></link><link name="tool0"/>'
+    + "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="{_LINKS6[i - 1]}"/>'
+        f'<child link="{_LINKS6[i]}"/><origin xyz="0 {0.1 * (-1) ** i} 0.3" '
+        f'rpy="0 {_HALF_PI * (i % 2)!r} 0"/><axis xyz="0 {i % 2} {1 - i % 2}"/>'
+        '<limit lower="-3" upper="3" velocity="2" effort="100"/></joint>'
+        for i in range(1, 7)
+    )
+    + '<joint name="flange_fixed" type="fixed"><parent link="wrist_3_link"/>'
+    f'<child link="flange"/><origin xyz="0 0.0823 0" rpy="0 0 {_HALF_PI!r}"/></joint>'
+    '<joint name="tool0_fixed" type="fixed"><parent link="flange"/><child link="tool0"/>'
+    f'<origin xyz="0 0 0.05" rpy="{-_HALF_PI!r} 0 0"/></joint></robot>'
+)
+
+
+def test_fixed_link_named_flange_before_the_tip_is_its_own_frame():
+    """Regression: a fixed URDF link 'flange' with a link 'tool0' fixed below it gave fk,
+    jacobian and ik at tool0's pose (0.05 m off) with a warning; every fixed link of the
+    chain is now its own frame, equal to Pinocchio's for fk, jacobian, ik and a tool."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", dynid.DynidWarning)
+        robot = robot_from_urdf_string(_FLANGE_ARM)
+    model = pin.buildModelFromXML(_FLANGE_ARM)
+    assert {"flange", "tool0"} <= set(robot.frames)
+    assert_matches_pinocchio(robot, *pin_model(model, robot), n_states=20, seed=43)
+    data = model.createData()
+    rng = np.random.default_rng(44)
+    q_goal = rng.uniform(-1.0, 1.0, 6)
+    pin.framesForwardKinematics(model, data, q_goal)
+    T_tool = np.eye(4)
+    T_tool[:3, 3] = [0.01, -0.02, 0.1]
+    for frame in ("flange", "tool0"):
+        goal = data.oMf[model.getFrameId(frame)].homogeneous
+        res = dynid.ik(robot, goal @ T_tool, q_goal + 0.05, frame=frame, tool=T_tool)
+        assert res.converged
+        pin.framesForwardKinematics(model, data, res.q)
+        reached = data.oMf[model.getFrameId(frame)].homogeneous @ T_tool
+        np.testing.assert_allclose(reached, goal @ T_tool, atol=1e-5, err_msg=frame)
+        pin.framesForwardKinematics(model, data, q_goal)
+    tooled = robot.with_tool(T_tool, name="tip")  # mounted at the URDF's flange
+    np.testing.assert_allclose(
+        dynid.fk(tooled, q_goal, "tip"),
+        data.oMf[model.getFrameId("flange")].homogeneous @ T_tool,
+        atol=1e-12,
+    )
 
 
 def test_absurd_axes_and_masses_are_refused_by_every_reader():

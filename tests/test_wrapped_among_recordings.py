@@ -103,7 +103,7 @@ def test_a_wrap_on_a_joint_limited_to_less_than_a_turn_is_named_a_wrap(panda, fi
     with pytest.warns(DynidWarning) as said:
         prepare_recordings(panda, [log], ["b.csv"])
     text = " ".join(str(w.message) for w in said)
-    assert "joint7 jumps a whole turn at t = " + f"{jumps[0]:.4g}" in text
+    assert "joint7 jumps a whole turn at t = " + f"{jumps[0]:.3f}" in text
     assert "do not allow a whole turn" in text and "x pi/180" not in text
 
 

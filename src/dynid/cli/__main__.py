@@ -181,15 +181,22 @@ def _raise_if_terminated() -> None:
 @contextlib.contextmanager
 def _signals_and_warnings(console: Console) -> Iterator[None]:
     """SIGTERM, SIGHUP and SIGQUIT raise :class:`Terminated`; warnings go to
-    :meth:`Console.warn` (one line, no source line; kept for the run's report with -q)."""
+    :meth:`Console.warn` (one line, no source line; kept for the run's report with -q),
+    each text once per run (a URDF read as the robot and again as ``--prior`` warned of
+    the same inconsistent inertial twice)."""
     old = {}
     _RECEIVED.clear()  # (a signal of an earlier run in this process is not this run's)
     with contextlib.suppress(ValueError):  # not the main thread: leave signals alone
         for sig in TERMINATING:
             old[sig] = signal.signal(sig, _terminate)
 
+    shown: set[str] = set()
+
     def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
-        console.warn(str(message))
+        text = str(message)
+        if text not in shown:
+            shown.add(text)
+            console.warn(text)
 
     try:
         with warnings.catch_warnings():

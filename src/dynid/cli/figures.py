@@ -63,12 +63,15 @@ def save_validation_figures(
     prefix: str = "validation",
     noise_std: float | None = None,
     title: str | None = None,
+    t0: float | None = None,
 ) -> list[Path]:
     """Write ``<prefix>_torques.png`` (Fig. 3) and ``<prefix>_rms.png`` under ``out``
-    (those skipped are left out)."""
+    (those skipped are left out); time drawn from ``t0`` [s] (default: the first sample)."""
     paths = [
         save_figure(
-            lambda: torque_plots.plot_torque_validation(validation, joint_names=names, title=title),
+            lambda: torque_plots.plot_torque_validation(
+                validation, joint_names=names, title=title, t0=t0
+            ),
             out / f"{prefix}_torques.png",
             dpi=100,
         ),
@@ -91,7 +94,10 @@ def save_heldout_figures(out: Path, held: HeldOutTorques) -> list[Path]:
     paths = [
         save_figure(
             lambda: torque_plots.plot_torque_validation(
-                held.validation, joint_names=names, title=f"Held-out: {held.block}"
+                held.validation,
+                joint_names=names,
+                title=f"Held-out: {held.block}",
+                t0=float(held.logs[0].t[0]) if held.logs else None,
             ),
             Path(out) / "heldout_torques.png",
             dpi=100,

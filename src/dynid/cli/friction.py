@@ -14,7 +14,8 @@ when every law does, the choice says so in a warning) (the model's own friction 
 candidate too, judged on the same blocks: as it is, or its own law, band and coefficients
 refitted on the other blocks when --model was identified from these recordings, the law
 it was trained with; a robot's own friction is never refitted; kept, it is kept as it is,
-friction at the motors and at the joints both) and prints the table; a law's name fits
+friction at the motors and at the joints both; shown as own (classical), its law
+named) and prints the table; a law's name fits
 that law. The smooth law's width tanh(dq / w) is chosen on the same held-out blocks among
 the widths identify searches (0.3 to 300 standstill bands), by name and in the
 comparison. smooth_stribeck is compared only when the model's own friction is that law.
@@ -35,10 +36,12 @@ the motor velocities where the drive's friction acts there (tau_f = K^T f(K dq))
 
 Writes OUT/friction.json (parameters, RMS of the residual before and after, the torques'
 sensor noise per joint, the held-out table) and
-OUT/friction.png (residual against velocity with the fitted curve, per joint; skipped,
-with a note, without matplotlib). The log is read strictly: rows with NaN/inf or a
-repeated timestamp are an error unless --drop-invalid; gaps up to --max-gap are bridged,
-longer ones cut the log into pieces.
+OUT/friction.png (residual against velocity with the fitted curve, per joint, or per
+motor against the motor velocity where the law was fitted at the motors; skipped, with a
+note, without matplotlib). The model's own friction is the table's row "own (classical)"
+(its law named, as the figure's title and validate name it). The log is read strictly:
+rows with NaN/inf or a repeated timestamp are an error unless --drop-invalid; gaps up to
+--max-gap are bridged, longer ones cut the log into pieces.
 
 Example:
   dynid friction --model out/identification.json --data traj.csv --out out/friction
@@ -153,7 +156,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     save_friction_json(args.out / "friction.json", fit, metadata=meta, selection=selection)
     names = list(robot.joint_names)
     if not args.no_figures:
-        title = shown(f"{fit.kind} friction fitted to the torque residual ({meta['data']})")
+        law = fit.kind if sel is None else sel.label(sel.chosen)  # as the table names it
+        title = shown(f"{law} friction fitted to the torque residual ({meta['data']})")
         save_friction_figure(
             args.out / "friction.png", result.residual, fit, names=names, title=title
         )

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._times import offset_text, stamp_text
 from ..feasibility.constraints import principal_moments
 from ..feasibility.convex import ConsistentResult
 from ..feasibility.determined import PRIOR, SUM
@@ -343,11 +344,17 @@ def recordings_lines(recordings: Any) -> list[str]:
 
 
 def _gaps(rec: Any) -> str:
-    """``, cut at gaps after 5.2 s (0.4 s long)`` (empty for a record without gaps)."""
+    """``, cut at the gap(s) after t = 86412.300 s (11.3 s into rec1.csv; 0.4 s long)``
+    (empty for a record without gaps): the stamp as in the file, its offset from the
+    recording's start when that is not 0."""
     gaps = rec.get("gaps") or []
     if not gaps:
         return ""
-    said = [f"{t:.4g} s ({length:.3g} s long)" for t, length in gaps[:4]]
+    t0, name = rec.get("start_s"), rec.get("file")
+    said = []
+    for t, length in gaps[:4]:
+        into = offset_text([t - (t0 or 0.0)], t0, name)
+        said.append(f"t = {stamp_text(t)} s ({into + '; ' if into else ''}{length:.3g} s long)")
     more = f" and {len(gaps) - 4} more" if len(gaps) > 4 else ""
     return f", cut at the gap(s) after {', '.join(said)}{more}"
 

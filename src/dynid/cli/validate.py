@@ -179,7 +179,11 @@ def _save_figures(out: Path, result: ValidateResult, names: list[str], label: st
     """The validation figures of the shown recording, titled with the model and the file."""
     what = result.files[0] + (" (its torques; errors over all)" if len(result.files) > 1 else "")
     save_validation_figures(
-        out, result.validation.shown, names=names, title=shown(f"{label} on {what}")
+        out,
+        result.validation.shown,
+        names=names,
+        title=shown(f"{label} on {what}"),
+        t0=result.validation.shown_start,
     )
 
 

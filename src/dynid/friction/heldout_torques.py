@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._times import stamp_text
 from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.floor_verdict import judged_prediction, prediction_input_noise
@@ -362,9 +363,11 @@ def _predicted(
         start = t0 + (k - 1) / k * (t1 - t0)
         first = int(np.searchsorted(log.t, start - trim))  # the block's rows: a view
         (held, spikes), fitted = _despiked_from(log, first), fold  # found on the whole log
+        log0, end = float(log.t[0]), float(log.t[-1])
+        into = f" ({start - log0:.4g}-{end - log0:.4g} s into the log)" if log0 else ""
         block = (
-            f"the last of {k} time blocks, {start:.1f}-{float(log.t[-1]):.1f} s, predicted by "
-            f"the fit of the other {k - 1}"
+            f"the last of {k} time blocks, t = {stamp_text(start)}-{stamp_text(end)} s{into}, "
+            f"predicted by the fit of the other {k - 1}"
         )
     elif model.holdout.scheme == "recordings":  # ``log``: the last recording alone
         k = model.holdout.folds

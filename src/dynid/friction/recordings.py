@@ -523,6 +523,14 @@ class RecordingsValidation:
             longest, without_friction=self.without_friction, with_friction=self.with_friction
         )
 
+    @property
+    def shown_start(self) -> float:
+        """The first prepared time stamp of the shown recording [s] (its log's start and
+        the filter's trim): where :attr:`shown`'s figure draws time from, so that its
+        piece sits at its place in the recording."""
+        pairs = zip(self.parts, self.pieces.recording, strict=True)
+        return min(float(v.log.t[0]) for v, r in pairs if r == 0)
+
     def as_dict(self) -> dict[str, object]:
         """JSON-ready: the pooled errors as :meth:`Validation.as_dict`, then
         ``recordings`` (one entry per file: pieces, samples, errors), ``skipped`` and

@@ -165,6 +165,10 @@ class FrictionSelection:
         Number of blocks (recordings when one is left out at a time).
     method : str
         How the held-out blocks were made.
+    own_kind : str or None
+        The law of the model's own friction (``"classical"``), when it is a candidate:
+        the ``own`` candidate is shown by it (:meth:`label`), as validate and the
+        figure name it.
     """
 
     fit: FrictionFit
@@ -173,6 +177,12 @@ class FrictionSelection:
     folds: int
     method: str = "contiguous-block cross-validation"
     rule: str = RULE
+    own_kind: str | None = None
+
+    def label(self, name: str) -> str:
+        """A candidate's name as shown: ``own (classical)`` for the model's own friction
+        (its law named, as validate names it), else the law's name."""
+        return f"{name} ({self.own_kind})" if name == OWN and self.own_kind else name
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready: ``method``, ``folds``, ``rule``, ``chosen`` and one row per candidate
@@ -205,7 +215,7 @@ class FrictionSelection:
     def table(self) -> str:
         """The candidates as a text table, the kept one marked with ``*``, those set aside
         (not dissipative) with ``x`` and a line each saying where, and the rule."""
-        w = max([12, *(len(s.name) for s in self.scores)])
+        w = max([12, *(len(self.label(s.name)) for s in self.scores)])
         p = max([10, *(len(", ".join(s.params)) for s in self.scores)])
         rows = [
             f"  {'friction law':<{w}} {'parameters':<{p}} {'train [%]':>10} "
@@ -214,7 +224,7 @@ class FrictionSelection:
         for s in self.scores:
             mark = "*" if s.name == self.chosen else ("x" if s.unphysical else " ")
             rows.append(
-                f"{mark} {s.name:<{w}} {', '.join(s.params) or '-':<{p}} "
+                f"{mark} {self.label(s.name):<{w}} {', '.join(s.params) or '-':<{p}} "
                 f"{s.train_error_percent:>10.3f} {s.heldout_error_percent:>13.3f} "
                 f"{s.scaled_error_percent:>13.3f}"
             )
@@ -226,8 +236,8 @@ class FrictionSelection:
             if s.unphysical:
                 flipped = [f"tau{v.joint + 1}" for v in s.unphysical if v.everywhere]
                 rows.append(
-                    f"set aside (x): {s.name}, not dissipative within the velocity limits "
-                    f"(the offset aside): {'; '.join(map(str, s.unphysical))}"
+                    f"set aside (x): {self.label(s.name)}, not dissipative within the velocity "
+                    f"limits (the offset aside): {'; '.join(map(str, s.unphysical))}"
                     + (
                         f" (pushing at every speed, as a torque of the opposite sign does: "
                         f"check the sign of {', '.join(flipped)})"
@@ -361,7 +371,10 @@ def select_friction(
     if own_score is not None and last:
         scores.append(own_score)
     kept = simplest_within(_dissipative(scores), prefer=OWN if own is not None else None)
-    return FrictionSelection(fits[kept.name], kept.name, tuple(scores), folds, method)
+    own_kind = fits[OWN].kind if OWN in fits else None
+    return FrictionSelection(
+        fits[kept.name], kept.name, tuple(scores), folds, method, own_kind=own_kind
+    )
 
 
 def choose_smooth_width(

@@ -10,9 +10,14 @@
 * **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
   median time step of at least 0.5 s with integer steps when no velocities were logged):
   ``--units t=ms`` (:func:`time_unit_finding`).
+
+A log may hold both (times in ms and positions in degrees): the checks that find them say
+them in one message with one hint, ``--units t=ms,q=deg`` (:func:`joined_unit_findings`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -23,6 +28,9 @@ from .log import TorqueLog
 __all__ = [
     "RATE_AGREES",
     "degrees_findings",
+    "joined_unit_findings",
+    "time_unit",
+    "time_unit_said",
     "milliseconds_findings",
     "rate_verdict",
     "joint_rate_factor",
@@ -157,20 +165,54 @@ def velocity_rate_factor(log: TorqueLog) -> float:
     return num / den if den > 0 else float("nan")
 
 
-def time_unit_finding(name: str, log: TorqueLog) -> str | None:
-    """One line naming the file ``name`` when its recorded velocities are a power of ten
-    (1e3, 1e6, 1e9, within 25 %) times the rate of change of its positions per unit of its
-    time column: the time column is then in ms, us or ns, not seconds
-    (:func:`velocity_rate_factor`); None otherwise."""
+def time_unit(log: TorqueLog) -> tuple[str, float] | None:
+    """The unit of ``log``'s time column when its recorded velocities are a power of ten
+    (1e3, 1e6, 1e9, within 25 %) times the rate of change of its positions per unit of it:
+    its ``--units t=`` spelling and its length [s] (``("ms", 1e-3)``); None otherwise
+    (:func:`velocity_rate_factor`)."""
     k = velocity_rate_factor(log)
     if not np.isfinite(k) or k <= 0:
         return None
     for unit, size in _TIME_UNITS:
         if abs(k / size - 1.0) < RATE_AGREES:
-            return (
-                f"{name}: its recorded velocities are {1 / k:.4g} times the rate of change of "
-                f"its positions per unit of its time column: the time column looks like "
-                f"{unit}, not seconds (t x {1 / size:g}); every filter, derivative and "
-                f"frequency read from it would be off by that factor; hint: --units t={unit}"
-            )
+            return unit, size
     return None
+
+
+def joined_unit_findings(findings: Sequence[str]) -> str:
+    """One line of several unit findings of one file, each ``what; hint: --units a=b``:
+    their reasons joined, and one hint, ``--units t=ms,q=deg`` (a hint that is not a
+    plain ``--units`` list is kept after it)."""
+    whats, units, others = [], [], []
+    for f in findings:
+        what, _, hint = f.partition("; hint: ")
+        whats.append(what)
+        head, _, rest = hint.partition(" ")
+        if hint.startswith("--units ") and " " not in rest:
+            units.append(rest)
+        elif hint:
+            others.append(hint)
+    hints = ([f"--units {','.join(units)}"] if units else []) + others
+    return "; and ".join(whats) + (f"; hint: {'; '.join(hints)}" if hints else "")
+
+
+def time_unit_finding(name: str, log: TorqueLog) -> str | None:
+    """One line naming the file ``name`` when its time column is in ms, us or ns, not
+    seconds (:func:`time_unit`); None otherwise."""
+    said = time_unit_said(log)
+    return None if said is None else f"{name}: {said}"
+
+
+def time_unit_said(log: TorqueLog) -> str | None:
+    """:func:`time_unit_finding` without the file's name."""
+    found = time_unit(log)
+    if found is None:
+        return None
+    unit, size = found
+    k = velocity_rate_factor(log)
+    return (
+        f"its recorded velocities are {1 / k:.4g} times the rate of change of "
+        f"its positions per unit of its time column: the time column looks like "
+        f"{unit}, not seconds (t x {1 / size:g}); every filter, derivative and "
+        f"frequency read from it would be off by that factor; hint: --units t={unit}"
+    )

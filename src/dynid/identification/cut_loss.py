@@ -20,6 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from .._times import stamp_text
 from .log import TorqueLog, default_max_gap
 
 __all__ = ["SHORT_GAP_STEPS", "bridging_gap", "cut_gaps", "left_out_finding"]
@@ -87,7 +88,8 @@ def left_out_finding(
     reasons = "; ".join(dict.fromkeys(why for _, why in left))
     if len(left) <= _NAMED:
         said = "; ".join(
-            f"{names[pieces[k][0]]}: piece {pieces[k][1].t[0]:.6g}-{pieces[k][1].t[-1]:.6g} s "
+            f"{names[pieces[k][0]]}: piece t = {stamp_text(pieces[k][1].t[0])}-"
+            f"{stamp_text(pieces[k][1].t[-1])} s "
             f"({pieces[k][1].n_samples} samples)"
             for k, _ in left
         )

@@ -44,10 +44,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, signals
+from .._times import said_times
 from ..exceptions import DataError, ShapeError
 from ..model.drive import Drive
 
 __all__ = [
+    "MILLISECONDS_HINT",
     "DEFAULT_CUTOFF_HZ",
     "OBSERVER_CUTOFF_HZ",
     "LogCleaning",
@@ -107,10 +109,11 @@ def jitter_text(jitter_s: float, period_s: float) -> str | None:
     return f"stamps jittered, std {jitter_s * 1e3:.2g} ms at a {period_s * 1e3:.3g} ms period"
 
 
-def timing_notes(c: LogCleaning) -> list[str]:
+def timing_notes(c: LogCleaning, t0: float | None = None) -> list[str]:
     """What a reader says of a log's timestamps: their jitter (its size, and the samples
     dropped or none) and the gaps that drop samples (count, the first :data:`GAPS_SAID`
-    start times [s], samples, longest [ms])."""
+    start times [s] with their offsets from the log's first stamp ``t0`` [s] when given,
+    samples, longest [ms])."""
     notes = []
     jitter = jitter_text(c.stamp_jitter_s, c.period_s)
     if jitter is not None:  # steps long by jitter alone are no gaps
@@ -120,10 +123,9 @@ def timing_notes(c: LogCleaning) -> list[str]:
             "uniform grid"
         )
     if c.gaps:
-        at = ", ".join(f"{a:.4g}" for a, _ in c.gaps[:GAPS_SAID])
-        more = ", ..." if len(c.gaps) > GAPS_SAID else ""
+        at = said_times([a for a, _ in c.gaps], t0, shown=GAPS_SAID)
         notes.append(
-            f"{len(c.gaps)} gap(s) in time of dropped samples at t = {at}{more} s "
+            f"{len(c.gaps)} gap(s) in time of dropped samples at {at} "
             f"({c.n_dropped} dropped; longest {max(b - a for a, b in c.gaps) * 1e3:.3g} ms)"
         )
     return notes
@@ -396,6 +398,13 @@ class TorqueLog:
         )
 
 
+#: The hint of a positions-only log whose time steps look like milliseconds
+#: (:func:`with_derived_velocities`): a reader that can check the other units reads it
+#: again in ms and says every unit found at once
+#: (:func:`dynid.workflows.data_files.read_torque_log`).
+MILLISECONDS_HINT = "hint: --units t=ms"
+
+
 def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ) -> TorqueLog:
     """The log with ``dq`` from the zero-phase filtered derivative of ``q``
     (:func:`dynid.signals.filtered_derivative`, low-pass at ``cutoff_hz`` [Hz]); for logs that
@@ -411,7 +420,7 @@ def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ
         dt = float(np.median(np.diff(log.t)))
         if dt > 0 and cutoff_hz >= 0.5 / dt:
             ms = (
-                f"; its time steps of {dt:g} look like milliseconds; hint: --units t=ms"
+                f"; its time steps of {dt:g} look like milliseconds; {MILLISECONDS_HINT}"
                 if 0.5 <= dt <= 100
                 else ""
             )

@@ -29,6 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from .._times import said_times, stamp_text
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -359,9 +360,9 @@ def wrapped_finding(
     limited = turn_limited(robot)
     for j in (j for j in joints if limited[j]):
         at = log.t[1:][np.abs(np.diff(log.q[:, j])) > np.pi]
-        times = ", ".join(f"{x:.4g}" for x in at[:5]) + (", ..." if at.size > 5 else "")
         said += (
-            f"; {robot.joint_names[j]} jumps a whole turn at t = {times} s, but its limits "
+            f"; {robot.joint_names[j]} jumps a whole turn at "
+            f"{said_times(at, float(log.t[0]), shown=5)}, but its limits "
             f"[{robot.q_min[j]:.4g}, {robot.q_max[j]:.4g}] do not allow a whole turn: "
             "unwrapped as a continuous joint; the log or the robot description is wrong "
             "(not degrees: those would be 57 times the radians)"
@@ -442,7 +443,7 @@ def start_turns(
         raise DataError(
             f"motor(s) {', '.join(str(m + 1) for m in motors)} recorded wrapped into "
             "[-pi, pi] lost the whole turns that set the joint positions, and the joints' "
-            f"limits leave several counts of them at t = {piece.t[0]:.6g} s (motor "
+            f"limits leave several counts of them at t = {stamp_text(piece.t[0])} s (motor "
             f"{'; motor '.join(told) or 'none fits every joint'}); hint: "
             + (
                 "give the joint positions at the log's first sample with --q-start "
@@ -500,7 +501,7 @@ def nearest_turns(
             f"turns of motor(s) {', '.join(str(k + 1) for k in motors)} recorded wrapped and "
             f"{d2:.3g} rad from another's ({apart:.3g} rad apart): it does not tell them; "
             f"hint: give the joint positions at the log's first sample (t = "
-            f"{piece.t[0]:.6g} s) to within {apart / 3:.3g} rad",
+            f"{stamp_text(piece.t[0])} s) to within {apart / 3:.3g} rad",
             file=name,
         )
     return best
@@ -655,6 +656,7 @@ def skipped_piece(name: str, piece: TorqueLog, exc: Exception) -> str:
     ``exc``), for the record; the warning is one for all the pieces left out
     (:func:`~dynid.identification.cut_loss.left_out_finding`)."""
     return (
-        f"{name}: piece {piece.t[0]:.6g}-{piece.t[-1]:.6g} s ({piece.n_samples} samples) "
+        f"{name}: piece t = {stamp_text(piece.t[0])}-{stamp_text(piece.t[-1])} s "
+        f"({piece.n_samples} samples) "
         f"left out: {exc}"
     )

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import signals
+from .._times import said_time
 from ..exceptions import DataError, DynidWarning, ShapeError
 from .log import _SIGNALS, DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap
 
@@ -503,7 +504,8 @@ def _check_gaps(t: NDArray[np.float64], dt: NDArray[np.float64], max_gap_s: floa
     if big.size:
         k = int(big[0])
         raise DataError(
-            f"gap of {dt[k]:.4g} s in the log between t = {t[k]:.6g} s and t = {t[k + 1]:.6g} s "
+            f"gap of {dt[k]:.4g} s in the log between {said_time(t[k], t[0])} and "
+            f"{said_time(t[k + 1], t[0])} "
             f"exceeds the longest gap bridged, {max_gap_s:g} s; hint: split the log at the gap "
             "or raise max_gap_s (--max-gap)"
         )

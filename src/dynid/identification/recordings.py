@@ -197,6 +197,9 @@ class Recordings(TorqueRoute):
     gaps : tuple of tuple of (float, float)
         Per recording, each gap it was cut at: the last time stamp before it [s, the
         recording's own time] and its length [s] (empty: not recorded).
+    starts : tuple of float
+        Per recording, its first time stamp as read [s] (empty: not recorded): where the
+        gaps lie in the recording.
     n_recorded : int
         Samples of every recording as read (pieces left out included); 0: the pieces'.
     band_gain : float
@@ -223,6 +226,7 @@ class Recordings(TorqueRoute):
     torque_delay_s: float = 0.0
     cuts: tuple[int, ...] = ()
     gaps: tuple[tuple[tuple[float, float], ...], ...] = ()
+    starts: tuple[float, ...] = ()
     n_recorded: int = 0
     band_gain: float = 1.0
     counts: tuple[SampleCounts, ...] = ()
@@ -351,9 +355,10 @@ class Recordings(TorqueRoute):
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
         ``decimate`` (every k-th sample kept: at its own rate, 10 times the cut-off or
-        more), the ``gaps`` it was cut at (``[t_before, length]`` [s] each, when any),
-        where the others went (:meth:`SampleCounts.as_dict`) when counted, and the
-        ``sha256`` of its samples as read when taken (:attr:`digests`)."""
+        more), the ``gaps`` it was cut at (``[t_before, length]`` [s] each, when any,
+        with ``start_s``, the recording's first time stamp [s]), where the others went
+        (:meth:`SampleCounts.as_dict`) when counted, and the ``sha256`` of its samples as
+        read when taken (:attr:`digests`)."""
         out = []
         for r, name in enumerate(self.names):
             mine = [p for p, k in zip(self.pieces, self.recording, strict=True) if k == r]
@@ -366,6 +371,8 @@ class Recordings(TorqueRoute):
             }
             if r < len(self.gaps) and self.gaps[r]:
                 rec["gaps"] = [[t, length] for t, length in self.gaps[r]]
+                if r < len(self.starts):
+                    rec["start_s"] = self.starts[r]
             if self.counts:
                 rec.update(self.counts[r].as_dict())
             if r < len(self.digests):
@@ -554,6 +561,7 @@ def prepare_recordings(
         torque_delay_s=float(torque_delay_s),
         cuts=tuple(cuts),
         gaps=tuple(gaps),
+        starts=tuple(float(log.t[0]) for log in logs),
         n_recorded=sum(log.n_samples for log in logs),
         counts=_counts(logs, pieces, gone),
         digests=tuple(log_digest(log) for log in logs),

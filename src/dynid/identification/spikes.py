@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from .._times import said_times
 from ..exceptions import ShapeError
 from .log import TorqueLog
 
@@ -222,7 +223,5 @@ def spike_finding(
 
 def _spike_times(t: NDArray[np.float64], rows: NDArray[np.intp], largest: float) -> str:
     """``3 (at t = 1.2, 3.4, 5.6 s and 2 more, largest 600 sigma)``: a joint's spikes."""
-    shown = ", ".join(f"{float(t[r]):.6g}" for r in rows[:SPIKE_TIMES_SHOWN])
-    more = rows.size - min(rows.size, SPIKE_TIMES_SHOWN)
-    rest = f" and {more} more" if more else ""
-    return f"{rows.size} (at t = {shown} s{rest}, largest {largest:.3g} sigma)"
+    said = said_times(t[rows], float(t[0]), shown=SPIKE_TIMES_SHOWN)
+    return f"{rows.size} (at {said}, largest {largest:.3g} sigma)"

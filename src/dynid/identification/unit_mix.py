@@ -31,6 +31,10 @@ pi`` times slower than the derivative of its positions, or agreeing with it and
 degrees the hint is ``--units q=deg,dq=deg/s``; when every joint with limits does and the
 continuous ones do not tell (slow), it is still that first, the conversion of the joints
 named second: a file is written in one unit.
+
+:func:`unit_findings` checks a file's time unit and its degrees in one pass (the
+positions judged on the time column read in its unit): a log in ms and degrees is told
+``--units t=ms,q=deg`` at once, not one unit a run.
 """
 
 from __future__ import annotations
@@ -40,11 +44,29 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
+from ..model.drive import Drive
 from ..model.robot import Robot
-from .angle_time_units import RATE_AGREES, joint_rate_factor, rate_verdict
-from .log import TorqueLog
+from .angle_time_units import (
+    RATE_AGREES,
+    joined_unit_findings,
+    joint_rate_factor,
+    rate_verdict,
+    time_unit,
+    time_unit_said,
+)
+from .log import TorqueLog, joint_side_log
 
-__all__ = ["DEGREE_TOLERANCE", "FREE_SPEED_FACTOR", "degrees_among_radians", "joints_in_degrees"]
+__all__ = [
+    "DEGREE_TOLERANCE",
+    "FREE_SPEED_FACTOR",
+    "LIMIT_MARGIN",
+    "degrees_among_radians",
+    "joints_in_degrees",
+    "unit_findings",
+]
+
+#: Margin [rad or m] beyond the joint limits before positions are called outside them.
+LIMIT_MARGIN = 0.2
 
 #: A scale ratio within this factor of ``180 / pi`` reads as degrees against radians.
 DEGREE_TOLERANCE = 2.0
@@ -152,9 +174,31 @@ def _free_in_degrees(robot: Robot, log: TorqueLog, j: int) -> tuple[str, bool] |
     return None
 
 
-def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list[int], str]:
+def _span_said(
+    j: int,
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    recorded: TorqueLog | None,
+    step: int,
+) -> str:
+    """``[-50.08, 58.41]`` (the file's values), or of a motor-side log ``[-50.08, 58.41]
+    at the joint side (motor 1 spans [-5008, 5841] in the file)``."""
+    span = f"[{lo[j]:.4g}, {hi[j]:.4g}]"
+    if recorded is None:
+        return span
+    m = recorded.q[::step, j]
+    motor = f"[{m.min():.4g}, {m.max():.4g}]"
+    return f"{span} at the joint side (motor {j + 1} spans {motor} in the file)"
+
+
+def joints_in_degrees(
+    robot: Robot, log: TorqueLog, margin: float, recorded: TorqueLog | None = None
+) -> tuple[list[int], str]:
     """The joints of a joint-side ``log`` whose positions read as degrees (module
     docstring), and the finding (one line, without the file's name; empty without them).
+    The spans said are the file's values: of ``log``, or, when ``recorded`` is given (a
+    motor-side log as read), the joint-side span said as such beside its motor's in the
+    file.
 
     Parameters
     ----------
@@ -164,6 +208,8 @@ def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list
         A joint-side log.
     margin : float
         Margin [rad or m] beyond the joint limits before positions are outside them.
+    recorded : TorqueLog, optional
+        The log as read from the file (motor angles), when ``log`` is its joint side.
     """
     step = max(1, log.n_samples // _MAX_SAMPLES)
     q = log.q[::step]
@@ -198,8 +244,8 @@ def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list
     if found:
         said.append(
             ", ".join(
-                f"{names[j]} spans [{lo[j]:.4g}, {hi[j]:.4g}], limits [{q_min[j]:.4g}, "
-                f"{q_max[j]:.4g}]"
+                f"{names[j]} spans {_span_said(j, lo, hi, recorded, step)}, limits "
+                f"[{q_min[j]:.4g}, {q_max[j]:.4g}]"
                 for j in found[:3]
             )
             + (f" (and {len(found) - 3} more)" if len(found) > 3 else "")
@@ -229,3 +275,47 @@ def joints_in_degrees(robot: Robot, log: TorqueLog, margin: float) -> tuple[list
         what = "joint(s) in degrees among joints in radians"
         hint = f"{convert} (--units converts every joint alike)"
     return every, f"{what}: {'; '.join(said)}; hint: {hint}"
+
+
+def unit_findings(
+    robot: Robot,
+    log: TorqueLog,
+    drive: Drive | None = None,
+    time: tuple[str, float] | None = None,
+    time_said: str | None = None,
+    side: TorqueLog | None = None,
+) -> str | None:
+    """Every unit finding of one log as read, in one line with one ``--units`` hint
+    (:func:`~dynid.identification.angle_time_units.joined_unit_findings`), or None.
+
+    Parameters
+    ----------
+    robot : Robot
+        The model's robot (limits [rad or m], speed limits [rad/s]).
+    log : TorqueLog
+        The log as read from the file (motor side through a motor-side ``drive``).
+    drive : Drive, optional
+        The drive it was recorded through: its joints judged on the joint side, the
+        file's motor angles quoted beside.
+    time : (str, float), optional
+        The time column's unit and length [s] when already found (a log unreadable in
+        seconds, read again in it), with ``time_said``, what was found; default: looked
+        for in the velocities (:func:`~dynid.identification.angle_time_units.time_unit`).
+    side : TorqueLog, optional
+        ``log`` on the joint side, when mapped already (default: mapped through ``drive``).
+    """
+    found = []
+    if time is None and (time := time_unit(log)) is not None:
+        time_said = time_unit_said(log)
+    mapped = drive is not None and drive.n == log.n
+    if side is None:
+        side = joint_side_log(log, drive) if mapped else log
+    if time is not None and time_said is not None:
+        found.append(time_said)  # the velocities were per second: the time column alone
+        log = TorqueLog(log.t * time[1], log.q, log.dq, log.tau, log.ddq)
+        side = TorqueLog(side.t * time[1], side.q, side.dq, side.tau, side.ddq)
+    motor = mapped and drive is not None and drive.side == "motor"
+    joints, said = joints_in_degrees(robot, side, LIMIT_MARGIN, log if motor else None)
+    if joints:
+        found.append(said)
+    return joined_unit_findings(found) if found else None

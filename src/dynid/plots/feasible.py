@@ -62,8 +62,8 @@ def plot_newton_euler_validation(
     Returns
     -------
     matplotlib.figure.Figure
-        One panel per joint: time [s] on x, torque [N m] on y; the RMS error of each
-        prediction in the panel title.
+        One panel per joint: time from the log's first sample [s] on x, torque [N m] on
+        y; the RMS error of each prediction in the panel title.
     """
     import matplotlib.pyplot as plt
 
@@ -77,7 +77,7 @@ def plot_newton_euler_validation(
         fig.clear()
     axes: list[Axes] = list(fig.subplots(nrows, ncols, sharex=True, squeeze=False).ravel())
     s = _stride(v.t.shape[0], max_points)
-    t = v.t[s]
+    t = v.t[s] - v.t[0]  # from the log's start (a log of absolute stamps too)
     label_ne = "Newton-Euler, feasible p" + (" + friction" if v.tau_friction is not None else "")
     for j in range(n):
         ax = axes[j]
@@ -100,7 +100,7 @@ def plot_newton_euler_validation(
         ax.grid(True, lw=0.3)
     for j in range(n):  # x labels on the lowest panel of every column
         if j + ncols >= n:
-            axes[j].set_xlabel("time [s]", fontsize=8)
+            axes[j].set_xlabel("time from the log's start [s]", fontsize=8)
             axes[j].tick_params(labelbottom=True)
     handles, labels = axes[0].get_legend_handles_labels()
     if n < len(axes):  # an empty slot holds the legend

@@ -11,13 +11,24 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..friction.fit import FrictionFit, FrictionResidual
-from ..friction.model import FrictionModel
+from ..friction.laws.base import Friction
+from ..friction.model import FrictionModel, FrictionSum
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
 __all__ = ["plot_friction_fit"]
+
+
+def _curve(
+    friction: FrictionModel | FrictionSum, V: np.ndarray, j: int, motors: bool
+) -> np.ndarray:
+    """Column ``j`` of the friction at velocities ``V`` (N, n): at the motors (``motors``)
+    the law of motor ``j`` at motor velocities [rad/s, N m], else the joint torques."""
+    if motors and isinstance(friction, Friction) and friction.at_motors:
+        return np.asarray(friction.law.torques(V, friction.params, friction.band))[:, j]
+    return np.asarray(friction.torques(V))[:, j]
 
 
 def plot_friction_fit(
@@ -54,14 +65,24 @@ def plot_friction_fit(
     Returns
     -------
     matplotlib.figure.Figure
-        One panel per joint: velocity [rad/s] on x, torque [N m] on y; the title of each
-        panel gives the RMS before and after compensation.
+        One panel per joint, or per motor where the friction was fitted at the motors of
+        a drive (one law per motor: the residual ``K^-T r`` against the motor velocity
+        ``K dq``, the law's own curve); velocity [rad/s] on x, torque [N m] on y, each
+        axis naming its side; the title of each panel gives the joint's RMS before and
+        after compensation.
     """
     import matplotlib.pyplot as plt
 
+    fr = fit.friction
+    motors = isinstance(fr, Friction) and fr.at_motors
     dq, r = residual.dq, residual.residual
     n = dq.shape[1]
     names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
+    side = "motor" if motors else "joint"
+    if isinstance(fr, Friction) and motors:
+        K = fr.transmission  # motor velocities per joint velocity where the law acts
+        dq = np.asarray(dq @ K.T, dtype=np.float64)  # r = K^T f(K dq): f at the motors
+        r = np.asarray(np.linalg.solve(K.T, r.T).T, dtype=np.float64)
     ncols = max(1, min(ncols, n))
     nrows = int(np.ceil(n / ncols))
     if fig is None:
@@ -88,7 +109,7 @@ def plot_friction_fit(
         V[:, j] = v
         ax.plot(
             v,
-            fit.friction.torques(V)[:, j],
+            _curve(fr, V, j, motors),
             color=COLOURS["friction"],
             lw=1.8,
             label=f"fitted {fit.kind}",
@@ -96,7 +117,7 @@ def plot_friction_fit(
         if reference is not None:
             ax.plot(
                 v,
-                reference.torques(V)[:, j],
+                _curve(reference, V, j, motors),
                 color=COLOURS["reference"],
                 lw=1.0,
                 ls="--",
@@ -104,11 +125,14 @@ def plot_friction_fit(
             )
         ax.axhline(0.0, color="0.7", lw=0.5)
         ax.axvline(0.0, color="0.7", lw=0.5)
+        who = f"motor {j + 1} ({names[j]})" if motors else names[j]
         ax.set_title(
-            f"{names[j]}: RMS {fit.rms_before[j]:.3f} -> {fit.rms_after[j]:.3f} N m", fontsize=9
+            f"{who}: {'joint ' if motors else ''}RMS {fit.rms_before[j]:.3f} -> "
+            f"{fit.rms_after[j]:.3f} N m",
+            fontsize=9,
         )
-        ax.set_xlabel("velocity [rad/s]", fontsize=8)
-        ax.set_ylabel("torque [N m]", fontsize=8)
+        ax.set_xlabel(f"{side} velocity [rad/s]", fontsize=8)
+        ax.set_ylabel(f"{side} torque [N m]", fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
     for k in range(n, nrows * ncols):

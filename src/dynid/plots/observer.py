@@ -38,7 +38,8 @@ def plot_residuals(
     Parameters
     ----------
     t : ndarray, shape (N,)
-        [s].
+        [s], the log's own stamps; drawn from the first (``t - t[0]``), the events and
+        labelled contacts with them.
     r : ndarray, shape (N, n)
         Residual [N m].
     contact, collision : ndarray, shape (N, n)
@@ -65,6 +66,9 @@ def plot_residuals(
     names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
     fig, axes = plt.subplots(n, 1, sharex=True, figsize=(10, 1.6 * n + 0.8), squeeze=False)
     s = slice(None, None, max(1, int(np.ceil(t.size / max_points))))
+    t0 = float(t[0]) if t.size else 0.0
+    t = t - t0  # from the log's start (a log of absolute stamps too)
+    labelled = [(a - t0, b - t0) for a, b in labelled]
     for j in range(n):
         ax = axes[j, 0]
         for k, (a, b) in enumerate(labelled):
@@ -74,7 +78,7 @@ def plot_residuals(
             )  # fmt: skip
         for e in events:
             ax.axvspan(
-                e.start, max(e.end, e.start + 1e-3),
+                e.start - t0, max(e.end, e.start + 1e-3) - t0,
                 color=COLOURS["collision" if e.level == "collision" else "contact"],
                 alpha=0.25, lw=0,
             )  # fmt: skip
@@ -90,7 +94,7 @@ def plot_residuals(
             ax.plot(t[s], -th[s, j], **line)
         ax.set_ylabel(f"{names[j]}\n[N m]", fontsize=8)
         ax.tick_params(labelsize=7)
-    axes[-1, 0].set_xlabel("t [s]")
+    axes[-1, 0].set_xlabel("time from the log's start [s]")
     fig.suptitle(title or "momentum observer: residual, thresholds and events", fontsize=10)
     handles, labels = axes[0, 0].get_legend_handles_labels()
     top = 1.0 - 0.45 / fig.get_figheight()  # the legend above the axes, over no data

@@ -46,6 +46,7 @@ def plot_torque_validation(
     max_points: int = 5000,
     title: str | None = None,
     fig: Figure | None = None,
+    t0: float | None = None,
 ) -> Figure:
     """Per joint: measured and predicted torques (left) and prediction errors (right).
 
@@ -60,12 +61,15 @@ def plot_torque_validation(
     title : str, optional
     fig : Figure, optional
         Drawn into (cleared first); a new figure by default.
+    t0 : float, optional
+        The log's first time stamp [s], from which times are drawn (default: the first
+        sample's; a held-out block's log's, so that the block sits at its place in it).
 
     Returns
     -------
     matplotlib.figure.Figure
-        ``n`` rows of two axes; the samples' own times [s] on x (the log's clock: a
-        held-out block's at its place in the log), the lines broken where the times jump
+        ``n`` rows of two axes; the samples' times from ``t0`` [s] on x (a log of absolute
+        stamps, 86400 s and on, drawn from 0), the lines broken where the times jump
         (pieces between gaps), torque [N m] on y. Each error panel gives the RMS of each
         prediction.
     """
@@ -80,7 +84,8 @@ def plot_torque_validation(
         fig.clear()
     axes = fig.subplots(n, 2, sharex=True, squeeze=False, gridspec_kw={"width_ratios": [3, 2]})
     s = _stride(log.n_samples, max_points)
-    t = np.asarray(log.t[s], dtype=np.float64)  # the samples' own times, not from 0
+    start = float(log.t[0]) if t0 is None else float(t0)
+    t = np.asarray(log.t[s], dtype=np.float64) - start  # from the log's start
     cut = _gaps(t)
     e0 = log.tau - validation.tau_model
     e1 = None if validation.tau_friction is None else e0 - validation.tau_friction
@@ -113,8 +118,8 @@ def plot_torque_validation(
     top = 1.0 - (0.6 if title else 0.3) / fig.get_figheight()  # room for the legend above
     fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=8,
                frameon=False, bbox_to_anchor=(0.5, top))  # fmt: skip
-    axes[-1, 0].set_xlabel("time [s]")
-    axes[-1, 1].set_xlabel("time [s]")
+    axes[-1, 0].set_xlabel("time from the log's start [s]")
+    axes[-1, 1].set_xlabel("time from the log's start [s]")
     if title:
         fig.suptitle(title, fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))

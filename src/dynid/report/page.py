@@ -36,6 +36,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .._times import said_time
 from ..io.atomic import write_text
 from .answers import answer_for
 from .html import cell, esc, figure, href, number, size, table
@@ -130,9 +131,14 @@ def _recordings(docs: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
 
 
 def _pieces(rec: Mapping[str, Any]) -> str:
-    """A recording's pieces, with where it was cut: ``2 (gap after 1.2 s, 1 s long)``."""
+    """A recording's pieces, with where it was cut: ``2 (gap after t = 86412.300 s
+    (11.3 s into rec1.csv), 1 s long)``: the stamp as in the file and its offset."""
     gaps = [g for g in rec.get("gaps") or () if isinstance(g, list) and len(g) == 2]
-    said = "; ".join(f"gap after {number(t, 4)} s, {number(n, 3)} s long" for t, n in gaps[:4])
+    t0 = rec.get("start_s") if isinstance(rec.get("start_s"), (int, float)) else None
+    name = rec.get("file") if isinstance(rec.get("file"), str) else None
+    said = "; ".join(
+        f"gap after {esc(said_time(t, t0, name))}, {number(n, 3)} s long" for t, n in gaps[:4]
+    )
     more = f"; {len(gaps) - 4} more" if len(gaps) > 4 else ""
     return esc(rec.get("pieces", "")) + (f" ({said}{more})" if said else "")
 

@@ -15,6 +15,7 @@ The policies, the same for the Python API and every command:
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import hashlib
 import logging
 import re
@@ -25,10 +26,11 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from ..exceptions import DataError, OptionError
+from ..exceptions import DataError, DynidError, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
-from ..identification.log import TorqueLog
+from ..identification.log import MILLISECONDS_HINT, TorqueLog
+from ..identification.unit_mix import unit_findings
 from ..io.column_hint import missing_joints
 from ..io.columns import (
     ColumnMap,
@@ -243,8 +245,15 @@ def read_torque_log(
     drop_invalid: bool = False,
     owner: str | None = None,
     robot: Robot | None = None,
+    drive: Drive | None = None,
 ) -> TorqueLog:
     """The torque log ``path``, read strictly, with ``n`` joints.
+
+    A log of positions only whose time steps look like milliseconds cannot be read (its
+    rate is too low to derive velocities); with ``robot`` it is read again with its time
+    in ms to check its positions too, and a log in degrees as well is refused with both
+    units said at once (``--units t=ms,q=deg``;
+    :func:`~dynid.identification.unit_mix.unit_findings`).
 
     Parameters
     ----------
@@ -262,6 +271,8 @@ def read_torque_log(
     robot : Robot, optional
         The robot of ``n`` joints: a log of fewer joints is told which joints of its chain
         it lacks (a gripper's, say) and the ``--tip`` link before them.
+    drive : Drive, optional
+        The drive the log was recorded through (its positions judged at the joints).
 
     Returns
     -------
@@ -271,9 +282,55 @@ def read_torque_log(
     Raises
     ------
     DataError
-        A bad file; invalid rows without ``drop_invalid``; another joint count than ``n``.
+        A bad file; invalid rows without ``drop_invalid``; another joint count than ``n``;
+        a time column in ms, with the other units found.
     """
-    path = Path(path)
+    try:
+        return _read_torque_log(Path(path), n, columns, drop_invalid, owner, robot)
+    except DataError as exc:
+        if robot is None or MILLISECONDS_HINT not in str(exc):
+            raise
+        said = _units_in_ms(Path(path), n, columns, robot, drive, exc)
+        if said is None:
+            raise
+        raise DataError(said, file=Path(path).name) from exc
+
+
+def _units_in_ms(
+    path: Path,
+    n: int | None,
+    columns: ColumnMap | None,
+    robot: Robot,
+    drive: Drive | None,
+    exc: DataError,
+) -> str | None:
+    """The unit findings of ``path`` read with its time column in ms, the finding of
+    ``exc`` first, when another unit is found too; None otherwise (or when the time
+    column's unit was given, or the file cannot be read so either)."""
+    if columns is not None and columns.factor("t") != 1.0:
+        return None
+    cm = columns if columns is not None else ColumnMap()
+    ms = dataclasses.replace(cm, factors={**cm.factors, "t": 1e-3}, names={**cm.names, "t": "ms"})
+    try:
+        log = load_mapped_torque_log(path, ms, n=n).log
+    except DynidError:
+        return None
+    if n is not None and log.n != n:
+        return None
+    first = str(exc).removeprefix(f"{exc.file}: ") if exc.file else str(exc)
+    found = unit_findings(robot, log, drive, ("ms", 1e-3), first)
+    return None if found is None or found == first else found
+
+
+def _read_torque_log(
+    path: Path,
+    n: int | None,
+    columns: ColumnMap | None,
+    drop_invalid: bool,
+    owner: str | None,
+    robot: Robot | None,
+) -> TorqueLog:
+    """:func:`read_torque_log`'s reading."""
     if columns is None:
         log = load_torque_log(path, drop_invalid=drop_invalid)
     else:

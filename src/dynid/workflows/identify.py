@@ -81,6 +81,7 @@ from .recordings import (
     check_limits,
     check_signs,
     check_torque_unit,
+    check_unit_findings,
     check_units,
     given_start,
     unwrapped_recorded,
@@ -532,6 +533,7 @@ def _read_logs(
             drop_invalid=opt.drop_invalid,
             owner=f"robot {robot.name!r}",
             robot=robot,
+            drive=opt.drive,
         )
         for p in paths
     ]
@@ -543,6 +545,7 @@ def _read_logs(
     rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
     check_derived_velocities(rec, cmap)
     rec = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
+    check_unit_findings(rec, robot)
     check_limits(rec, robot)
     check_units(rec)
     check_signs(rec.select(slice(len(logs), None)), robot)  # the held-out log's

@@ -124,6 +124,7 @@ from .recordings import (
     check_limits,
     check_signs,
     check_torque_unit,
+    check_unit_findings,
     check_units,
     despiked_recordings,
     given_start,
@@ -668,6 +669,7 @@ def _read_logs(
             drop_invalid=opts.drop_invalid,
             owner="the model",
             robot=model.robot,
+            drive=model.drive,
         )
         for p in map(Path, paths)
     ]
@@ -675,6 +677,7 @@ def _read_logs(
     logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
     read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
     checked = unwrapped_recorded(read, model.robot, opts.max_gap)  # as prepared_log reads
+    check_unit_findings(checked, model.robot)
     check_limits(checked, model.robot)
     check_units(checked)
     check_derived_velocities(read, cmap)

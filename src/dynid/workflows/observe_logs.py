@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._times import said_times, stamp_text
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..friction.model import FrictionModel, FrictionSum
@@ -307,8 +308,7 @@ def _pieces(path: Path, log: TorqueLog, max_gap: float | None) -> list[int]:
         limit = default_max_gap(float(np.median(dt)) if dt.size else 1.0)
     starts = [int(k) for k in pieces(log.t, limit)]
     if len(starts) > 1:
-        at = ", ".join(f"{log.t[k]:.6g}" for k in starts[1:6])
-        more = f" and {len(starts) - 6} more" if len(starts) > 6 else ""
+        at = said_times([log.t[k] for k in starts[1:]], float(log.t[0]), shown=5)
         after = np.searchsorted(log.t, np.asarray(c.invalid_after, dtype=np.float64), side="right")
         why = f"gaps longer than {limit:.3g} s" + (
             " (some where rows were dropped for NaN/inf)"
@@ -316,8 +316,7 @@ def _pieces(path: Path, log: TorqueLog, max_gap: float | None) -> list[int]:
             else ""
         )
         warnings.warn(
-            f"{path.name}: cut at {why}: the observer starts again at t = {at}{more} s "
-            "(no event spans a cut)",
+            f"{path.name}: cut at {why}: the observer starts again at {at} (no event spans a cut)",
             DynidWarning,
             stacklevel=4,
         )
@@ -369,7 +368,7 @@ def _cut_at_jumps(
             continue
         jumps.sort(key=lambda x: (x.t, x.joint))
         listed = ", ".join(
-            f"joint {x.joint + 1} by {x.size:+.3g} at t = {x.t:.6g} s" for x in jumps[:3]
+            f"joint {x.joint + 1} by {x.size:+.3g} at t = {stamp_text(x.t)} s" for x in jumps[:3]
         )
         more = f" and {len(jumps) - 3} more" if len(jumps) > 3 else ""
         warnings.warn(

@@ -8,8 +8,9 @@ line naming the file, never a recording dropped silently:
 
 * an empty file, NaN/inf or a repeated timestamp (without ``drop_invalid``), another
   joint count than the model's: the reader's error, naming the file;
-* a time column in ms, us or ns (:func:`~dynid.identification.angle_time_units.time_unit_finding`):
-  an error naming the file and ``--units t=ms``;
+* a time column in ms, us or ns (:func:`~dynid.identification.angle_time_units.time_unit_finding`)
+  and positions in degrees, checked together (:func:`check_unit_findings`): one error
+  naming the file, every unit found and one hint, ``--units t=ms,q=deg``;
 * a recording in other units than the others (its torques, or its velocities against the
   derivative of its positions on the joints that move, a power of ten away from the other
   recordings'): an error naming it (a recording at rest, or without velocity columns, has
@@ -51,14 +52,18 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError, DynidWarning, OptionError
-from ..identification.angle_time_units import time_unit_finding
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, velocity_note
 from ..identification.model_sign import sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
 from ..identification.recorded_signs import SignFinding, recording_sign_findings
 from ..identification.sanity import too_few_samples, torque_unit_finding
 from ..identification.spikes import despiked, spike_finding
-from ..identification.unit_mix import degrees_among_radians, joints_in_degrees
+from ..identification.unit_mix import (
+    LIMIT_MARGIN,
+    degrees_among_radians,
+    joints_in_degrees,
+    unit_findings,
+)
 from ..identification.velocity_noise import moving_joints
 from ..io.columns import CURRENT_UNITS, ColumnMap, parse_column_map
 from ..io.torque_log import declared_tau_unit
@@ -87,6 +92,7 @@ __all__ = [
     "warn_signs",
     "recorded_sign_map_findings",
     "check_torque_unit",
+    "check_unit_findings",
     "check_units",
     "despiked_recordings",
     "given_start",
@@ -99,8 +105,6 @@ _log = logging.getLogger(__name__)
 #: Ratio of a recording's torque scale (or velocity unit) to the other recordings' median
 #: beyond which it is taken to be in another unit (a power of ten: mN m, ms, degrees).
 UNIT_RATIO = 30.0
-#: Margin [rad or m] beyond the joint limits before positions are called far outside.
-LIMIT_MARGIN = 0.2
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -219,16 +223,20 @@ def read_recordings(
 
     def read(p: Path) -> TorqueLog:
         return read_torque_log(
-            p, robot.n, columns=cmap, drop_invalid=drop_invalid, owner=owner, robot=robot
+            p,
+            robot.n,
+            columns=cmap,
+            drop_invalid=drop_invalid,
+            owner=owner,
+            robot=robot,
+            drive=drive,
         )
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths), drive)
-    for name, log in zip(out.names, out.logs, strict=True):  # the time unit named first
-        if (unit := time_unit_finding(name, log)) is not None:  # it names the file
-            raise DataError(unit.removeprefix(f"{name}: "), file=name)
     checked = unwrapped_recorded(out, robot, max_gap_s)  # as the preparation reads them
+    check_unit_findings(checked, robot)  # the time unit and degrees, named first
     check_limits(checked, robot)
     check_units(checked)
     check_derived_velocities(out, cmap)
@@ -400,6 +408,26 @@ def check_derived_velocities(rec: Recorded, cmap: ColumnMap | None = None) -> No
     cutoff = DEFAULT_CUTOFF_HZ if cmap is None else cmap.velocity_cutoff_hz
     which = ", ".join(names) if len(names) <= 4 else f"{len(names)} recordings ({names[0]}, ...)"
     _log.log(NOTE, "%s: %s", which, velocity_note(cutoff))
+
+
+def check_unit_findings(rec: Recorded, robot: Robot) -> None:
+    """Refuse a recording whose time column (ms, us, ns) or positions (degrees) are in
+    other units, every unit found said at once with one ``--units`` hint
+    (:func:`~dynid.identification.unit_mix.unit_findings`): a log in ms and degrees was
+    told ``--units t=ms`` and, run again, ``--units q=deg``.
+
+    A recording in degrees among recordings in radians is said first
+    (:func:`check_degrees`): the file to convert, as ``--units`` applies to every file.
+
+    Raises
+    ------
+    DataError
+        Naming the recording, what each unit finding rests on and the ``--units`` hint.
+    """
+    check_degrees(rec, robot)
+    for name, log, side in zip(rec.names, rec.logs, rec.joint_side, strict=True):
+        if (found := unit_findings(robot, log, rec.drive, side=side)) is not None:
+            raise DataError(found, file=name)
 
 
 def check_degrees(rec: Recorded, robot: Robot) -> None:
@@ -626,8 +654,10 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
     """
     check_degrees(rec, robot)
     sides = rec.joint_side
-    for name, log in zip(rec.names, sides, strict=True):
-        if (found := joints_in_degrees(robot, log, LIMIT_MARGIN))[0]:
+    motor = rec.drive is not None and rec.drive.side == "motor"
+    for name, log, read in zip(rec.names, sides, rec.logs, strict=True):
+        recorded = read if motor and read is not log else None  # the file's motor angles
+        if (found := joints_in_degrees(robot, log, LIMIT_MARGIN, recorded))[0]:
             raise DataError(found[1], file=name)
     lo = np.asarray(robot.q_min) - LIMIT_MARGIN
     hi = np.asarray(robot.q_max) + LIMIT_MARGIN

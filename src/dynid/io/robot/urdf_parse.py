@@ -17,8 +17,9 @@ Conventions
   ``T_parent_joint[0]``; a fixed joint after a moving joint makes its child part of the
   rigid body of the preceding moving link. Every URDF link on the chain, and every link
   hanging off a chain link through fixed joints only (a hand, a tool-centre-point link),
-  becomes a named frame ``Frame(link index, T_link_frame)``; ``flange`` is the frame of
-  the tip link.
+  becomes a named frame ``Frame(link index, T_link_frame)`` at its own pose; ``flange``
+  is the frame of the tip link, unless the URDF has a link of that name (then it is that
+  link's frame, as every other link's).
 * The inertia of a link rigidly fixed to moving link ``k`` (on or off the chain) is added
   to link ``k``: its CoM and its inertia about the CoM are carried into link-``k``
   coordinates (``c_k = R c + p``, ``I_k = R I R^T``) before the standard parameters are
@@ -218,7 +219,8 @@ def robot_from_urdf_string(
     base_link : str, optional
         Link whose frame is the base frame (link 0). Default: the root link of the tree.
     tip_link : str, optional
-        Last link of the chain; its frame is ``flange``. Default: the unique leaf link
+        Last link of the chain; its frame is ``flange`` (unless a URDF link is named
+        ``flange``). Default: the unique leaf link
         below ``base_link``.
     source : str
         Name of the document used in error messages (a file path, say).
@@ -237,7 +239,8 @@ def robot_from_urdf_string(
         ``T_parent_joint`` (n, 4, 4) [m], ``axes`` (n, 3) unit vectors in link
         coordinates, ``phi`` (n, 10) standard parameters about the link origins [SI],
         limits (n,), gravity ``(0, 0, -9.80665)`` m/s^2 in the base frame, frames for every
-        URDF link on the chain and fixed to it, ``flange`` at the tip link. See the module
+        URDF link on the chain and fixed to it (each at its own pose), ``flange`` at the tip
+        link unless a URDF link has that name. See the module
         docstring for the merging of fixed joints.
 
     Raises
@@ -257,8 +260,7 @@ def robot_from_urdf_string(
         The inertial of a link that enters the model is physically inconsistent
         (negative mass, inertia not positive semi-definite, triangle inequality violated):
         it is kept as given. A velocity or
-        effort limit is not positive: it is treated as unbounded. A URDF link named
-        ``flange`` is not the tip link (the frame ``flange`` is the tip's). Joint-origin
+        effort limit is not positive: it is treated as unbounded. Joint-origin
         angles are rounded near multiples of pi/2 (``rpy="1.5708"``) in a way that
         matters and ``snap_angles`` is False: the joints and the unscaled condition
         numbers of the structural regressor as written and snapped are named (a harmless
@@ -492,14 +494,9 @@ def _read_chain(
         for link, (kl, T) in w.placed.items()
         if link not in moving_links
     }
-    if "flange" in w.placed and tip != "flange":
-        warnings.warn(
-            f"URDF link 'flange' is not the tip link {tip!r}; the frame 'flange' is the tip link's",
-            DynidWarning,
-            stacklevel=4,
-        )
-    k_tip, T_tip = w.placed[tip]
-    frames["flange"] = Frame(k_tip, T_tip)
+    if "flange" not in w.placed:  # a URDF link 'flange' keeps its own pose (Pinocchio's)
+        k_tip, T_tip = w.placed[tip]
+        frames["flange"] = Frame(k_tip, T_tip)
 
     n = len(w.joint_names)
     lim = np.array(w.limits)
@@ -541,7 +538,8 @@ def load_urdf(
     base_link : str, optional
         Link whose frame is the base frame (link 0). Default: the root link.
     tip_link : str, optional
-        Last link of the chain; its frame is ``flange``. Default: the unique leaf link
+        Last link of the chain; its frame is ``flange`` (unless a URDF link is named
+        ``flange``). Default: the unique leaf link
         below ``base_link``.
     snap_angles : bool
         Snap joint-origin angles rounded near multiples of pi/2 (:func:`robot_from_urdf_string`).
