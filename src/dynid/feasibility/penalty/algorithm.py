@@ -215,6 +215,8 @@ def _run_all(
     workers: int,
     on_done: Callable[[RetrievalRun], None],
 ) -> list[RetrievalRun]:
+    import scipy.optimize  # noqa: F401 (imported before the workers fork, not in each)
+
     seqs = np.random.SeedSequence(seed).spawn(options.runs)
     runs: list[RetrievalRun | None] = [None] * options.runs
     if workers <= 1 or options.runs == 1:
