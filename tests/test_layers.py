@@ -131,6 +131,29 @@ def test_import_dynid_does_not_load_matplotlib():
     assert out.stdout.strip() == "False"
 
 
+def test_command_help_loads_neither_scipy_nor_numba_nor_matplotlib():
+    """``dynid --help`` and each subcommand's ``--help`` import no scipy, numba or
+    matplotlib (start-up time: the parsers need the library's light modules only)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import contextlib, io, sys\n"
+        "from dynid.cli.__main__ import SUBCOMMANDS, main\n"
+        "for argv in [[], *([c.replace('_', '-')] for c in SUBCOMMANDS)]:\n"
+        "    if argv == ['import-bag']:\n"
+        "        argv = ['import']\n"
+        "    with contextlib.redirect_stdout(io.StringIO()) as out:\n"
+        "        assert main([*argv, '--help']) == 0, argv\n"
+        "    assert 'usage: dynid' in out.getvalue(), argv\n"
+        "heavy = sorted(m for m in ('scipy', 'numba', 'matplotlib') if m in sys.modules)\n"
+        "print(' '.join(heavy))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "", f"imported by --help: {out.stdout.strip()}"
+
+
 def test_io_exports_every_public_name_lazily_and_only_save_load_verbs():
     """dynid.io resolves each exported name on first use; every file verb is save_/load_."""
     import importlib

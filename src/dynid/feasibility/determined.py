@@ -24,7 +24,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from ..identification.model import IdentifiedModel
@@ -118,6 +117,8 @@ def _row_space(P: NDArray[np.float64], tol: float) -> tuple[int, NDArray[np.floa
     """The rank of ``P`` (r, p) and, per column ``j``, the squared norm of ``e_j``'s
     projection on its row space (p,), by pivoted QR of ``P^T`` (``P``'s columns, then its
     rows, scaled to unit norm: a rotor's gear ratio squared does not hide its sum)."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
     if P.size == 0:
         return 0, np.zeros(P.shape[1])
     cols = P / np.maximum(np.linalg.norm(P, axis=0), 1e-300)  # e_j's membership unchanged
@@ -131,6 +132,8 @@ def _row_space(P: NDArray[np.float64], tol: float) -> tuple[int, NDArray[np.floa
 
 def _rank(P: NDArray[np.float64], tol: float) -> int:
     """The rank of ``P`` with unit columns (pivoted QR)."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
     cols = np.linalg.norm(P, axis=0)
     keep = cols > 0
     if not keep.any():

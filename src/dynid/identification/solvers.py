@@ -12,7 +12,6 @@ from __future__ import annotations
 from typing import Literal, get_args
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from .. import _checks
@@ -124,6 +123,8 @@ def _null_echelon(
 ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """The ``k - rank`` null directions of ``R`` in the coefficients' units (d, k) and the
     column of largest (scaled) weight naming each."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
     k = R.shape[1]
     d = k - rank
     Vt = np.linalg.svd(R)[2]
@@ -282,6 +283,8 @@ def _solve_semi_normal(
     matrix is not finite or out of range, its Cholesky factorisation fails or the
     condition number exceeds the guard (see the module docstring).
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     m, rk = y.size, Wk.shape[1]
     if G is None:
         G = _gram(Wk, blk)
@@ -339,6 +342,8 @@ def _solve_qr(
         Rank below the column count, fewer rows than columns included (with the null
         direction, for naming the columns).
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     m, rk = Wk.shape
     norms = np.sqrt(np.einsum("ij,ij->j", Wk, Wk))
     scale = np.where(norms > 0, norms, 1.0)

@@ -14,7 +14,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, NonFiniteError, RankDeficientError
@@ -57,6 +56,8 @@ def _solve(
     labels: tuple[str, ...] | None,
 ) -> _Solved:
     """The least-squares fit of the kept columns from the factor ``Raug`` of ``[W y]``."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
     c = Raug.shape[1] - 1
     idx = np.flatnonzero(keep)
     rk = idx.size

@@ -48,7 +48,6 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from .. import _checks
@@ -211,6 +210,8 @@ def _on_top(R: NDArray[np.float64], X: NDArray[np.float64]) -> NDArray[np.float6
 
 def _triangular(X: NDArray[np.float64]) -> NDArray[np.float64]:
     """The upper triangular factor (c+1, c+1) of ``X`` (M, c+1), M >= c+1, zero-padded."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
     k = X.shape[1]
     R = scipy.linalg.qr(X, mode="r", overwrite_a=True, check_finite=False)[0][:k]
     if R.shape[0] < k:
@@ -221,6 +222,8 @@ def _triangular(X: NDArray[np.float64]) -> NDArray[np.float64]:
 def _stacked_r(buf: NDArray[np.float64]) -> NDArray[np.float64]:
     """The upper triangular factor (k, k) of ``buf`` (M, k), M >= k, column-major,
     overwritten (LAPACK ``dgeqrf`` in place: no copy of the block)."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
     k = buf.shape[1]
     qr, _, _, info = scipy.linalg.lapack.dgeqrf(buf, overwrite_a=1)
     if info != 0:  # pragma: no cover - LAPACK argument error

@@ -16,7 +16,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
@@ -96,6 +95,8 @@ def structural_rank(
     -------
     StructuralRank
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     W = _random_columns(robot, columns, n_samples, rng)
     labels = columns.labels
     if used is not None:

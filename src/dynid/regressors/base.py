@@ -46,7 +46,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
@@ -249,6 +248,8 @@ def _pivoted_r(
     is, the column of largest remaining norm; ``rank`` steps are taken. The choice then
     depends on the structure of the regressor, not on rounding or on the samples.
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     m, p = A.shape
     R0 = scipy.linalg.qr(A, mode="r", overwrite_a=True, check_finite=False)[0]
     R = np.array(R0[: min(m, p)], dtype=np.float64)
@@ -373,6 +374,8 @@ def _from_scaled(
 
     ``Ws`` is overwritten by its QR factorisation.
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     m, p = Ws.shape
     R, piv, r, gap, cut = _pivoted_r(Ws, rtol)
     ind, dep = np.sort(piv[:r]), np.sort(piv[r:])
@@ -465,6 +468,8 @@ def base_parameters(
     OptionError
         An unknown ``kind``.
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     rng = np.random.default_rng(0) if rng is None else rng
     if kind not in ("static", "torque"):
         raise OptionError(f"kind must be 'static' or 'torque'; got {kind!r}")

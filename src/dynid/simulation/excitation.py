@@ -49,7 +49,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
@@ -661,6 +660,13 @@ def _preferred_rest(robot: Robot, q_start: ArrayLike | None) -> NDArray[np.float
     return _checks.as_exact("q_start", q_start, (robot.n,))
 
 
+def _minimize(*args: Any, **kwargs: Any) -> Any:
+    """``scipy.optimize.minimize``, imported on first use (start-up time)."""
+    import scipy.optimize
+
+    return scipy.optimize.minimize(*args, **kwargs)
+
+
 def optimise_excitation(
     robot: Robot,
     rng: np.random.Generator,
@@ -736,7 +742,7 @@ def optimise_excitation(
         if progress is not None:
             progress(len(history), options.max_iter, cond)
 
-    res = scipy.optimize.minimize(
+    res = _minimize(
         prob.objective,
         x0,
         method="L-BFGS-B",

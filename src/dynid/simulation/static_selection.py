@@ -30,7 +30,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
@@ -84,6 +83,8 @@ def stacked_condition_numbers(
     those of its triangular factor ``R`` (``W = Q R``), updated block by block, and the
     column-scaled ones those of ``R D^-1`` (``D``: the column norms, summed by block).
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     base = base_parameters(robot) if base is None else base
     n, r = robot.n, base.rank
     per = (n * (n + 1) // 2 + n) * 10 * n * 8  # bytes of one configuration's regressor

@@ -52,9 +52,7 @@ from collections.abc import Callable
 from concurrent.futures import as_completed
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
-from scipy.optimize import dual_annealing
 
 from ..._parallel import process_pool
 from ...exceptions import InfeasibleError, OptionError
@@ -91,6 +89,8 @@ def _refine(
     (the slow zig-zag of constraints switching at their target). Returns the point and
     the number of residual evaluations.
     """
+    import scipy.linalg  # scipy on first use (start-up time)
+
     e = problem.lsq_residual(z, xi)
     cost = float(e @ e)
     nfev = 1
@@ -166,6 +166,8 @@ def _one_run(
     problem: PenaltyProblem, seq: np.random.SeedSequence, options: RetrievalOptions, index: int
 ) -> RetrievalRun:
     """Run ``index`` of Algorithm 1 (executed in a worker process or in-process)."""
+    from scipy.optimize import dual_annealing  # scipy on first use (start-up time)
+
     t0 = time.perf_counter()
     rng = np.random.default_rng(seq)
     d = problem.dim
@@ -213,6 +215,8 @@ def _run_all(
     workers: int,
     on_done: Callable[[RetrievalRun], None],
 ) -> list[RetrievalRun]:
+    import scipy.optimize  # noqa: F401 (imported before the workers fork, not in each)
+
     seqs = np.random.SeedSequence(seed).spawn(options.runs)
     runs: list[RetrievalRun | None] = [None] * options.runs
     if workers <= 1 or options.runs == 1:

@@ -54,7 +54,6 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from ... import __version__
 from ...exceptions import DynidWarning, ModelError, ShapeError
@@ -92,6 +91,8 @@ def _v(v: np.ndarray) -> str:
 
 def _pose(T: np.ndarray) -> str:
     """``pos`` and ``quat`` (w x y z) attributes of a pose (4, 4)."""
+    from scipy.spatial.transform import Rotation  # scipy on first use (start-up time)
+
     x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
     return f'pos="{_v(T[:3, 3])}" quat="{_v(np.array([w, x, y, z]))}"'
 
