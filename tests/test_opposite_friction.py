@@ -90,16 +90,15 @@ def pair():
     fv = np.array([0.25, 0.3, 0.2, 0.2, 0.12, 0.1, 0.06])
     fc = np.array([0.6, 0.7, 0.5, 0.5, 0.35, 0.3, 0.25])
     fr = ClassicalFriction(fv, fc, np.zeros(7))
-    return recordings(
-        truth, (91, 92), friction=fr, duration=3.0, noise=GEARED_NOISE, added=_stribeck
-    )
+    return recordings(truth, (1, 2), friction=fr, duration=3.0, noise=GEARED_NOISE, added=_stribeck)
 
 
 def test_two_recordings_of_opposite_sign_on_a_wrist_joint_name_the_flipped_file(pair):
     """Two recordings, joint 7's torque negated in one (no majority to compare with): the
     description's torques and dissipating friction name that file, whichever it is, and
     identify's preparation refuses with its --units entry; the clean pair (a payload the
-    description lacks, Stribeck friction, noise) names nothing."""
+    description lacks, Stribeck friction, noise) names nothing (joint 2 of b.csv had been
+    named, its own terms taking what the description lacks)."""
     panda = dynid.panda()
     a, b = pair
     names = ["a.csv", "b.csv"]
