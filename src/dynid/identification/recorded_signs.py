@@ -7,7 +7,10 @@ sign to the others.
   before the sign (:func:`reversed_joint`).
 * **Opposite sign between recordings**: of several recordings, one motor (joint) the links
   barely load of the opposite sign to the others' is told by its own friction and rotor
-  (:func:`opposite_friction_among`).
+  (:func:`opposite_friction_among`), confirmed by one friction, rotor and offset fitted to
+  the recordings pooled; where none reads right to compare with (two recordings), that
+  pooled fit names the disagreement, and the file when the model's torques or
+  dissipating friction tell it (:func:`opposite_among_pooled`).
 
 :func:`recording_sign_findings` runs these sign checks, with the sign against the model's
 torques (:func:`~dynid.identification.model_sign.opposite_sign_among`), in the one order
