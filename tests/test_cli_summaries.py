@@ -120,3 +120,21 @@ def test_the_structure_table_shows_each_shaped_law_at_its_best_shape():
     assert shown == [names[0], chosen, names[2], names[5]], lines
     said = "  (2 more candidate(s) of a smooth or Stribeck law"
     assert any(line.startswith(said) for line in lines)
+
+
+def test_a_per_joint_structure_and_its_every_joint_structure_read_apart():
+    """The every-joint structure and the per-joint one of the same terms (the coefficients
+    left out in their own column): their names differ, the per-joint one marked ", per
+    joint" (two rows read alike, 71 and 65 parameters)."""
+    row = {"train_error_percent": 0.3, "heldout_se_percent": 0.03}
+    full = "links + viscous + smooth:10 + stribeck:0.0803 + offset"
+    pruned = f"{full} - fo1 - fo3"
+    cands = [
+        row | {"name": full, "n_params": 71, "heldout_error_percent": 0.2978},
+        row | {"name": pruned, "n_params": 69, "heldout_error_percent": 0.2979},
+    ]
+    sel = {"validation": "2 recordings", "chosen": pruned, "rule": "rule", "candidates": cands}
+    lines = selection_lines(sel)
+    rows = [line[4:].split("  ")[0].strip() for line in lines[2:] if line.startswith("  ")]
+    assert rows == [full, f"{full}, per joint"], lines
+    assert lines[-1].endswith("  fo1 fo3"), lines

@@ -18,7 +18,7 @@ import pytest
 import dynid
 from dynid.exceptions import DataError
 from dynid.friction.model import ClassicalFriction
-from dynid.identification.recorded_signs import opposite_friction_among
+from dynid.identification.recorded_signs import opposite_friction_among, recording_sign_findings
 from dynid.identification.recordings import prepare_recordings
 
 from conftest import GEARED_NOISE, geared_recordings, recordings
@@ -67,3 +67,69 @@ def test_three_clean_joint_side_recordings_name_nothing_and_a_wrist_flip_is_name
     said = opposite_friction_among(panda, [*logs[:2], _negated(logs[2], 6)], names)
     assert said is not None and said.startswith("c.csv: the torques of joint7 read"), said
     assert "--units c.csv:tau7=-1" in said, said
+
+
+def _stribeck(log):
+    """A Stribeck peak (0.6 x the Coulomb friction of :func:`_pair`, 0.08 rad/s) beside the
+    simulated classical friction: torques [N m] (N, 7) at the log's velocities."""
+    fc = np.array([0.6, 0.7, 0.5, 0.5, 0.35, 0.3, 0.25])
+    return 0.6 * fc * np.exp(-((log.dq / 0.08) ** 2)) * np.tanh(log.dq / 0.01)
+
+
+@pytest.fixture(scope="module")
+def pair():
+    """Two noisy 3 s recordings of a Panda carrying a 1.2 kg payload its description lacks,
+    with viscous, Coulomb and Stribeck friction (the FR3 trial's)."""
+    truth = dynid.panda().with_tool(
+        np.eye(4),
+        name="gripper",
+        mass=1.2,
+        com=(0.01, 0.0, 0.08),
+        inertia=(0.006, 0, 0, 0.007, 0, 0.003),
+    )
+    fv = np.array([0.25, 0.3, 0.2, 0.2, 0.12, 0.1, 0.06])
+    fc = np.array([0.6, 0.7, 0.5, 0.5, 0.35, 0.3, 0.25])
+    fr = ClassicalFriction(fv, fc, np.zeros(7))
+    return recordings(truth, (1, 2), friction=fr, duration=3.0, noise=GEARED_NOISE, added=_stribeck)
+
+
+def test_two_recordings_of_opposite_sign_on_a_wrist_joint_name_the_flipped_file(pair):
+    """Two recordings, joint 7's torque negated in one (no majority to compare with): the
+    description's torques and dissipating friction name that file, whichever it is, and
+    identify's preparation refuses with its --units entry; the clean pair (a payload the
+    description lacks, Stribeck friction, noise) names nothing (joint 2 of b.csv had been
+    named, its own terms taking what the description lacks)."""
+    panda = dynid.panda()
+    a, b = pair
+    names = ["a.csv", "b.csv"]
+    assert recording_sign_findings(panda, [a, b], names) == ()
+    for flipped, (x, y) in (("b.csv", (a, _negated(b, 6))), ("a.csv", (_negated(a, 6), b))):
+        found = recording_sign_findings(panda, [x, y], names)
+        assert [f.name for f in found] == [flipped], found
+        said = found[0].text
+        assert said.startswith("the torques of joint7 read of the opposite sign"), said
+        assert f"--units {flipped}:tau7=-1 reads it flipped" in said, said
+    with pytest.raises(DataError, match=r"b\.csv:tau7=-1"):
+        prepare_recordings(panda, [a, _negated(b, 6)], names)
+
+
+def test_two_recordings_of_opposite_sign_the_description_cannot_tell_name_both():
+    """A description without inertial parameters and joint 7 without friction (its own
+    rotor inertia alone): the two recordings' disagreement on joint 7 is named with both
+    files and both --units entries, and identify's preparation refuses; the pair as
+    recorded names nothing."""
+    truth = dynid.panda()
+    fr = ClassicalFriction(np.r_[np.full(6, 0.3), 0.0], np.r_[np.full(6, 0.4), 0.0], np.zeros(7))
+    a, b = recordings(
+        truth, (93, 94), friction=fr, armature=np.full(7, 0.2), duration=3.0, noise=GEARED_NOISE
+    )
+    bare = truth.with_params(np.zeros_like(truth.phi))
+    names = ["a.csv", "b.csv"]
+    assert recording_sign_findings(bare, [a, b], names) == ()
+    found = recording_sign_findings(bare, [a, _negated(b, 6)], names)
+    assert [f.name for f in found] == ["a.csv, b.csv"], found
+    said = found[0].text
+    assert said.startswith("the torques of joint7 read of opposite signs in a.csv and b.csv")
+    assert "--units a.csv:tau7=-1 or --units b.csv:tau7=-1" in said, said
+    with pytest.raises(DataError, match="read of opposite signs in a.csv and b.csv"):
+        prepare_recordings(bare, [a, _negated(b, 6)], names)

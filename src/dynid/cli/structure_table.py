@@ -31,7 +31,6 @@ def selection_lines(selection: Any) -> list[str]:
         (name, _, " - ".join(c.get("left_out") or ()) or dropped)
         for c, (name, _, dropped) in zip(selection["candidates"], split, strict=True)
     ]
-    w = text_width("structure", [name for name, _, _ in split], 46)
     # the choice reads the held-out error with each joint in units of its own noise
     white = any(c.get("heldout_whitened_percent") is not None for c in selection["candidates"])
     cands = selection["candidates"]
@@ -40,6 +39,8 @@ def selection_lines(selection: Any) -> list[str]:
     # every candidate skipped is shown, marked x, as the selection's note says
     marked = {str(c["name"]) for c in cands if skip and _skipped(c)}
     shown, hidden = _best_of_shapes(cands, selection["chosen"], marked)
+    split = _told_apart(split, [c["name"] in shown for c in cands])
+    w = text_width("structure", [name for name, _, _ in split], 46)
     # the column of the coefficients left out, when a row shown holds some
     left = any(d for c, (_, _, d) in zip(cands, split, strict=True) if c["name"] in shown)
     out = [
@@ -82,6 +83,21 @@ def selection_lines(selection: Any) -> list[str]:
         )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
+
+
+def _told_apart(
+    split: list[tuple[str, str, str]], shown: Sequence[bool]
+) -> list[tuple[str, str, str]]:
+    """The rows' (name, separator, coefficients left out), a per-joint structure's name
+    told from another row ``shown`` of the same name (its every joint's coefficients) by
+    ``, per joint``: the coefficients left out go to their own column, and the two rows
+    read alike (FR3, two recordings: ``links + viscous + smooth:10 + stribeck:0.0803 +
+    offset`` twice, 71 and 65 parameters)."""
+    names = [name for (name, _, _), on in zip(split, shown, strict=True) if on]
+    return [
+        (f"{name}, per joint" if dropped and names.count(name) > 1 else name, sep, dropped)
+        for name, sep, dropped in split
+    ]
 
 
 def _determined_line(kept: Sequence[dict[str, Any]]) -> list[str]:

@@ -52,6 +52,7 @@ from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.residual_dependence import (
     Dependence,
+    friction_left_out,
     held_terms,
     judged_springs,
     offsets_of,
@@ -134,6 +135,10 @@ class HeldOutTorques:
         :data:`~dynid.friction.validation.KEPT_SAMPLES` samples in all: the model's
         residual on them is read (:func:`~dynid.friction.delay_check.logs_delay`) without
         preparing them again; empty otherwise.
+    left_out : mapping of int to tuple of str
+        The friction coefficients the model left out per joint
+        (:func:`~dynid.identification.residual_dependence.friction_left_out`): a held-out
+        residual that follows the velocity there is said to be that friction.
     """
 
     validation: Validation
@@ -150,6 +155,7 @@ class HeldOutTorques:
     springs: ResidualSpring | None = None
     offsets: Mapping[int, tuple[str, bool]] = field(default_factory=dict)
     prepared: tuple[TorqueLog, ...] = ()
+    left_out: Mapping[int, tuple[str, ...]] = field(default_factory=dict)
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -206,6 +212,7 @@ class HeldOutTorques:
             self.springs,
             [v.log.tau],
             self.offsets,
+            self.left_out,
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -457,7 +464,7 @@ def _held_out(
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model),
-        offsets=offsets_of(model),
+        offsets=offsets_of(model), left_out=friction_left_out(model),
     )  # fmt: skip
     verdict, floor = held._judged()
     total = floor.total_rms

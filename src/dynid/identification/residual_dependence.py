@@ -48,6 +48,7 @@ __all__ = [
     "BINS",
     "Dependence",
     "dependence_hint",
+    "friction_left_out",
     "held_terms",
     "judged_springs",
     "offsets_of",
@@ -282,12 +283,17 @@ def _sentence(
     terms: Collection[str] = (),
     springs: ResidualSpring | None = None,
     offsets: Mapping[int, tuple[str, bool]] | None = None,
+    left_out: Mapping[int, tuple[str, ...]] | None = None,
 ) -> str:
     """One joint's diagnosis in words; ``terms`` the model's term names (:func:`held_terms`),
     so that the remedy names what the model lacks, not what it holds; ``springs`` the
     stiffness per joint fitted with the model (its named joints' said with their
     stiffness, a position dependence no spring explains said so); ``offsets`` the model's
-    offset per joint (:func:`offsets_of`), with which a constant residual is told."""
+    offset per joint (:func:`offsets_of`), with which a constant residual is told;
+    ``left_out`` its friction coefficients left out per joint (:func:`friction_left_out`):
+    a residual that follows the velocity there is that friction, not one the law misses
+    (a model fitted to two FR3 recordings of opposite signs on joint 7 had dropped fv7 and
+    fc7, and its validation had suggested comparing the laws)."""
     head = f"{name}: "
     named = springs is not None and d.joint in springs.named  # judged_springs judged it
     follows = f"{head}{d.position:.2g} of {d.rms:.2g} N m RMS residual follows its position"
@@ -308,6 +314,15 @@ def _sentence(
             f"{follows}, but a linear spring fitted there with the model's columns explains "
             f"little of it ({k:.2g} N m/rad): the links' parameters pulled by an effect on "
             "another joint, or a dependence that is not a spring's"
+        )
+    gone = (left_out or {}).get(d.joint)
+    if d.velocity >= FOLLOWS * d.systematic and gone:
+        return (
+            f"{head}{d.velocity:.2g} of {d.rms:.2g} N m RMS residual follows its velocity: "
+            f"friction the model left out there ({', '.join(gone)} dropped by its fit: the "
+            f"recordings it was identified from may disagree in {name}'s torque sign, which "
+            "averages its friction to nothing (dynid identify names such recordings), or "
+            "show too little of it)"
         )
     if d.velocity >= FOLLOWS * d.systematic:
         return (
@@ -356,6 +371,33 @@ def offsets_of(model: IdentifiedModel | Robot) -> dict[int, tuple[str, bool]]:
     return out
 
 
+def friction_left_out(model: IdentifiedModel | Robot) -> dict[int, tuple[str, ...]]:
+    """The joints whose friction the model left out in part, each with the labels of the
+    velocity-dependent coefficients left out (``{6: ("fv7", "fc7")}``: the structure
+    chosen on held-out data dropped them on joint 7, or they were pruned); offsets are
+    :func:`offsets_of`'s. Friction at coupled motors, no one joint's, and a robot's own
+    friction give none."""
+    if isinstance(model, Robot):
+        return {}
+    out: dict[int, tuple[str, ...]] = {}
+    for t in model.terms.values():
+        term = t.term
+        if not isinstance(term, LinearFriction):
+            continue
+        kept = {lab for lab, k in zip(term.labels, t.kept, strict=True) if k}
+        coupled = set(term.drive.coupled)
+        for j in range(term.drive.n):
+            labels = [f"{term.prefix}{PART_LABELS[p]}{j + 1}" for p in term.parts]
+            gone = [
+                lab
+                for p, lab in zip(term.parts, labels, strict=True)
+                if p != "offset" and lab not in kept
+            ]
+            if j not in coupled and gone:
+                out[j] = out.get(j, ()) + tuple(gone)
+    return out
+
+
 def dependence_hint(
     q: Sequence[NDArray[np.float64]],
     dq: Sequence[NDArray[np.float64]],
@@ -367,6 +409,7 @@ def dependence_hint(
     ratios: NDArray[np.float64] | None = None,
     springs: ResidualSpring | None = None,
     offsets: Mapping[int, tuple[str, bool]] | None = None,
+    left_out: Mapping[int, tuple[str, ...]] | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -382,19 +425,22 @@ def dependence_hint(
     model (:func:`~dynid.identification.residual_spring.residual_spring`), which names a
     spring's joint with its stiffness and says where a position dependence is no
     spring's. ``offsets``: the model's offset per joint (:func:`offsets_of`), with which a
-    constant residual is told."""
+    constant residual is told; ``left_out``: the friction coefficients the model left out
+    per joint (:func:`friction_left_out`), named where the residual follows the velocity."""
     if tilt is not None and tilt.named:
         rows = tilt.rows
         q = [np.concatenate([np.asarray(x, dtype=np.float64) for x in q])[rows]]
         dq = [np.concatenate([np.asarray(x, dtype=np.float64) for x in dq])[rows]]
-        rest = dependence_hint(q, dq, [tilt.rest], noise_rms, joint_names, terms, offsets=offsets)
+        rest = dependence_hint(
+            q, dq, [tilt.rest], noise_rms, joint_names, terms, offsets=offsets, left_out=left_out
+        )
         return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
     found = residual_dependence(q, dq, error, noise_rms, ratios)
     if not found:
         return None
     worst = sorted(found, key=lambda d: d.ratio, reverse=True)
     said = "; ".join(
-        _sentence(d, joint_names[d.joint], terms, springs, offsets) for d in worst[:NAMED]
+        _sentence(d, joint_names[d.joint], terms, springs, offsets, left_out) for d in worst[:NAMED]
     )
     more = len(worst) - NAMED
     return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
@@ -440,6 +486,7 @@ def with_dependence_hint(
     springs: ResidualSpring | None = None,
     torques: Sequence[NDArray[np.float64]] | None = None,
     offsets: Mapping[int, tuple[str, bool]] | None = None,
+    left_out: Mapping[int, tuple[str, ...]] | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself; with the
@@ -449,13 +496,14 @@ def with_dependence_hint(
     points to, said first when it explains it; ``ratios``: the verdict's per joint, which
     say which joints are above their noise; ``springs``: the stiffness per joint fitted
     with the model, said for a spring's joint; ``offsets``: the model's offset per joint
-    (:func:`offsets_of`), with which a constant residual is told."""
+    (:func:`offsets_of`), with which a constant residual is told; ``left_out``: its
+    friction coefficients left out per joint (:func:`friction_left_out`)."""
     if verdict.level == "good":
         return verdict
     if (exact := round_off(error, torques)) is not None:
         return with_hint(verdict, round_off_note(exact))
     said = dependence_hint(
-        q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets
+        q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets, left_out
     )
     return with_hint(verdict, said)
 

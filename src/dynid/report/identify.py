@@ -180,7 +180,7 @@ def _own_facts(
         within_motion=within_motion,
         what="noise floor",
         above=_above_noise(held),
-        samples=VERDICT_SAMPLES,
+        samples=verdict_samples(held),
     )
     block = esc(str(held.get("block", "held-out data")))
     said = f"{fact[0].lower()}{fact[1:]}"
@@ -318,14 +318,27 @@ def _overfit_fact(
     return fact, ["fair"] if ratio > OVERFIT_GOOD else []
 
 
-#: What the held-out verdict's error is computed on (heldout.json's, the command's verdict).
-VERDICT_SAMPLES = "every sample of the held-out block, torques as measured"
+def verdict_samples(held: dict | None) -> str:
+    """What the held-out verdict's error is computed on (heldout.json's, the command's
+    verdict): every sample of the held-out recordings (each left out in turn, or the
+    last), of the separate log (``--validate-on``) or of the held-out time block, torques
+    as measured; read from heldout.json's ``block``, which names them. Before, whole
+    recordings left out in turn were called "the held-out block"."""
+    block = str((held or {}).get("block", ""))
+    where = (
+        "the held-out recordings"
+        if "recordings" in block
+        else "the separate log"
+        if "--validate-on" in block
+        else "the held-out block"
+    )
+    return f"every sample of {where}, torques as measured"
 
 
 def pooled_label(ho: Any) -> str:
     """What least squares' held-out error of the record (``metadata.heldout``) is computed
     on: the fit's own rows, filtered and decimated, pooled over the folds where there are
-    several (a figure apart from the verdict's, :data:`VERDICT_SAMPLES`)."""
+    several (a figure apart from the verdict's, :func:`verdict_samples`)."""
     folds = isinstance(ho, dict) and ho.get("scheme") in ("blocks", "recordings")
     return "filtered, decimated samples" + (", pooled over the folds" if folds else "")
 
@@ -742,7 +755,9 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
             "error / noise" + (" (each sample against its own)" if weighed else ""),
             "held-out relative error [%]",
         ]
-        said = f"{held.get('block', 'Held-out data')}: {VERDICT_SAMPLES} (the verdict's numbers)"
+        said = (
+            f"{held.get('block', 'Held-out data')}: {verdict_samples(held)} (the verdict's numbers)"
+        )
         parts.append(f"<p>{esc(capitalised(said))}.</p>" + table(headers, rows))
     if not parts:
         return ""

@@ -70,6 +70,7 @@ from ..identification.motion_range import motion_range_hint, with_motion_range_h
 from ..identification.pieces import check_below_nyquist
 from ..identification.recorded_signs import SignFinding
 from ..identification.residual_dependence import (
+    friction_left_out,
     held_terms,
     offsets_of,
     with_dependence_hint,
@@ -399,7 +400,7 @@ def validate_files(
     dependence = not beyond and not opposite
     verdict, springs = _with_hints(
         model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model),
-        offsets=offsets_of(model),
+        offsets=offsets_of(model), left_out=friction_left_out(model),
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
@@ -474,12 +475,15 @@ def _with_hints(
     dependence: bool = True,
     terms: frozenset[str] = frozenset(),
     offsets: Mapping[int, tuple[str, bool]] | None = None,
+    left_out: Mapping[int, tuple[str, ...]] | None = None,
 ) -> tuple[Verdict, ResidualSpring | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
     any residual follows the motion; ``terms`` the model's, which its remedies leave out;
     ``offsets`` its offset per joint, with which a constant residual is told;
+    ``left_out`` its friction coefficients left out per joint, named where the residual
+    follows the velocity;
     first the tilt of the gravity vector the residual points to, when it explains it:
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
     with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`), the
@@ -497,7 +501,7 @@ def _with_hints(
         tau = [v.log.tau for v in val.parts]
         verdict = with_dependence_hint(
             verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau,
-            offsets,
+            offsets, left_out,
         )  # fmt: skip
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
