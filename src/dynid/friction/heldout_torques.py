@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DynidError, DynidWarning
 from ..dynamics.terms import gravity_torques
+from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains, drive_gains
 from ..identification.floor_verdict import judged_prediction, prediction_input_noise

@@ -31,6 +31,7 @@ above the noise down to at most :data:`EXPLAINED` of what it was (:attr:`DriveGa
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Literal
 
@@ -46,6 +47,7 @@ __all__ = [
     "EXPLAINED",
     "LINKED",
     "OFF",
+    "RAISE",
     "SIGNIFICANT",
     "DriveGains",
     "drive_gains",
@@ -57,12 +59,15 @@ OFF = 0.10
 #: Smallest ratio of a gain's distance from 1 to its standard deviation.
 SIGNIFICANT = 5.0
 #: Largest relative standard deviation of a determined gain.
-DETERMINED = 0.05
+DETERMINED = 0.02
 #: Largest share of the error above the noise (RMS) the fitted gains may leave.
 EXPLAINED = 0.5
 #: Smallest energy above the noise (per row, relative to the noise's) of a motor's effort
 #: with the model's columns projected out, for its gain to be fitted.
 LINKED = 0.25
+#: Smallest rise of the squared error ratio (to the noise's) when a named motor's gain is
+#: held at 1.
+RAISE = 0.02
 #: Relative tolerance of the model columns' rank (pivoted QR of the scaled columns).
 _RANK_RTOL = 1e-10
 
@@ -88,6 +93,12 @@ class DriveGains:
         every gain 1 (the efforts as logged).
     ratio_fitted : float
         The same with the gains fitted.
+    ratio_held : ndarray, shape (m,), optional
+        The weighted residual's RMS over the noise with the gains fitted but motor
+        ``k``'s held at 1 (the constant as logged), the parameters fitted again; NaN where
+        not fitted. A gain whose holding raises ``ratio^2`` by less than :data:`RAISE`
+        is no finding's, whatever its standard deviation (a long log makes a systematic
+        error of a few percent of the noise many standard deviations).
     effort : {"current", "torque"}
         What the log holds, for the finding's words: motor currents through a drive's
         torque constants, or torques (sensors' scales).
@@ -98,6 +109,7 @@ class DriveGains:
     scaled: bool
     ratio_fixed: float
     ratio_fitted: float
+    ratio_held: NDArray[np.float64] | None = None
     effort: Literal["current", "torque"] = "torque"
 
     def ratio_std(self, k: int, r: int) -> float:
@@ -166,6 +178,9 @@ class DriveGains:
             return ()
         d, std = np.abs(np.nan_to_num(self.factor, nan=1.0) - 1.0), self.std
         ok = self.determined & (d >= OFF) & (d >= SIGNIFICANT * std)
+        if self.ratio_held is not None:  # the error depends on it
+            held = np.nan_to_num(self.ratio_held, nan=0.0)
+            ok &= held**2 - self.ratio_fitted**2 >= RAISE
         return tuple(int(k) for k in np.flatnonzero(ok))
 
     def sentence(self) -> str | None:
@@ -315,12 +330,36 @@ def drive_gains(
     c *= float(np.linalg.norm(factor[active]) / np.linalg.norm(g))
     cov = np.full((m, m), np.nan)
     cov[np.ix_(active, active)] = cov_a * c**2
-    found = DriveGains(factor, cov, scaled, float(np.sqrt(fixed)), float(np.sqrt(fitted)))
+    held = _held_ratios(factor, g, active, B, Qa, dof)
+    found = DriveGains(factor, cov, scaled, float(np.sqrt(fixed)), float(np.sqrt(fitted)), held)
     sure = found.determined
     if scaled or not sure.any():
         return found
     mean = float(np.exp(np.mean(np.log(factor[sure]))))  # geometric mean 1 over the determined
-    return DriveGains(factor / mean, cov / mean**2, False, found.ratio_fixed, found.ratio_fitted)
+    return dataclasses.replace(found, factor=factor / mean, cov=cov / mean**2)
+
+
+def _held_ratios(
+    factor: NDArray[np.float64],
+    g: NDArray[np.float64],
+    active: NDArray[np.bool_],
+    B: NDArray[np.float64],
+    Q0: NDArray[np.float64],
+    dof: int,
+) -> NDArray[np.float64]:
+    """Per motor, the weighted residual's RMS over the noise with its gain held at 1
+    (:attr:`DriveGains.ratio_held`): ``g`` the gains of the ``active`` motors at the
+    scale of the efforts ``B``, ``factor`` at the description's, ``Q0`` the columns fitted
+    again."""
+    motors = np.flatnonzero(active)
+    unit = float(g[0] / factor[motors[0]])  # a gain of 1 at the scale of g
+    held = np.full(factor.size, np.nan)
+    for i, k in enumerate(motors):
+        h = g.copy()
+        h[i] = unit
+        r = B[:, active] @ h
+        held[k] = np.sqrt(float(np.sum((r - Q0 @ (Q0.T @ r)) ** 2)) / max(dof, 1))
+    return held
 
 
 def _linked(
