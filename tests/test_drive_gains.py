@@ -160,3 +160,29 @@ def test_right_torque_constants_raise_no_finding(panda, geared_pair):
     held = _heldout(panda, logs, drive)
     assert held.gains is None or held.gains.named == ()
     assert "a gain per" not in held.verdict.reason
+
+
+def test_validate_names_the_factor_of_a_model_identified_through_a_guess(
+    panda, geared_pair, tmp_path
+):
+    """validate of the second log against the model identified from the first through
+    motor 2's torque constant guessed 1.25 times too small: the verdict names motor 2's
+    factor (multiply by about 1.25) and no spring."""
+    from dynid.io.torque_log import save_torque_log
+    from dynid.workflows.validate import ValidateOptions, validate_files
+
+    (train, held), drive = geared_pair
+    truth = np.array([1.0, 1.25, 1.0, 1.0, 1.0, 1.0, 1.0])
+    assert drive.torque_constant is not None
+    guess = dataclasses.replace(drive, torque_constant=drive.torque_constant / truth)
+    save_torque_log(tmp_path / "held.csv", held)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_from_log(panda, train, drive=guess)
+        said = validate_files(model, tmp_path / "held.csv", ValidateOptions()).verdict.reason
+    m = re.search(
+        r"torque_constant of motor 2 looks [0-9.]+ times the true one: multiply it by ([0-9.]+)",
+        said,
+    )
+    assert m is not None and abs(float(m[1]) - 1.25) < 0.05, said
+    assert "spring" not in said, said

@@ -580,8 +580,9 @@ def residual_gains(
     found = drive_gains(W, log.tau[rows], noise, K, G, gd)
     if found is None:
         return None
-    effort = "current" if drive is not None and drive.effort == "current" else "torque"
-    return dataclasses.replace(found, effort=effort)
+    if drive is not None and drive.effort == "current":
+        return dataclasses.replace(found, effort="current")
+    return found
 
 
 def beside_columns(
