@@ -150,6 +150,8 @@ def test_guessed_torque_constants_are_named_in_place_of_a_spring(panda, geared_p
     said = held.verdict.reason
     pattern = r"torque_constant of motor 2 looks 0\.6\d* times the true one: multiply it by 1\.[45]"
     assert re.search(pattern, said), said
+    doc = held.as_dict()["drive_gains"]
+    assert doc["named"] == list(gains.named) and doc["effort"] == "current"
     assert "spring" not in said, said
 
 

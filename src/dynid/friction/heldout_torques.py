@@ -258,7 +258,8 @@ class HeldOutTorques:
         the floor, the low-speed note (``low_speed``, the report's own line) and the tilt
         of the gravity vector the residual points to (``gravity_tilt``, null when not
         judged), and the stiffness per joint it points to (``springs``, null when not
-        judged; schema ``heldout.json``)."""
+        judged; schema ``heldout.json``), and the gain per motor of the logged efforts
+        (``drive_gains``, null when not judged)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
             "block": self.block,
@@ -277,6 +278,7 @@ class HeldOutTorques:
             "low_speed": None if v.level == "good" else self.low_speed,
             "gravity_tilt": None if self.tilt is None else self.tilt.as_dict(),
             "springs": None if self.springs is None else self.springs.as_dict(),
+            "drive_gains": None if self.gains is None else self.gains.as_dict(),
             "units": {
                 "rms": "N m",
                 "noise_rms": "N m",
@@ -581,8 +583,8 @@ def residual_gains(
     if found is None:
         return None
     if drive is not None and drive.effort == "current":
-        return dataclasses.replace(found, effort="current")
-    return found
+        return dataclasses.replace(found, effort="current", per="motor" if motor else "joint")
+    return dataclasses.replace(found, per="motor") if motor else found
 
 
 def beside_columns(

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import scipy.linalg
@@ -100,6 +100,9 @@ class DriveGains:
     effort : {"current", "torque"}
         What the log holds, for the finding's words: motor currents through a drive's
         torque constants, or torques (sensors' scales).
+    per : {"joint", "motor"}
+        Whose efforts the gains scale, for the finding's words: a joint-side log's joints
+        or a motor-side log's motors.
     """
 
     factor: NDArray[np.float64]
@@ -109,6 +112,7 @@ class DriveGains:
     ratio_fitted: float
     ratio_held: NDArray[np.float64] | None = None
     effort: Literal["current", "torque"] = "torque"
+    per: Literal["joint", "motor"] = "joint"
 
     def ratio_std(self, k: int, r: int) -> float:
         """The standard deviation [-] of motor ``k``'s gain relative to motor ``r``'s,
@@ -182,6 +186,29 @@ class DriveGains:
             ok &= held**2 - self.ratio_fitted**2 >= RAISE
         return tuple(int(k) for k in np.flatnonzero(ok))
 
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``factor`` and ``std`` per motor (null where left out), ``scaled``,
+        ``ratio_fixed``, ``ratio_fitted``, ``ratio_held`` (per motor), ``determined`` and
+        ``named`` (the motors' indices from 0), ``effort`` and ``per``."""
+
+        def listed(x: NDArray[np.float64] | None) -> list[float | None] | None:
+            if x is None:
+                return None
+            return [float(v) if np.isfinite(v) else None for v in x]
+
+        return {
+            "factor": listed(self.factor),
+            "std": listed(self.std),
+            "scaled": self.scaled,
+            "ratio_fixed": self.ratio_fixed,
+            "ratio_fitted": self.ratio_fitted,
+            "ratio_held": listed(self.ratio_held),
+            "determined": [int(k) for k in np.flatnonzero(self.determined)],
+            "named": list(self.named),
+            "effort": self.effort,
+            "per": self.per,
+        }
+
     def sentence(self) -> str | None:
         """The finding in words, or None when :attr:`named` is empty: of currents, a
         drive's torque constants (``torque_constant of motor 2 looks 0.667 times the true
@@ -190,7 +217,7 @@ class DriveGains:
         named, what, std = self.named, self.effort, self.std
         if not named:
             return None
-        unit = "motor" if what == "current" else "joint"
+        unit = "motor" if what == "current" else self.per
         if what == "current":
             parts = [
                 f"torque_constant of motor {k + 1} looks {1 / self.factor[k]:.3g} times the "
@@ -199,7 +226,7 @@ class DriveGains:
             ]
         else:
             parts = [
-                f"the torques of joint {k + 1} read {1 / self.factor[k]:.3g} times the true "
+                f"the torques of {unit} {k + 1} read {1 / self.factor[k]:.3g} times the true "
                 f"ones: scale them by {self.factor[k]:.3g} (std {std[k]:.2g})"
                 for k in named
             ]
