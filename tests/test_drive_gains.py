@@ -82,6 +82,12 @@ def test_known_factors_come_back_within_their_noise(panda):
     motor = dataclasses.replace(found, effort="current").sentence()
     assert motor is not None and "torque_constant of motor 4 looks 1.43 times" in motor
     assert "multiply it by 0.7 " in motor
+    relative = drive_gains(W, logged, noise)  # no description: the factors' ratios alone
+    assert relative is not None and not relative.scaled
+    ratio = relative.factor / relative.factor[0]
+    np.testing.assert_allclose(ratio[[1, 3, 5]], truth[[1, 3, 5]], rtol=0.02)
+    words = dataclasses.replace(relative, effort="current").sentence()
+    assert words is not None and "relative to each other" in words and "motor 2's by" in words
 
 
 def test_right_factors_or_one_common_factor_name_nothing(panda):

@@ -213,39 +213,48 @@ class DriveGains:
         """The finding in words, or None when :attr:`named` is empty: of currents, a
         drive's torque constants (``torque_constant of motor 2 looks 0.667 times the true
         one: multiply it by 1.5``); of torques, the sensors' scales (``the torques of joint
-        2 read 0.667 times the true ones``)."""
+        2 read 0.667 times the true ones``); relative gains (:attr:`scaled` false) as the
+        factors between the motors, their common one not known."""
         named, what, std = self.named, self.effort, self.std
         if not named:
             return None
         unit = "motor" if what == "current" else self.per
-        if what == "current":
-            parts = [
-                f"torque_constant of motor {k + 1} looks {1 / self.factor[k]:.3g} times the "
-                f"true one: multiply it by {self.factor[k]:.3g} (std {std[k]:.2g})"
-                for k in named
-            ]
-        else:
-            parts = [
-                f"the torques of {unit} {k + 1} read {1 / self.factor[k]:.3g} times the true "
-                f"ones: scale them by {self.factor[k]:.3g} (std {std[k]:.2g})"
-                for k in named
-            ]
-        loose = ", ".join(str(k + 1) for k in np.flatnonzero(~self.determined))
         said = (
             f"a gain per {unit} explains the residual (fitted with the model's columns, the "
             f"error falls from {self.ratio_fixed:.3g} to {self.ratio_fitted:.3g} x the noise): "
-            + "; ".join(parts)
         )
         if not self.scaled:
-            said += " (relative to each other: the description holds no masses to fix their scale)"
-        else:
+            what_of = "torque_constant" if what == "current" else "torques"
+            said += (
+                f"the {unit}s' {what_of} are off by different factors: multiply "
+                + ", ".join(
+                    f"{unit} {k + 1}'s by {self.factor[k]:.3g} (std {std[k]:.2g})" for k in named
+                )
+                + " (relative to each other, their geometric mean 1: without the robot "
+                "description's masses the common factor is not known; dynid identify with "
+                "--robot names it)"
+            )
+        elif what == "current":
+            said += "; ".join(
+                f"torque_constant of motor {k + 1} looks {1 / self.factor[k]:.3g} times the "
+                f"true one: multiply it by {self.factor[k]:.3g} (std {std[k]:.2g})"
+                for k in named
+            )
             said += " (the common scale from the description's masses)"
+        else:
+            said += "; ".join(
+                f"the torques of {unit} {k + 1} read {1 / self.factor[k]:.3g} times the true "
+                f"ones: scale them by {self.factor[k]:.3g} (std {std[k]:.2g})"
+                for k in named
+            )
+            said += " (the common scale from the description's masses)"
+        loose = ", ".join(str(k + 1) for k in np.flatnonzero(~self.determined))
         if loose:
             said += f"; the data do not determine the gain of {unit}(s) {loose}"
         if what == "current":
             return said + ": change torque_constant in the drive file and identify again"
         return said + (
-            ': a scale per joint is a drive file with effort = "current" and these factors '
+            f': a scale per {unit} is a drive file with effort = "current" and these factors '
             "as torque_constant (--units tau=... scales every joint alike)"
         )
 
