@@ -35,8 +35,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._times import stamp_text
+from ..dynamics.terms import gravity_torques
 from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
+from ..identification.drive_gains import DriveGains, drive_gains
 from ..identification.floor_verdict import judged_prediction, prediction_input_noise
 from ..identification.gravity_tilt import GravityTilt, gravity_tilt, tilt_columns
 from ..identification.input_noise import (
@@ -49,6 +51,7 @@ from ..identification.log import TorqueLog, joint_side_log
 from ..identification.log_rows import term_regressor
 from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
+from ..identification.model_sign import gravity_loaded
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
 from ..identification.residual_dependence import (
     Dependence,
@@ -74,9 +77,13 @@ __all__ = [
     "HeldOutTorques",
     "beside_columns",
     "heldout_torques",
+    "residual_gains",
     "residual_springs",
     "residual_tilt",
 ]
+
+#: Samples the gains' fit uses at most (evenly spread).
+_GAIN_SAMPLES = 4_000
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -139,6 +146,12 @@ class HeldOutTorques:
         The friction coefficients the model left out per joint
         (:func:`~dynid.identification.residual_dependence.friction_left_out`): a held-out
         residual that follows the velocity there is said to be that friction.
+    gains : DriveGains or None
+        The gain per motor (or joint) of the logged efforts the held-out residual points
+        to (:func:`residual_gains`); when it names some
+        (:attr:`~dynid.identification.drive_gains.DriveGains.named`), the verdict says
+        them in place of what each joint's residual follows (the springs and the tilt
+        they explain are not judged).
     """
 
     validation: Validation
@@ -156,6 +169,7 @@ class HeldOutTorques:
     offsets: Mapping[int, tuple[str, bool]] = field(default_factory=dict)
     prepared: tuple[TorqueLog, ...] = ()
     left_out: Mapping[int, tuple[str, ...]] = field(default_factory=dict)
+    gains: DriveGains | None = None
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -199,20 +213,25 @@ class HeldOutTorques:
         (:func:`~dynid.identification.residual_dependence.with_dependence_hint`)."""
         verdict, fl = self._judged()
         v = self.validation
-        verdict = with_dependence_hint(
-            verdict,
-            [v.log.q],
-            [v.log.dq],
-            [v.log.tau - v.tau_hat],
-            fl.total_rms,
-            self.joint_names,
-            self.terms,
-            self.tilt,
-            fl.joint_ratios,
-            self.springs,
-            [v.log.tau],
-            self.offsets,
-            self.left_out,
+        said = None if self.gains is None else self.gains.sentence()
+        verdict = (
+            with_hint(verdict, said)
+            if said is not None
+            else with_dependence_hint(
+                verdict,
+                [v.log.q],
+                [v.log.dq],
+                [v.log.tau - v.tau_hat],
+                fl.total_rms,
+                self.joint_names,
+                self.terms,
+                self.tilt,
+                fl.joint_ratios,
+                self.springs,
+                [v.log.tau],
+                self.offsets,
+                self.left_out,
+            )
         )
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
@@ -255,7 +274,8 @@ class HeldOutTorques:
         the floor, the low-speed note (``low_speed``, the report's own line) and the tilt
         of the gravity vector the residual points to (``gravity_tilt``, null when not
         judged), and the stiffness per joint it points to (``springs``, null when not
-        judged; schema ``heldout.json``)."""
+        judged; schema ``heldout.json``), and the gain per motor of the logged efforts
+        (``drive_gains``, null when not judged)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
             "block": self.block,
@@ -274,6 +294,7 @@ class HeldOutTorques:
             "low_speed": None if v.level == "good" else self.low_speed,
             "gravity_tilt": None if self.tilt is None else self.tilt.as_dict(),
             "springs": None if self.springs is None else self.springs.as_dict(),
+            "drive_gains": None if self.gains is None else self.gains.as_dict(),
             "units": {
                 "rms": "N m",
                 "noise_rms": "N m",
@@ -468,11 +489,15 @@ def _held_out(
     )  # fmt: skip
     verdict, floor = held._judged()
     total = floor.total_rms
-    springs = None  # said only above the floor: a good verdict takes no hint
+    springs = gains = None  # said only above the floor: a good verdict takes no hint
     if verdict.level != "good":
-        springs = residual_springs(model, v if whole is None else whole(), total, v)
+        every = v if whole is None else whole()
+        gains = residual_gains(model, every, total)
+        if gains is not None and gains.named:  # the gains explain it: no spring, no tilt
+            return dataclasses.replace(held, gains=gains)
+        springs = residual_springs(model, every, total, v)
     tilt = residual_tilt(model, v, total, springs)
-    return dataclasses.replace(held, tilt=tilt, springs=springs)
+    return dataclasses.replace(held, tilt=tilt, springs=springs, gains=gains)
 
 
 def residual_tilt(
@@ -544,6 +569,47 @@ def residual_springs(
     seen = v if judged is None else judged
     found = residual_spring(log.q, log.tau, seen.log.tau - seen.tau_hat, noise, columns)
     return judged_springs(found, log.q, log.dq, log.tau - v.tau_hat)
+
+
+def residual_gains(
+    model: IdentifiedModel | Robot, v: Validation, noise: NDArray[np.float64]
+) -> DriveGains | None:
+    """The gain per motor of the logged efforts the prediction ``v`` points to
+    (:func:`~dynid.identification.drive_gains.drive_gains`; ``noise`` (n,) [N m] each
+    joint's): the efforts of ``v``'s log per motor through the model's drive
+    (:func:`~dynid.identification.drive_gains.effort_columns`; a joint-side log per joint)
+    fitted with the model's own columns and each motor's friction and rotor inertia
+    (:func:`beside_columns`), their common scale the description's gravity torques at the
+    joints gravity loads. None for a robot's own parameters or a log without
+    accelerations."""
+    log = v.log
+    if isinstance(model, Robot) or log.ddq is None:
+        return None
+    beside = beside_columns(model, log)
+    if beside is None:
+        return None
+    n_rows = log.q.shape[0]
+    rows = np.unique(np.linspace(0, n_rows - 1, min(n_rows, _GAIN_SAMPLES)).astype(np.intp))
+    W = beside(rows)
+    q = log.q[rows]
+    drive = model.drive
+    motor = drive is not None and drive.side == "motor"
+    K = drive.transmission if motor and drive is not None else None
+    robot = model.robot
+    G = gd = None
+    if np.any(robot.phi):
+        rest = np.zeros_like(q)
+        Y, _ = term_regressor(robot, model.base, (), q, rest, rest)
+        rigid = int(np.count_nonzero(np.asarray(model.base.independent) < 10 * robot.n))
+        G = np.zeros_like(W)
+        G[..., :rigid] = Y[..., :rigid]
+        gd = gravity_torques(robot, q) * gravity_loaded(robot, q)
+    found = drive_gains(W, log.tau[rows], noise, K, G, gd)
+    if found is None:
+        return None
+    if drive is not None and drive.effort == "current":
+        return dataclasses.replace(found, effort="current", per="motor" if motor else "joint")
+    return dataclasses.replace(found, per="motor") if motor else found
 
 
 def beside_columns(

@@ -423,10 +423,18 @@ def _predicted_heldout(
 
 
 def _say_gravity_scale(
-    robot: Robot, model: IdentifiedModel, logs: Sequence[TorqueLog], drive: Drive | None
+    robot: Robot,
+    model: IdentifiedModel,
+    logs: Sequence[TorqueLog],
+    drive: Drive | None,
+    held: HeldOutTorques | None = None,
 ) -> None:
     """Warn when ``model``'s gravity torques are one factor off the description's on every
-    loaded joint (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`)."""
+    loaded joint (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`);
+    not when the held-out verdict names a factor per motor (``held.gains``, which holds
+    the common one too): one judgement of the efforts' scale."""
+    if held is not None and held.gains is not None and held.gains.named:
+        return
     q = [log.q if drive is None else drive.joint_states(log.q)[0] for log in logs]
     found = gravity_scale_finding(robot, model, q, drive)
     if found is not None:
@@ -462,7 +470,7 @@ def _identify(
         )
         model = in_file(path, fit) if len(paths) == 1 else fit()
         held = _predicted_heldout(model, logs, heldout.get("validate_on"))
-        _say_gravity_scale(robot, model, logs, opt.drive)
+        _say_gravity_scale(robot, model, logs, opt.drive, held)
         model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
     else:
         held = delay = None
@@ -635,7 +643,7 @@ def _identify_consistent(
         unconstrained = result.identified
         held = None if unconstrained is None else _predicted_heldout(unconstrained, logs, separate)
         if unconstrained is not None:
-            _say_gravity_scale(robot, unconstrained, logs, opt.drive)
+            _say_gravity_scale(robot, unconstrained, logs, opt.drive, held)
         result = _with_outside_model_note(result, held, robot.joint_names)
     else:
         held = None

@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.delay_check import validations_delay
 from ..friction.fit import same_drive, torques_through
-from ..friction.heldout_torques import residual_springs, residual_tilt
+from ..friction.heldout_torques import residual_gains, residual_springs, residual_tilt
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.pooled import joined_validation
 from ..friction.recordings import RecordingsValidation, validate_recordings
@@ -486,7 +486,9 @@ def _with_hints(
     follows the velocity;
     first the tilt of the gravity vector the residual points to, when it explains it:
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
-    with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`), the
+    with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`; in
+    their place, a gain per motor of the logged efforts that explains the residual,
+    :func:`~dynid.friction.heldout_torques.residual_gains`), the
     hint of a
     cut-off too high for derived states, and that of an error at low speed; and the
     springs fitted (None: not judged)."""
@@ -494,8 +496,12 @@ def _with_hints(
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     springs = None
-    if dependence:
-        whole = joined_validation(val.parts) if verdict.level != "good" else None
+    whole = joined_validation(val.parts) if dependence and verdict.level != "good" else None
+    gains = None if whole is None else residual_gains(model, whole, noise.total)
+    said = None if gains is None else gains.sentence()
+    if said is not None:  # the efforts' scale per motor explains it: no spring, no tilt
+        verdict = with_hint(verdict, said)
+    elif dependence:
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]

@@ -1,0 +1,472 @@
+"""Per-motor gains of the logged efforts, identified with the model: torque constants (or
+torque sensors' scales) that are off by a different factor on each joint.
+
+A log of currents read through guessed torque constants, or of torque sensors with a
+scale error each, gives efforts ``e`` that are the true torques divided by a gain ``g_m``
+per motor (a log recorded on the joint side: per joint). The true joint torques
+``sum_m g_m E_m`` (``E_m``: motor ``m``'s logged effort mapped to the joints,
+:func:`effort_columns`) are the model's ``W theta`` (rigid-body base parameters, friction,
+rotor inertia, the model's terms), which is linear and homogeneous in ``(g, theta)``
+jointly (the known approach of identifying drive gains with the dynamic parameters,
+Khalil and Dombre, *Modeling, Identification and Control of Robots*, ch. 12). With each
+joint's rows in units of its noise, the model's columns projected out leave ``S g ~ 0``
+(``S``: the gains' normal matrix after the projection, ``m x m``); ``g`` is the
+eigenvector of ``S``'s smallest eigenvalue (noise in the efforts adds about a multiple of
+the identity to ``S``, which leaves its eigenvectors). The data fix the gains' ratios, not
+their common scale: that is the robot description's masses (the fitted model's gravity
+torques against the description's, pooled over the joints gravity loads; as
+:mod:`~dynid.identification.gravity_scale` does for one factor on every joint), else the
+gains are relative (geometric mean 1).
+
+A motor's gain is determined where its joints' equations share link parameters with the
+others' (the base parameters of a serial arm: a link's appear in every joint before it);
+one whose equation is its own (its friction and rotor, parameters of its own link alone,
+or a joint that never moved) is not, and its standard deviation says so
+(:attr:`DriveGains.determined`). The finding (:attr:`DriveGains.named`) names the
+determined motors whose gain differs from 1 by at least :data:`OFF` and :data:`SIGNIFICANT`
+standard deviations, when the gains differ between joints (a common factor alone is
+:mod:`~dynid.identification.gravity_scale`'s) and fitting them brings the error's part
+above the noise down to at most :data:`EXPLAINED` of what it was (:attr:`DriveGains.explains`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = [
+    "DETERMINED",
+    "EXPLAINED",
+    "LINKED",
+    "OFF",
+    "RAISE",
+    "SIGNIFICANT",
+    "DriveGains",
+    "drive_gains",
+    "effort_columns",
+]
+
+#: Relative distance from 1 of a gain the finding names.
+OFF = 0.10
+#: Smallest ratio of a gain's distance from 1 to its standard deviation.
+SIGNIFICANT = 5.0
+#: Largest relative standard deviation of a determined gain.
+DETERMINED = 0.02
+#: Largest share of the error above the noise (RMS) the fitted gains may leave.
+EXPLAINED = 0.5
+#: Smallest energy above the noise (per row, relative to the noise's) of a motor's effort
+#: with the model's columns projected out, for its gain to be fitted.
+LINKED = 0.25
+#: Smallest rise of the squared error ratio (to the noise's) when a named motor's gain is
+#: held at 1.
+RAISE = 0.02
+#: Relative tolerance of the model columns' rank (pivoted QR of the scaled columns).
+_RANK_RTOL = 1e-10
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class DriveGains:
+    """The per-motor gains a torque log points to (module docstring).
+
+    Attributes
+    ----------
+    factor : ndarray, shape (m,)
+        Each motor's gain: the true effort over the logged one (a torque constant to
+        multiply by it) [-]; scaled by the description's masses when :attr:`scaled`, else
+        relative (geometric mean 1 over the determined motors).
+    cov : ndarray, shape (m, m)
+        Their covariance [-] at the normalization of the eigenvector (white residual
+        assumed: a lower bound); only ratios of gains are determined by the data, so the
+        standard deviations are those of ratios (:attr:`std`, :meth:`ratio_std`).
+    scaled : bool
+        Whether the common scale is the robot description's (its gravity torques).
+    ratio_fixed : float
+        The weighted residual's RMS over the noise [-] of the model's columns fitted with
+        every gain 1 (the efforts as logged).
+    ratio_fitted : float
+        The same with the gains fitted.
+    ratio_held : ndarray, shape (m,), optional
+        The weighted residual's RMS over the noise with the gains fitted but motor
+        ``k``'s held at 1 (the constant as logged), the parameters fitted again; NaN where
+        not fitted. A gain whose holding raises ``ratio^2`` by less than :data:`RAISE`
+        is no finding's, whatever its standard deviation (a long log makes a systematic
+        error of a few percent of the noise many standard deviations).
+    effort : {"current", "torque"}
+        What the log holds, for the finding's words: motor currents through a drive's
+        torque constants, or torques (sensors' scales).
+    per : {"joint", "motor"}
+        Whose efforts the gains scale, for the finding's words: a joint-side log's joints
+        or a motor-side log's motors.
+    """
+
+    factor: NDArray[np.float64]
+    cov: NDArray[np.float64]
+    scaled: bool
+    ratio_fixed: float
+    ratio_fitted: float
+    ratio_held: NDArray[np.float64] | None = None
+    effort: Literal["current", "torque"] = "torque"
+    per: Literal["joint", "motor"] = "joint"
+
+    def ratio_std(self, k: int, r: int) -> float:
+        """The standard deviation [-] of motor ``k``'s gain relative to motor ``r``'s,
+        ``factor[k] / factor[r]``, times ``factor[r]``: ``k``'s gain with ``r``'s held
+        (first-order propagation of :attr:`cov`)."""
+        f = self.factor
+        grad = np.zeros(f.size)
+        grad[k] += 1.0 / f[r]
+        grad[r] -= f[k] / f[r] ** 2
+        cov = np.nan_to_num(self.cov, nan=0.0)  # the motors left out: no part
+        return float(abs(f[r]) * np.sqrt(max(float(grad @ cov @ grad), 0.0)))
+
+    @property
+    def std(self) -> NDArray[np.float64]:
+        """Each motor's standard deviation [-]: the smallest of :meth:`ratio_std` over the
+        other motors (a gain is determined against the one it shares most with); infinite
+        for a single motor."""
+        m = self.factor.size
+        out = np.full(m, np.inf)
+        fitted = np.isfinite(self.factor) & (self.factor != 0)
+        for k in np.flatnonzero(fitted):
+            for r in np.flatnonzero(fitted):
+                if r != k:
+                    out[k] = min(out[k], self.ratio_std(int(k), int(r)))
+        return out
+
+    @property
+    def determined(self) -> NDArray[np.bool_]:
+        """The motors (m,) whose gain the data determine: fitted (not NaN) and of relative
+        standard deviation at most :data:`DETERMINED`."""
+        f = np.nan_to_num(self.factor, nan=0.0)
+        return np.isfinite(self.factor) & (self.std <= DETERMINED * np.abs(f))
+
+    @property
+    def uneven(self) -> bool:
+        """Whether the determined gains differ between motors: the largest and smallest
+        differ by at least :data:`OFF` of the smallest and :data:`SIGNIFICANT` standard
+        deviations of their difference."""
+        js = np.flatnonzero(self.determined)
+        if js.size < 2:
+            return False
+        hi, lo = js[np.argmax(self.factor[js])], js[np.argmin(self.factor[js])]
+        gap = float(self.factor[hi] - self.factor[lo])
+        return gap >= OFF * float(self.factor[lo]) and gap >= SIGNIFICANT * self.ratio_std(
+            int(hi), int(lo)
+        )
+
+    @property
+    def explains(self) -> bool:
+        """Whether the efforts as logged leave an error above the noise and fitting the
+        gains leaves at most :data:`EXPLAINED` of its part above the noise (RMS,
+        ``sqrt(ratio^2 - 1)``). Both fits are in-sample: the parameters fitted again to
+        the log judged take much of a prediction's error (a held-out error 13 x the noise
+        is 1.1 x in-sample), so the error being above the noise is the verdict's to say."""
+        before = np.sqrt(max(self.ratio_fixed**2 - 1.0, 0.0))
+        after = np.sqrt(max(self.ratio_fitted**2 - 1.0, 0.0))
+        return before > 0 and after <= EXPLAINED * before
+
+    @property
+    def named(self) -> tuple[int, ...]:
+        """The motors (from 0) the finding names: the gains uneven and explaining the
+        error (:attr:`uneven`, :attr:`explains`), each determined motor whose gain is at
+        least :data:`OFF` from 1 and :data:`SIGNIFICANT` standard deviations clear of it
+        (relative gains: from their geometric mean)."""
+        if not (self.uneven and self.explains):
+            return ()
+        d, std = np.abs(np.nan_to_num(self.factor, nan=1.0) - 1.0), self.std
+        ok = self.determined & (d >= OFF) & (d >= SIGNIFICANT * std)
+        if self.ratio_held is not None:  # the error depends on it
+            held = np.nan_to_num(self.ratio_held, nan=0.0)
+            ok &= held**2 - self.ratio_fitted**2 >= RAISE
+        return tuple(int(k) for k in np.flatnonzero(ok))
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``factor`` and ``std`` per motor (null where left out), ``scaled``,
+        ``ratio_fixed``, ``ratio_fitted``, ``ratio_held`` (per motor), ``determined`` and
+        ``named`` (the motors' indices from 0), ``effort`` and ``per``."""
+
+        def listed(x: NDArray[np.float64] | None) -> list[float | None] | None:
+            if x is None:
+                return None
+            return [float(v) if np.isfinite(v) else None for v in x]
+
+        return {
+            "factor": listed(self.factor),
+            "std": listed(self.std),
+            "scaled": self.scaled,
+            "ratio_fixed": self.ratio_fixed,
+            "ratio_fitted": self.ratio_fitted,
+            "ratio_held": listed(self.ratio_held),
+            "determined": [int(k) for k in np.flatnonzero(self.determined)],
+            "named": list(self.named),
+            "effort": self.effort,
+            "per": self.per,
+        }
+
+    def sentence(self) -> str | None:
+        """The finding in words, or None when :attr:`named` is empty: of currents, a
+        drive's torque constants (``torque_constant of motor 2 looks 0.667 times the true
+        one: multiply it by 1.5``); of torques, the sensors' scales (``the torques of joint
+        2 read 0.667 times the true ones``); relative gains (:attr:`scaled` false) as the
+        factors between the motors, their common one not known."""
+        named, what, std = self.named, self.effort, self.std
+        if not named:
+            return None
+        unit = "motor" if what == "current" else self.per
+        said = (
+            f"a gain per {unit} explains the residual (fitted with the model's columns, the "
+            f"error falls from {self.ratio_fixed:.3g} to {self.ratio_fitted:.3g} x the noise): "
+        )
+        if not self.scaled:
+            what_of = "torque_constant" if what == "current" else "torques"
+            said += (
+                f"the {unit}s' {what_of} are off by different factors: multiply "
+                + ", ".join(
+                    f"{unit} {k + 1}'s by {self.factor[k]:.3g} (std {std[k]:.2g})" for k in named
+                )
+                + " (relative to each other, their geometric mean 1: without the robot "
+                "description's masses the common factor is not known; dynid identify with "
+                "--robot names it)"
+            )
+        elif what == "current":
+            said += "; ".join(
+                f"torque_constant of motor {k + 1} looks {1 / self.factor[k]:.3g} times the "
+                f"true one: multiply it by {self.factor[k]:.3g} (std {std[k]:.2g})"
+                for k in named
+            )
+            said += " (the common scale from the description's masses)"
+        else:
+            said += "; ".join(
+                f"the torques of {unit} {k + 1} read {1 / self.factor[k]:.3g} times the true "
+                f"ones: scale them by {self.factor[k]:.3g} (std {std[k]:.2g})"
+                for k in named
+            )
+            said += " (the common scale from the description's masses)"
+        loose = ", ".join(str(k + 1) for k in np.flatnonzero(~self.determined))
+        if loose:
+            said += f"; the data do not determine the gain of {unit}(s) {loose}"
+        if what == "current":
+            return said + ": change torque_constant in the drive file and identify again"
+        return said + (
+            f': a scale per {unit} is a drive file with effort = "current" and these factors '
+            "as torque_constant (--units tau=... scales every joint alike)"
+        )
+
+
+def effort_columns(tau: ArrayLike, transmission: ArrayLike | None = None) -> NDArray[np.float64]:
+    """Each motor's logged effort mapped to the joints: the columns of its gain.
+
+    ``tau = sum_m E_m`` with ``E_m[:, j] = tau_m[:, m] K[m, j]`` and ``tau_m = K^-T tau``
+    the motors' torques (:class:`~dynid.model.drive.Drive`: ``tau = K^T tau_m``).
+
+    Parameters
+    ----------
+    tau : array_like, shape (N, n)
+        The joint torques [N m] as read from the log (the efforts through the drive).
+    transmission : array_like, shape (n, n), optional
+        ``K`` of a motor-side log; None: each joint its own (a joint-side log).
+
+    Returns
+    -------
+    ndarray, shape (N, n, n)
+        [N m]: ``[:, j, m]`` motor ``m``'s part of joint ``j``'s torque.
+    """
+    T = np.asarray(tau, dtype=np.float64)
+    if transmission is None:
+        return T[:, :, None] * np.eye(T.shape[1])
+    K = np.asarray(transmission, dtype=np.float64)
+    motor = np.linalg.solve(K.T, T.T).T
+    return motor[:, None, :] * K.T[None, :, :]
+
+
+def drive_gains(
+    columns: ArrayLike,
+    tau: ArrayLike,
+    noise_rms: ArrayLike,
+    transmission: ArrayLike | None = None,
+    gravity_columns: ArrayLike | None = None,
+    gravity: ArrayLike | None = None,
+) -> DriveGains | None:
+    """The per-motor gains that make the logged efforts the model's torques (module
+    docstring).
+
+    The gains are the generalized eigenvector of the smallest eigenvalue of ``(S, C)``:
+    ``S`` the efforts' normal matrix with the model's columns projected out, ``C`` the
+    covariance the noise puts into it per sample (each joint's noise on a joint-side log;
+    on a motor-side log each motor's, read from the joints' through ``K``), which makes
+    the estimate consistent where the noise differs between the effort columns (a coupled
+    motor's effort reaches two joints).
+
+    Parameters
+    ----------
+    columns : array_like, shape (N, n, p)
+        The model's regressor at the samples (base parameters, friction, rotor inertia and
+        terms) [N m per parameter unit].
+    tau : array_like, shape (N, n)
+        The joint torques [N m] as read from the log (the efforts through the drive).
+    noise_rms : array_like, shape (n,)
+        Each joint's noise [N m].
+    transmission : array_like, shape (n, n), optional
+        ``K`` of a motor-side log (a gain per motor); None: a gain per joint.
+    gravity_columns : array_like, shape (N, n, p), optional
+        ``columns`` at rest (zero velocity and acceleration), the links' gravity alone
+        (the other columns zero) [N m per parameter unit].
+    gravity : array_like, shape (N, n), optional
+        The description's gravity torques [N m] at the samples, zero on the joints gravity
+        does not load: with ``gravity_columns``, they fix the gains' common scale.
+
+    Returns
+    -------
+    DriveGains or None
+        None with fewer rows than columns, a noise that is not positive or efforts the
+        model's columns hold exactly.
+    """
+    W = np.asarray(columns, dtype=np.float64)
+    s = np.asarray(noise_rms, dtype=np.float64)
+    E = effort_columns(tau, transmission)
+    N, n, p = W.shape
+    m = E.shape[-1]
+    if not np.all(np.isfinite(s) & (s > 0)) or N * n <= p + m:
+        return None
+    A = (W / s[:, None]).reshape(N * n, p)
+    B = (E / s[:, None]).reshape(N * n, m)
+    Q = _column_space(A)
+    ones = np.ones(m)
+    P = B - Q @ (Q.T @ B)  # the efforts with the model's columns projected out
+    dof = N * n - Q.shape[1] - (m - 1)
+    fixed = float(ones @ P.T @ P @ ones) / max(dof, 1)
+    if not fixed > 0:
+        return None
+    C = _noise_covariance(s, transmission)
+    active = _linked(A, B, C, N)
+    Qa = _column_space(np.concatenate([A, B[:, ~active]], axis=1))
+    Pa = B[:, active] - Qa @ (Qa.T @ B[:, active])
+    S = Pa.T @ Pa
+    lam, V = scipy.linalg.eigh(S, C[np.ix_(active, active)])  # V' C V = I
+    g = V[:, 0] * np.sign(np.sum(V[:, 0]))
+    dof = N * n - Qa.shape[1] - (int(active.sum()) - 1)
+    var = max(float(lam[0]), 0.0) / max(dof, 1)  # per row, at g' C g = 1
+    gap = np.maximum(lam[1:] - lam[0], 1e-300)
+    cov_a = (V[:, 1:] / gap) @ V[:, 1:].T * var
+    # the gains scaled so that the torques they give carry the logged efforts' energy
+    c = float(np.linalg.norm(B[:, active] @ ones[active]))
+    c /= max(float(np.linalg.norm(B[:, active] @ g)), 1e-300)
+    g = g * c
+    fitted = float(g @ S @ g) / max(dof, 1)
+    full = np.full(m, np.nan)
+    full[active] = g
+    factor, scaled = _common_scale(full, W, B, A, gravity_columns, gravity)
+    c *= float(np.linalg.norm(factor[active]) / np.linalg.norm(g))
+    cov = np.full((m, m), np.nan)
+    cov[np.ix_(active, active)] = cov_a * c**2
+    held = _held_ratios(factor, g, active, B, Qa, dof)
+    found = DriveGains(factor, cov, scaled, float(np.sqrt(fixed)), float(np.sqrt(fitted)), held)
+    sure = found.determined
+    if scaled or not sure.any():
+        return found
+    mean = float(np.exp(np.mean(np.log(factor[sure]))))  # geometric mean 1 over the determined
+    return dataclasses.replace(found, factor=factor / mean, cov=cov / mean**2)
+
+
+def _held_ratios(
+    factor: NDArray[np.float64],
+    g: NDArray[np.float64],
+    active: NDArray[np.bool_],
+    B: NDArray[np.float64],
+    Q0: NDArray[np.float64],
+    dof: int,
+) -> NDArray[np.float64]:
+    """Per motor, the weighted residual's RMS over the noise with its gain held at 1
+    (:attr:`DriveGains.ratio_held`): ``g`` the gains of the ``active`` motors at the
+    scale of the efforts ``B``, ``factor`` at the description's, ``Q0`` the columns fitted
+    again."""
+    motors = np.flatnonzero(active)
+    unit = float(g[0] / factor[motors[0]])  # a gain of 1 at the scale of g
+    held = np.full(factor.size, np.nan)
+    for i, k in enumerate(motors):
+        h = g.copy()
+        h[i] = unit
+        r = B[:, active] @ h
+        held[k] = np.sqrt(float(np.sum((r - Q0 @ (Q0.T @ r)) ** 2)) / max(dof, 1))
+    return held
+
+
+def _linked(
+    A: NDArray[np.float64], B: NDArray[np.float64], C: NDArray[np.float64], samples: int
+) -> NDArray[np.bool_]:
+    """The motors (m,) whose effort keeps a part above the noise once the model's columns
+    ``A`` and the other left-out efforts are projected out (energy per row at least
+    :data:`LINKED` of the noise's, ``C``'s diagonal): the others' gains their own columns
+    take (left out one at a time, the weakest first)."""
+    m = B.shape[1]
+    active = np.ones(m, dtype=bool)
+    while active.sum() > 2:
+        Q = _column_space(np.concatenate([A, B[:, ~active]], axis=1))
+        P = B[:, active] - Q @ (Q.T @ B[:, active])
+        rows = samples * (1.0 - Q.shape[1] / B.shape[0])  # the samples the projection leaves
+        above = np.sum(P**2, axis=0) / (rows * np.diag(C)[active]) - 1.0
+        k = int(np.argmin(above))
+        if above[k] >= LINKED:
+            break
+        active[np.flatnonzero(active)[k]] = False
+    return active
+
+
+def _column_space(A: NDArray[np.float64]) -> NDArray[np.float64]:
+    """An orthonormal basis of ``A``'s columns, its rank from the pivoted QR of the
+    scaled columns (relative tolerance :data:`_RANK_RTOL` on the diagonal)."""
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    Q, R, _ = scipy.linalg.qr(A / scale, mode="economic", pivoting=True)
+    d = np.abs(np.diag(R))
+    rank = int(np.count_nonzero(d > _RANK_RTOL * max(float(d[0]) if d.size else 0.0, 1e-300)))
+    return np.asarray(Q[:, :rank], dtype=np.float64)
+
+
+def _noise_covariance(
+    s: NDArray[np.float64], transmission: ArrayLike | None
+) -> NDArray[np.float64]:
+    """The covariance (m, m) the noise puts into one sample's effort columns, each joint's
+    rows in units of its noise ``s`` (n,) [N m]: the identity on a joint-side log; on a
+    motor-side log, each motor's noise ``sigma_m`` from ``s_j^2 = sum_m sigma_m^2 K_mj^2``
+    (non-negative least squares), then ``sigma_m^2 sum_j K_mj^2 / s_j^2`` on the diagonal."""
+    if transmission is None:
+        return np.eye(s.size)
+    K = np.asarray(transmission, dtype=np.float64)
+    var, _ = scipy.optimize.nnls((K**2).T, s**2)
+    diag = var * np.sum(K**2 / s**2, axis=1)
+    return np.diag(np.maximum(diag, 1e-12 * max(float(diag.max()), 1e-300)))
+
+
+def _common_scale(
+    g: NDArray[np.float64],
+    W: NDArray[np.float64],
+    B: NDArray[np.float64],
+    A: NDArray[np.float64],
+    gravity_columns: ArrayLike | None,
+    gravity: ArrayLike | None,
+) -> tuple[NDArray[np.float64], bool]:
+    """The gains ``g`` at the description's scale (the fitted parameters' gravity torques
+    over the description's, pooled over the loaded joints) and True; without a description's
+    gravity, at geometric mean 1 over the positive gains, and False. ``g`` is NaN on the
+    motors left out, whose efforts are free columns beside ``A``."""
+    fitted = np.isfinite(g)
+    if gravity_columns is not None and gravity is not None:
+        G = np.asarray(gravity_columns, dtype=np.float64)
+        gd = np.asarray(gravity, dtype=np.float64)
+        X = np.concatenate([A, B[:, ~fitted]], axis=1)
+        x, *_ = np.linalg.lstsq(X, B[:, fitted] @ g[fitted], rcond=None)
+        gm = G @ x[: A.shape[1]]
+        loaded = np.any(gd != 0, axis=0)
+        d, f = gd[:, loaded].ravel(), gm[:, loaded].ravel()
+        if d @ d > 0 and d @ f > 0:
+            return g / float(d @ f / (d @ d)), True
+    pos = g[fitted & (np.nan_to_num(g) > 0)]
+    mean = float(np.exp(np.mean(np.log(pos)))) if pos.size else 1.0
+    return g / mean, False

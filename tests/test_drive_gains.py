@@ -1,0 +1,196 @@
+"""Per-motor gains of the logged efforts (torque constants off by a different factor on each
+joint) fitted with the model: the factors come back within their noise, named in place of a
+spring; correct constants, or one factor on every joint, name nothing.
+
+References: torques made from a Panda's true parameters (its regressor at random states,
+its gravity torques) and logged through known factors with known noise; the simulated
+geared Panda of ``conftest.geared_recordings`` (motor friction and rotor inertias the
+description lacks) read through torque constants off by known factors.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.dynamics.terms import gravity_torques
+from dynid.exceptions import DynidWarning
+from dynid.friction.heldout_torques import heldout_torques
+from dynid.identification.classical import identify_from_log
+from dynid.identification.drive_gains import drive_gains, effort_columns
+from dynid.regressors.base import base_parameters
+from dynid.regressors.torque import torque_regressor
+
+from conftest import geared_recordings, random_states
+
+
+def _panda_columns(robot: dynid.Robot, seed: int, n: int = 600):
+    """The Panda's base regressor with a viscous and a Coulomb column per joint at ``n``
+    random states, its gravity columns at rest, the true coefficients and the joint torques
+    they give [N m]."""
+    base = base_parameters(robot, kind="torque", rng=np.random.default_rng(seed))
+    q, dq, ddq = random_states(robot, n, seed)
+    eye = np.eye(robot.n)
+    friction = np.concatenate([dq[:, :, None] * eye, np.sign(dq)[:, :, None] * eye], axis=-1)
+    W = np.concatenate([base.reduce(torque_regressor(robot, q, dq, ddq)), friction], axis=-1)
+    Yg = base.reduce(torque_regressor(robot, q, np.zeros_like(q), np.zeros_like(q)))
+    G = np.concatenate([Yg, np.zeros_like(friction)], axis=-1)
+    theta = np.concatenate([base.beta_from_phi(robot.phi), np.full(robot.n, 0.5), np.ones(7)])
+    return W, G, gravity_torques(robot, q), W @ theta
+
+
+def test_effort_columns_split_the_torques_into_each_motors_part():
+    """``sum_m E_m`` is the joint torque, and motor ``m``'s part is its torque times row
+    ``m`` of ``K`` (``tau = K^T tau_m``, a coupled wrist)."""
+    rng = np.random.default_rng(1)
+    K = np.diag([100.0, 80.0, 50.0])
+    K[2, 1] = 20.0
+    tau_m = rng.normal(size=(30, 3))
+    tau = tau_m @ K
+    E = effort_columns(tau, K)
+    np.testing.assert_allclose(E.sum(axis=-1), tau, rtol=1e-12, atol=1e-12)
+    for m in range(3):
+        np.testing.assert_allclose(E[:, :, m], tau_m[:, m : m + 1] * K[m], rtol=1e-10)
+    np.testing.assert_allclose(effort_columns(tau)[:, :, 1], tau[:, 1:2] * np.eye(3)[1])
+
+
+def test_known_factors_come_back_within_their_noise(panda):
+    """Torques logged through factors 1, 1.5, 1, 0.7, 1, 1.2, 1 with 1 % noise: each
+    determined factor within 5 standard deviations (and 2 %) of the truth, those off named,
+    the error brought to the noise."""
+    rng = np.random.default_rng(7)
+    W, G, gd, tau = _panda_columns(panda, 7)
+    truth = np.array([1.0, 1.5, 1.0, 0.7, 1.0, 1.2, 1.0])
+    noise = 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    logged = tau / truth + rng.normal(size=tau.shape) * noise
+    found = drive_gains(W, logged, noise, None, G, gd)
+    assert found is not None and found.scaled
+    sure = found.determined
+    assert sure[[1, 3, 5]].all(), found.std
+    err = np.abs(found.factor[sure] - truth[sure])
+    assert np.all(err <= np.maximum(5 * found.std[sure], 1e-3)) and np.all(err < 0.02), err
+    assert found.named == (1, 3, 5)
+    assert found.ratio_fixed > 3 and found.ratio_fitted < 1.1
+    said = found.sentence()
+    assert said is not None and "the torques of joint 2 read 0.66" in said
+    assert "scale them by 1.5 " in said and "joint 1 " not in said
+    motor = dataclasses.replace(found, effort="current").sentence()
+    assert motor is not None and "torque_constant of motor 4 looks 1.43 times" in motor
+    assert "multiply it by 0.7 " in motor
+    relative = drive_gains(W, logged, noise)  # no description: the factors' ratios alone
+    assert relative is not None and not relative.scaled
+    ratio = relative.factor / relative.factor[0]
+    np.testing.assert_allclose(ratio[[1, 3, 5]], truth[[1, 3, 5]], rtol=0.02)
+    words = dataclasses.replace(relative, effort="current").sentence()
+    assert words is not None and "relative to each other" in words and "motor 2's by" in words
+
+
+def test_right_factors_or_one_common_factor_name_nothing(panda):
+    """The true torques with noise: every factor near 1, none named; every joint read 1.3
+    times too small: the factor 1.3 on each (the description's scale) and none named (one
+    factor is the gravity-scale finding's, and it fits as well)."""
+    rng = np.random.default_rng(8)
+    W, G, gd, tau = _panda_columns(panda, 8)
+    noise = 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    clean = drive_gains(W, tau + rng.normal(size=tau.shape) * noise, noise, None, G, gd)
+    assert clean is not None and clean.named == () and not clean.explains
+    assert np.all(np.abs(clean.factor[clean.determined] - 1) < 0.02)
+    common = drive_gains(W, tau / 1.3 + rng.normal(size=tau.shape) * noise, noise, None, G, gd)
+    assert common is not None and common.named == () and not common.uneven
+    np.testing.assert_allclose(common.factor[common.determined], 1.3, rtol=0.02)
+
+
+def test_a_joint_whose_torque_the_model_holds_alone_is_not_determined(panda):
+    """A model column that holds joint 7's torque alone (its equation its own): joint 7's
+    gain is left out (NaN, not determined, said so) and the others still come back."""
+    rng = np.random.default_rng(9)
+    W, G, gd, tau = _panda_columns(panda, 9)
+    own = np.zeros(tau.shape + (1,))
+    own[:, 6, 0] = tau[:, 6]
+    W, G = np.concatenate([W, own], axis=-1), np.concatenate([G, np.zeros_like(own)], axis=-1)
+    truth = np.array([1.0, 1.4, 1.0, 1.0, 1.0, 1.0, 0.5])
+    noise = 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    found = drive_gains(W, tau / truth + rng.normal(size=tau.shape) * noise, noise, None, G, gd)
+    assert found is not None and not found.determined[6]
+    assert abs(found.factor[1] - 1.4) < 0.03
+    said = found.sentence()
+    assert said is not None and "do not determine the gain of joint(s) 7" in said
+
+
+@pytest.fixture(scope="module")
+def geared_pair(panda):
+    """Two noisy 4 s current logs of the geared Panda (motor friction, rotor inertias) and
+    the drive they are read through."""
+    return geared_recordings(panda, (3, 4), duration=4.0)
+
+
+def _heldout(panda, logs, drive):
+    """The held-out prediction of the second log by the model identified from the first
+    through ``drive``."""
+    train, held = logs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_from_log(panda, train, drive=drive, validate_on=held)
+        return heldout_torques(model, train, separate=held)
+
+
+def test_guessed_torque_constants_are_named_in_place_of_a_spring(panda, geared_pair):
+    """Motor 2's torque constant guessed 1.5 times too small and motor 4's 0.8 times: the
+    held-out verdict names both with their factors (within 5 standard deviations or 3 %
+    of 1.5 and 0.8), no other motor, and no spring."""
+    logs, drive = geared_pair
+    truth = np.array([1.0, 1.5, 1.0, 0.8, 1.0, 1.0, 1.0])
+    assert drive.torque_constant is not None
+    guess = dataclasses.replace(drive, torque_constant=drive.torque_constant / truth)
+    held = _heldout(panda, logs, guess)
+    gains = held.gains
+    assert gains is not None and {1, 3} <= set(gains.named), gains
+    for k in gains.named:  # those named, and only those, off by their factor
+        err = abs(gains.factor[k] - truth[k])
+        assert err <= max(5 * gains.std[k], 0.03 * truth[k]), (k, gains.factor, gains.std)
+    said = held.verdict.reason
+    pattern = r"torque_constant of motor 2 looks 0\.6\d* times the true one: multiply it by 1\.[45]"
+    assert re.search(pattern, said), said
+    doc = held.as_dict()["drive_gains"]
+    assert doc["named"] == list(gains.named) and doc["effort"] == "current"
+    assert "spring" not in said, said
+
+
+def test_right_torque_constants_raise_no_finding(panda, geared_pair):
+    """The true torque constants, with motor friction and rotor inertias in the log: no
+    gain named and no gain finding in the verdict."""
+    logs, drive = geared_pair
+    held = _heldout(panda, logs, drive)
+    assert held.gains is None or held.gains.named == ()
+    assert "a gain per" not in held.verdict.reason
+
+
+def test_validate_names_the_factor_of_a_model_identified_through_a_guess(
+    panda, geared_pair, tmp_path
+):
+    """validate of the second log against the model identified from the first through
+    motor 2's torque constant guessed 1.25 times too small: the verdict names motor 2's
+    factor (multiply by about 1.25) and no spring."""
+    from dynid.io.torque_log import save_torque_log
+    from dynid.workflows.validate import ValidateOptions, validate_files
+
+    (train, held), drive = geared_pair
+    truth = np.array([1.0, 1.25, 1.0, 1.0, 1.0, 1.0, 1.0])
+    assert drive.torque_constant is not None
+    guess = dataclasses.replace(drive, torque_constant=drive.torque_constant / truth)
+    save_torque_log(tmp_path / "held.csv", held)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        model = identify_from_log(panda, train, drive=guess)
+        said = validate_files(model, tmp_path / "held.csv", ValidateOptions()).verdict.reason
+    m = re.search(
+        r"torque_constant of motor 2 looks [0-9.]+ times the true one: multiply it by ([0-9.]+)",
+        said,
+    )
+    assert m is not None and abs(float(m[1]) - 1.25) < 0.05, said
+    assert "spring" not in said, said
