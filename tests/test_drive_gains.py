@@ -90,6 +90,22 @@ def test_known_factors_come_back_within_their_noise(panda):
     assert words is not None and "relative to each other" in words and "motor 2's by" in words
 
 
+def test_a_torque_of_the_opposite_sign_is_left_to_the_sign_checks(panda):
+    """Joint 3's torques logged negated (a factor of -1, the others right): no gains are
+    returned, with or without the description's scale, and no warning of a logarithm of a
+    negative factor (a sign is judged by the sign checks, not named as a torque constant)."""
+    rng = np.random.default_rng(11)
+    W, G, gd, tau = _panda_columns(panda, 11)
+    sign = np.ones(7)
+    sign[2] = -1.0
+    noise = 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    logged = tau * sign + rng.normal(size=tau.shape) * noise
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert drive_gains(W, logged, noise, None, G, gd) is None
+        assert drive_gains(W, logged, noise) is None
+
+
 def test_right_factors_or_one_common_factor_name_nothing(panda):
     """The true torques with noise: every factor near 1, none named; every joint read 1.3
     times too small: the factor 1.3 on each (the description's scale) and none named (one

@@ -36,8 +36,6 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
-import scipy.linalg
-import scipy.optimize
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
@@ -324,8 +322,10 @@ def drive_gains(
     Returns
     -------
     DriveGains or None
-        None with fewer rows than columns, a noise that is not positive or efforts the
-        model's columns hold exactly.
+        None with fewer rows than columns, a noise that is not positive, efforts the
+        model's columns hold exactly, or a motor whose gain comes out negative (a torque
+        of the opposite sign, which the sign checks of
+        :mod:`~dynid.identification.recorded_signs` judge).
     """
     W = np.asarray(columns, dtype=np.float64)
     s = np.asarray(noise_rms, dtype=np.float64)
@@ -348,6 +348,8 @@ def drive_gains(
     Qa = _column_space(np.concatenate([A, B[:, ~active]], axis=1))
     Pa = B[:, active] - Qa @ (Qa.T @ B[:, active])
     S = Pa.T @ Pa
+    import scipy.linalg  # here: the command's start loads no scipy
+
     lam, V = scipy.linalg.eigh(S, C[np.ix_(active, active)])  # V' C V = I
     g = V[:, 0] * np.sign(np.sum(V[:, 0]))
     dof = N * n - Qa.shape[1] - (int(active.sum()) - 1)
@@ -362,6 +364,8 @@ def drive_gains(
     full = np.full(m, np.nan)
     full[active] = g
     factor, scaled = _common_scale(full, W, B, A, gravity_columns, gravity)
+    if np.any(factor[active] <= 0):  # a motor of the opposite sign: the sign checks name it
+        return None
     c *= float(np.linalg.norm(factor[active]) / np.linalg.norm(g))
     cov = np.full((m, m), np.nan)
     cov[np.ix_(active, active)] = cov_a * c**2
@@ -423,6 +427,8 @@ def _column_space(A: NDArray[np.float64]) -> NDArray[np.float64]:
     scaled columns (relative tolerance :data:`_RANK_RTOL` on the diagonal)."""
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
+    import scipy.linalg
+
     Q, R, _ = scipy.linalg.qr(A / scale, mode="economic", pivoting=True)
     d = np.abs(np.diag(R))
     rank = int(np.count_nonzero(d > _RANK_RTOL * max(float(d[0]) if d.size else 0.0, 1e-300)))
@@ -439,6 +445,8 @@ def _noise_covariance(
     if transmission is None:
         return np.eye(s.size)
     K = np.asarray(transmission, dtype=np.float64)
+    import scipy.optimize
+
     var, _ = scipy.optimize.nnls((K**2).T, s**2)
     diag = var * np.sum(K**2 / s**2, axis=1)
     return np.diag(np.maximum(diag, 1e-12 * max(float(diag.max()), 1e-300)))
