@@ -68,8 +68,8 @@ def plot_friction_fit(
         One panel per joint, or per motor where the friction was fitted at the motors of
         a drive (one law per motor: the residual ``K^-T r`` against the motor velocity
         ``K dq``, the law's own curve); velocity [rad/s] on x, torque [N m] on y, each
-        axis naming its side; the title of each panel gives the joint's RMS before and
-        after compensation.
+        axis naming its side; the title of each panel names it on one line and gives the
+        joint's RMS before and after compensation on the next.
     """
     import matplotlib.pyplot as plt
 
@@ -86,7 +86,7 @@ def plot_friction_fit(
     ncols = max(1, min(ncols, n))
     nrows = int(np.ceil(n / ncols))
     if fig is None:
-        fig = plt.figure(figsize=(3.4 * ncols, 2.9 * nrows + 0.6))
+        fig = plt.figure(figsize=(3.4 * ncols, 3.1 * nrows + 0.6))
     else:
         fig.clear()
     axes = fig.subplots(nrows, ncols, squeeze=False)
@@ -126,8 +126,8 @@ def plot_friction_fit(
         ax.axhline(0.0, color="0.7", lw=0.5)
         ax.axvline(0.0, color="0.7", lw=0.5)
         who = f"motor {j + 1} ({names[j]})" if motors else names[j]
-        ax.set_title(
-            f"{who}: {'joint ' if motors else ''}RMS {fit.rms_before[j]:.3f} -> "
+        ax.set_title(  # two lines: a drive's long joint names ran into the next title
+            f"{who}\n{'joint ' if motors else ''}RMS {fit.rms_before[j]:.3f} -> "
             f"{fit.rms_after[j]:.3f} N m",
             fontsize=9,
         )
