@@ -11,6 +11,7 @@ effort column negated in one of them.
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -18,7 +19,11 @@ import pytest
 import dynid
 from dynid.exceptions import DataError
 from dynid.friction.model import ClassicalFriction
-from dynid.identification.recorded_signs import opposite_friction_among, recording_sign_findings
+from dynid.identification.recorded_signs import (
+    DISAGREE_SHARE,
+    opposite_friction_among,
+    recording_sign_findings,
+)
 from dynid.identification.recordings import prepare_recordings
 
 from conftest import GEARED_NOISE, geared_recordings, recordings
@@ -47,7 +52,7 @@ def test_a_motor_of_the_opposite_sign_in_one_recording_is_named_with_its_files_e
     names = ["a.csv", "b.csv"]
     assert opposite_friction_among(panda, [a, b], names, drive) is None
     said = opposite_friction_among(panda, [a, _negated(b, 4)], names, drive)
-    assert said is not None and said.startswith("b.csv: the torques of motor 5 read of the opp")
+    assert said is not None and said.startswith("b.csv: the torques of motor 5 have the opp")
     assert "--units b.csv:tau5=-1 reads it flipped" in said, said
     assert opposite_friction_among(panda, [_negated(a, 4), _negated(b, 4)], names, drive) is None
     with pytest.raises(DataError, match="b.csv:tau5=-1"):
@@ -65,7 +70,7 @@ def test_three_clean_joint_side_recordings_name_nothing_and_a_wrist_flip_is_name
     names = ["a.csv", "b.csv", "c.csv"]
     assert opposite_friction_among(panda, logs, names) is None
     said = opposite_friction_among(panda, [*logs[:2], _negated(logs[2], 6)], names)
-    assert said is not None and said.startswith("c.csv: the torques of joint7 read"), said
+    assert said is not None and said.startswith("c.csv: the torques of joint7 have"), said
     assert "--units c.csv:tau7=-1" in said, said
 
 
@@ -93,6 +98,18 @@ def pair():
     return recordings(truth, (1, 2), friction=fr, duration=3.0, noise=GEARED_NOISE, added=_stribeck)
 
 
+def _check_numbers(said: str, negated: str) -> None:
+    """The finding's "N times better with <negated> (residual r of that as read)": r at
+    most DISAGREE_SHARE, and N its inverse rounded to two digits."""
+    m = re.search(
+        rf"fit \S+ recordings (\S+) times better with {negated} \(residual (\S+) of", said
+    )
+    assert m is not None, said
+    times, left = float(m[1].replace(",", "")), float(m[2])
+    assert 0 < left <= DISAGREE_SHARE, said
+    assert times == pytest.approx(1 / left, rel=0.1), said
+
+
 def test_two_recordings_of_opposite_sign_on_a_wrist_joint_name_the_flipped_file(pair):
     """Two recordings, joint 7's torque negated in one (no majority to compare with): the
     description's torques and dissipating friction name that file, whichever it is, and
@@ -107,8 +124,11 @@ def test_two_recordings_of_opposite_sign_on_a_wrist_joint_name_the_flipped_file(
         found = recording_sign_findings(panda, [x, y], names)
         assert [f.name for f in found] == [flipped], found
         said = found[0].text
-        assert said.startswith("the torques of joint7 read of the opposite sign"), said
+        other = "a.csv" if flipped == "b.csv" else "b.csv"
+        assert said.startswith(f"the torques of joint7 have the opposite sign to those of {other}")
         assert f"--units {flipped}:tau7=-1 reads it flipped" in said, said
+        _check_numbers(said, f"{flipped}'s tau7 negated")
+        assert f"agree with {other} (residual " in said, said
     with pytest.raises(DataError, match=r"b\.csv:tau7=-1"):
         prepare_recordings(panda, [a, _negated(b, 6)], names)
 
@@ -129,7 +149,8 @@ def test_two_recordings_of_opposite_sign_the_description_cannot_tell_name_both()
     found = recording_sign_findings(bare, [a, _negated(b, 6)], names)
     assert [f.name for f in found] == ["a.csv, b.csv"], found
     said = found[0].text
-    assert said.startswith("the torques of joint7 read of opposite signs in a.csv and b.csv")
+    assert said.startswith("the torques of joint7 have opposite signs in a.csv and b.csv")
     assert "--units a.csv:tau7=-1 or --units b.csv:tau7=-1" in said, said
-    with pytest.raises(DataError, match="read of opposite signs in a.csv and b.csv"):
+    _check_numbers(said, "either file's tau7 negated")
+    with pytest.raises(DataError, match="have opposite signs in a.csv and b.csv"):
         prepare_recordings(bare, [a, _negated(b, 6)], names)

@@ -89,5 +89,7 @@ def test_a_motors_encoder_reversed_alone_is_told_from_its_current(panda):
     on the geared arm: named as its position only, the hint q3=-1 without tau3."""
     log, drive = _geared(93)
     said = reversed_joint(panda, _negated(log, [2], []), drive)
-    assert said is not None and said.startswith("motor 3 looks recorded reversed: its position of")
+    assert said is not None and said.startswith(
+        "motor 3 looks recorded reversed: its position has the opp"
+    )
     assert "--units q3=-1 reads it so" in said, said

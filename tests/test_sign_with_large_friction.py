@@ -79,7 +79,7 @@ def test_large_coulomb_friction_against_gravity_is_no_flipped_sign():
     assert opposite_sign(robot, log) is None
     said = opposite_sign(robot, _negated(log, 1))
     assert said is not None and "tau2=-1" in said and robot.joint_names[1] in said, said
-    assert "friction that pushes as read" in said, said
+    assert "as read its friction would push the arm" in said, said
 
 
 def test_a_flipped_joint_whose_friction_outweighs_gravity_is_found(panda):

@@ -107,7 +107,7 @@ def test_one_flipped_recording_among_others_gets_its_own_units_entry(panda_logs)
 
 def test_report_headline_and_json_name_the_flipped_file(panda_logs, tmp_path):
     """dynid validate on flip.csv: validation.json's opposite_sign holds the finding and
-    the report's headline says the file's torques read with the opposite sign."""
+    the report's headline says the file's torques have the opposite sign."""
     _, d = panda_logs
     out = tmp_path / "v"
     args = ["validate", "--robot", "panda", "--no-friction", "--data", str(d / "flip.csv")]
@@ -118,7 +118,7 @@ def test_report_headline_and_json_name_the_flipped_file(panda_logs, tmp_path):
     assert "--units tau4=-1 " in doc["opposite_sign"]["flip.csv"]
     page = (out / "report.html").read_text()
     head = page[page.index('class="headline"') :].split("</p>")[0]
-    assert "The torques of flip.csv read with the opposite sign" in head
+    assert "The torques of flip.csv have the opposite sign" in head
 
 
 def test_a_model_identified_with_a_files_own_flip_validates_other_files(panda_logs, caplog):

@@ -82,7 +82,7 @@ def test_validate_names_one_recordings_motor_of_the_opposite_sign(geared):
     d, drive = geared
     result, _ = _validate([d / "flip" / "a.csv", d / "flip" / "b.csv"], drive)
     reason = result.verdict.reason
-    assert reason.startswith("b.csv: the torques of motor 5 read of the opposite sign"), reason
+    assert reason.startswith("b.csv: the torques of motor 5 have the opposite sign"), reason
     assert "--units b.csv:tau5=-1" in reason, reason
     assert list(result.metadata()["opposite_sign"]) == ["b.csv"]
 
@@ -128,9 +128,7 @@ def test_one_flipped_recording_alone_is_named_against_the_identified_models_fric
         flipped = validate_files(model, d / "flip" / "b.csv", opts)
         clean = validate_files(model, d / "clean" / "b.csv", opts)
     reason = flipped.verdict.reason
-    assert reason.startswith("b.csv: the torques of motor 5 read of the opposite sign to the"), (
-        reason
-    )
+    assert reason.startswith("b.csv: the torques of motor 5 have the opposite sign to the"), reason
     assert "--units tau5=-1" in reason, reason
     assert "opposite_sign" not in clean.metadata(), clean.verdict.reason
 

@@ -496,13 +496,13 @@ def _opposite(
             f"{names[k]}: correlation {corr[k]:+.2f}"
             + (
                 f", {near[int(k)][0]:.3g} N m RMS from the negated model's torques against "
-                f"{near[int(k)][1]:.3g} from the model's, means included"
+                f"{near[int(k)][1]:.3g} from the model's (means included)"
                 if k in near
                 else ""
             )
             + (
-                f", friction that pushes as read (Coulomb {push[int(k)]:.3g} N m), the "
-                "negated torques the model's plus friction"
+                f", as read its friction would push the arm (Coulomb {push[int(k)]:.3g} N m), "
+                "while negated its torques are the model's plus friction"
                 if k in push and k not in near
                 else ""
             )
@@ -515,7 +515,7 @@ def _opposite(
         + f" the model's torques (gravity and motion; {evidence})"
         + (
             f" while those of {', '.join(f'{names[k]} ({corr[k]:+.2f})' for k in rest)} are "
-            "not, on some joints only"
+            "not (the sign differs on some joints only)"
             if rest.size
             else ""
         )

@@ -255,15 +255,20 @@ def _reversed_line(
         + [f"tau{k + 1}=-1" for k in alone]
     )
     rates = ", ".join(f"dq{k + 1}=-1, ddq{k + 1}=-1" for k in rev)
+    single = len(what) == 1 and " and " not in what[0]
     gears = drive is not None and not drive.is_coupled and bool(np.all(torque[rev]))
     return (
         f"{', '.join(names[k] for k in rev)} {'looks' if one else 'look'} recorded reversed: "
-        f"{', '.join(what)} of the opposite sign to the model's convention (with "
-        f"{'it' if one else 'them'} reversed, what the model and each "
-        + ("motor's friction and rotor" if drive is not None else "joint's friction and armature")
-        + f" leave is {np.sqrt(left / total):.2g} of the RMS of the torques the links carry "
-        f"(what that friction leaves of them), {np.sqrt(read / total):.2g} as read): a "
-        "motor or encoder mounted the other way; "
+        f"{', '.join(what)} {'has' if single else 'have'} the opposite sign to the model's "
+        f"convention (with {'it' if one else 'them'} reversed, the model and each "
+        + (
+            "motor's own friction and rotor"
+            if drive is not None
+            else "joint's own friction and armature"
+        )
+        + f" leave a residual of {np.sqrt(left / total):.2g} of the links' RMS torque, "
+        f"against {np.sqrt(read / total):.2g} as read): a motor or encoder mounted the "
+        "other way; "
         f"hint: --units {cols} reads {'it' if one else 'them'} so (and {rates} for the log's "
         "velocity and acceleration columns, if it has them"
         + ("; the motors' columns of this motor-side log" if motors else "")
@@ -486,25 +491,35 @@ def opposite_friction_among(
     assert mine is not None  # found holds recordings with their terms
     power = any(mine[k][0] < -z * mine[k][1] for k in motors)
     inertia = any(mine[k][2] < -z * mine[k][3] for k in motors)
-    what = " and ".join(
-        w
-        for w, said in (
-            ("the friction fitted there puts energy into the arm", power),
-            ("the rotor inertia fitted there is negative", inertia),
+    said = [
+        f"the friction of {named} fitted to {names[r]} puts energy into the arm" if power else "",
+        (
+            "its rotor inertia fitted there"
+            if power
+            else f"the rotor inertia of {named} fitted to {names[r]}"
         )
-        if said
-    )
-    against, where = (
-        (f"those of {', '.join(others) or 'the other recordings'}", "in the others they are")
+        + " is negative"
+        if inertia
+        else "",
+    ]
+    what = " and ".join(x for x in said if x)
+    where = (
+        f"in {', '.join(others) or 'the other recordings'} its friction and rotor inertia have "
+        "the right sign"
         if others or model is None
-        else ("the model's", "the model's identified friction and rotor are")
+        else "the model's identified friction and rotor inertia have the right sign"
+    )
+    against = (
+        f"those of {', '.join(others) or 'the other recordings'}"
+        if others or model is None
+        else "the model's"
     )
     return (
-        f"{names[r]}: the torques of {named} read of the opposite sign to {against}: "
-        f"{what}, where {where} of the right sign (a file logged with another sign "
-        "convention; the check "
-        "against the model's torques does not tell a joint the links barely load); hint: "
-        f"--units {flip_entries(motors, names[r] if len(names) > 1 else None)} reads it flipped"
+        f"{names[r]}: the torques of {named} have the opposite sign to {against}: {what}, "
+        f"while {where}: {names[r]} was likely logged with another sign convention (the "
+        f"links barely load {named}, so the check against the model's torques cannot tell); "
+        f"hint: --units {flip_entries(motors, names[r] if len(names) > 1 else None)} reads it "
+        "flipped"
     )
 
 
@@ -637,7 +652,7 @@ def opposite_among_pooled(
         which = _told(fits, order, OWN_TERMS_SIGNIFICANCE)
         pair = [have[r] for r in ([which] if which is not None else sorted(order[:2]))]
         mine, other = (order[0], order[1]) if which != order[1] else (order[1], order[0])
-        said = (fits[order[0]][0] / read[k][0], fits[mine], fits[other])
+        said = (fits[order[0]][0] / read[k][0], fits[mine], fits[other], other)
         told.setdefault(None if which is None else pair[0], []).append((k, pair, said))
     if not told:
         return None
@@ -652,29 +667,54 @@ def opposite_among_pooled(
         left = max(x[0] for k, p, x in told[None] if p == pair)
         files = [names[i] for i in pair]
         return (
-            f"{', '.join(files)}: the torques of {named(ks)} read of opposite signs in "
-            f"{' and '.join(files)}: one friction, rotor and offset explain both with either "
-            f"negated (what they leave {left:.2g} of as read), and neither the model's "
-            "rigid-body torques nor dissipating friction tell which file was logged with "
-            "another sign convention (a description without inertial parameters, a joint of "
-            f"negligible friction); hint: --units {flip_entries(ks, files[0])} or --units "
-            f"{flip_entries(ks, files[1])}, whichever file's sign convention is not the "
-            "robot's"
+            f"{', '.join(files)}: the torques of {named(ks)} have opposite signs in "
+            f"{' and '.join(files)}: one friction, rotor inertia and offset fit both "
+            f"recordings {_times(left)} times better with either file's {_columns(ks)} "
+            f"negated (residual {left:.2g} of that as read), but neither the robot "
+            "description's torques nor the friction's sign tell which file is the wrong "
+            "one (a description without inertial parameters, or a joint of negligible "
+            f"friction); hint: --units {flip_entries(ks, files[0])} or --units "
+            f"{flip_entries(ks, files[1])}, whichever file was logged with another sign "
+            "convention than the robot's"
         )
     r = first
     ks = [k for k, _, _ in told[r]]
     others = [names[i] for i in have if i != r]
-    k, _, (left, mine, alt) = told[r][0]
+    k, _, (left, mine, alt, j) = told[r][0]
+    other = names[have[j]]
+    ratio = mine[0] / alt[0]
+    agree = (
+        f"the robot description's torques agree with {other} (residual {ratio:.2g} of that "
+        f"with {other}'s negated instead)"
+        if ratio <= TOLD_SHARE
+        else f"the robot description's torques fit either about as well ({ratio:.2g})"
+    )
+    pushes = (
+        f"with {other}'s negated instead it would put {-alt[1]:.3g} W into the arm"
+        if alt[1] < 0
+        else f"{alt[1]:.3g} W with {other}'s negated instead"
+    )
     return (
-        f"{names[r]}: the torques of {named(ks)} read of the opposite sign to those of "
-        f"{', '.join(others)}: one friction, rotor and offset explain them all with "
-        f"{names[r]}'s negated (what they leave {left:.2g} of as read); so negated, what "
-        f"the model's rigid-body torques and that friction leave is {mine[0] / alt[0]:.2g} of "
-        f"what they leave with {'the other' if len(others) == 1 else 'another'} negated, "
-        f"and the friction dissipates {mine[1]:.3g} W (with the other negated "
-        f"{alt[1]:+.3g} W) (a file logged with another sign convention); hint: --units "
+        f"{names[r]}: the torques of {named(ks)} have the opposite sign to those of "
+        f"{', '.join(others)}: one friction, rotor inertia and offset fit the recordings "
+        f"{_times(left)} times better with {names[r]}'s {_columns(ks)} negated (residual "
+        f"{left:.2g} of that as read); {agree}, and the friction so fitted dissipates "
+        f"{mine[1]:.3g} W ({pushes}): {names[r]} was "
+        f"likely logged with another sign convention; hint: --units "
         f"{flip_entries(ks, names[r])} reads it flipped"
     )
+
+
+def _times(share: float) -> str:
+    """How many times better a fit leaving ``share`` of what another leaves is, rounded
+    for a sentence ("18", "3.3")."""
+    x = 1.0 / share if share > 0 else math.inf
+    return f"{x:.2g}" if x < 10 else f"{x:,.0f}" if x < 1e6 else f"{x:.1e}"
+
+
+def _columns(ks: Sequence[int]) -> str:
+    """The log's effort columns of motors (joints) ``ks`` (from 0): "tau7", "tau5, tau7"."""
+    return ", ".join(f"tau{k + 1}" for k in ks)
 
 
 @dataclass(frozen=True, slots=True)

@@ -139,8 +139,9 @@ def validate_answer(run: RunFiles) -> Answer | None:
     if isinstance(doc.get("opposite_sign"), dict) and doc["opposite_sign"]:  # the likelier cause
         files = ", ".join(esc(str(k)) for k in doc["opposite_sign"])
         head = (
-            f"The torques of {files} read with the opposite sign to the model's on some "
-            f"joints or on all (--units flips them; below); as read: {head[0].lower()}{head[1:]}"
+            f"The torques of {files} have the opposite sign (to the model's or to the other "
+            "recordings') on some joints or on all (--units flips them; below); as read: "
+            f"{head[0].lower()}{head[1:]}"
         )
     if isinstance(doc.get("sign_map"), str):  # the likelier cause, said before the error
         head = (
