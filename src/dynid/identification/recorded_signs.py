@@ -255,7 +255,9 @@ def _reversed_line(
         + [f"tau{k + 1}=-1" for k in alone]
     )
     rates = ", ".join(f"dq{k + 1}=-1, ddq{k + 1}=-1" for k in rev)
-    single = len(what) == 1 and " and " not in what[0]
+    if not one and alone.size == 0 and len(set(torque[rev].tolist())) == 1:  # all alike
+        what = ["their positions and torques" if torque[rev[0]] else "their positions"]
+    single = len(what) == 1 and " and " not in what[0] and not what[0].startswith("their")
     gears = drive is not None and not drive.is_coupled and bool(np.all(torque[rev]))
     return (
         f"{', '.join(names[k] for k in rev)} {'looks' if one else 'look'} recorded reversed: "
