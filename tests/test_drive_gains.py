@@ -216,7 +216,6 @@ def test_validate_names_the_factor_of_a_model_identified_through_a_guess(
     assert "spring" not in said, said
 
 
-
 def test_a_factor_is_named_where_it_improves_the_held_out_recordings(panda):
     """Joints 2 and 6 logged through 1.5 and 0.7 in three recordings (1 % noise): fitted on
     two recordings, each factor predicts the third better than the constant as logged, by

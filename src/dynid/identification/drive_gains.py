@@ -503,24 +503,32 @@ def _heldout(
         unit = g / factor[active]  # a gain of 1 at the scale of g, per motor (all equal)
 
         inverse = np.linalg.pinv(X[tr], rcond=_RANK_RTOL)
-
-        def score(h: NDArray[np.float64]) -> float:
-            y = Ba @ h
-            r = y[te] - X[te] @ (inverse @ y[tr])
-            return float(np.mean(r**2))
-
-        base = score(g)
+        base = _fold_score(Ba @ g, X, inverse, tr, te)
         d = np.full(B.shape[1], np.nan)
         for i, k in enumerate(motors):
             h = g.copy()
             h[i] = unit[i]
-            d[k] = score(h) - base
+            d[k] = _fold_score(Ba @ h, X, inverse, tr, te) - base
         diffs.append(d)
     m = B.shape[1]
     if len(diffs) < 2:
         return np.full(m, np.nan), np.full(m, np.nan)
     D = np.asarray(diffs)
     return np.mean(D, axis=0), np.std(D, axis=0, ddof=1) / np.sqrt(D.shape[0])
+
+
+def _fold_score(
+    y: NDArray[np.float64],
+    X: NDArray[np.float64],
+    inverse: NDArray[np.float64],
+    tr: NDArray[np.bool_],
+    te: NDArray[np.bool_],
+) -> float:
+    """The mean square [-] over the rows ``te`` of the weighted torques ``y`` less the
+    columns ``X`` fitted to them on the rows ``tr`` (``inverse``: ``X[tr]``'s
+    pseudo-inverse)."""
+    r = y[te] - X[te] @ (inverse @ y[tr])
+    return float(np.mean(r**2))
 
 
 def _held_ratios(

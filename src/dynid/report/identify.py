@@ -225,7 +225,9 @@ def _above_noise(held: dict) -> str:
     if not said:
         return ""
     gains = _gains_words(held.get("drive_gains"))
-    return ", ".join(said) + (f" (a systematic residual: {gains})" if gains else " (a systematic residual)")
+    return ", ".join(said) + (
+        f" (a systematic residual: {gains})" if gains else " (a systematic residual)"
+    )
 
 
 def _gains_words(gains: object) -> str:
@@ -253,7 +255,9 @@ def _gains_words(gains: object) -> str:
             f"the true one (multiply it by {f:.3g})"
         )
     else:
-        said = f"the torques of {unit} {k + 1} read {1 / f:.3g} times the true ones (scale by {f:.3g})"
+        said = (
+            f"the torques of {unit} {k + 1} read {1 / f:.3g} times the true ones (scale by {f:.3g})"
+        )
     more = len(named) - 1
     return said + (f", and {more} more" if more else "")
 
