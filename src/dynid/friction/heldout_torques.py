@@ -41,6 +41,7 @@ from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains, drive_gains
 from ..identification.floor_verdict import judged_prediction, prediction_input_noise
 from ..identification.gravity_tilt import GravityTilt, gravity_tilt, tilt_columns
+from ..identification.holdout import DEFAULT_FOLDS, block_labels
 from ..identification.input_noise import (
     NoiseFloor,
     quantized_noise_std,
@@ -427,6 +428,7 @@ def _each_recording(
     others, pooled; the states' noise through ``model`` itself (the floor, not the
     prediction: the folds' coefficients barely move it)."""
     parts: list[Validation] = []
+    folds: list[NDArray[np.intp]] = []  # each sample's recording
     pieces: list[TorqueLog] = []
     prepared: list[TorqueLog] | None = []  # every piece whole, for the delay's check
     spikes = 0
@@ -438,6 +440,7 @@ def _each_recording(
         mine = _pieces(model, held, turns)
         v, _, each = _pieces_validation(fitted, mine)
         parts.append(v)  # pooled one after another
+        folds.append(np.full(v.log.q.shape[0], fold, np.intp))
         pieces += mine
         spikes += replaced
         whole = replaced == 0 and all(p.step == 1 for p in each)
@@ -447,7 +450,8 @@ def _each_recording(
     block = f"each of the {k} recordings, predicted by the fit of the other {k - 1}"
     if len(pieces) > k:
         block += f" ({len(pieces)} pieces between gaps)"
-    held_out = _held_out(model, v, block, logs, None, spikes, _input_noise(model, v, pieces))
+    inputs = _input_noise(model, v, pieces)
+    held_out = _held_out(model, v, block, logs, None, spikes, inputs, folds=np.concatenate(folds))
     if prepared is None or sum(p.n_samples for p in prepared) > KEPT_SAMPLES:
         return held_out
     return dataclasses.replace(held_out, prepared=tuple(prepared))
@@ -468,12 +472,15 @@ def _held_out(
     spikes: int,
     inputs: tuple[tuple[int, NDArray[np.float64]], ...] | None,
     whole: Callable[[], Validation] | None = None,
+    folds: NDArray[np.intp] | None = None,
 ) -> HeldOutTorques:
     """The held-out prediction ``v`` judged against the sensors' noise: the
     identification's record, at least the held-out torques' rounding; above the noise
     floor, the springs fitted on ``whole()`` (the model on the whole log of a held-out
     time block, whose few samples leave a stiffness fitted with the model's columns
-    loose: 776 N m/rad for 20 on a Panda's last 1.4 s) or on ``v``."""
+    loose: 776 N m/rad for 20 on a Panda's last 1.4 s) or on ``v``; the gains per motor on
+    the same, judged on the identification's folds (``folds``, each sample's recording
+    of ``v``; else its contiguous time blocks)."""
     assert model.info.log is not None
     recorded = _recorded_noise(model)
     noise = (
@@ -492,7 +499,11 @@ def _held_out(
     springs = gains = None  # said only above the floor: a good verdict takes no hint
     if verdict.level != "good":
         every = v if whole is None else whole()
-        gains = residual_gains(model, every, total)
+        if folds is None or folds.size != every.log.q.shape[0]:
+            ho = model.holdout
+            k = ho.folds if ho is not None and ho.scheme == "blocks" else DEFAULT_FOLDS
+            folds = _block_folds(every.log.q.shape[0], k)
+        gains = residual_gains(model, every, total, folds)
         if gains is not None and gains.named:  # the gains explain it: no spring, no tilt
             return dataclasses.replace(held, gains=gains)
         springs = residual_springs(model, every, total, v)
@@ -571,8 +582,19 @@ def residual_springs(
     return judged_springs(found, log.q, log.dq, log.tau - v.tau_hat)
 
 
+def _block_folds(samples: int, folds: int) -> NDArray[np.intp] | None:
+    """``folds`` contiguous time blocks of ``samples`` (None when too few to cut)."""
+    try:
+        return block_labels(samples, max(folds, 2))
+    except DynidError:
+        return None
+
+
 def residual_gains(
-    model: IdentifiedModel | Robot, v: Validation, noise: NDArray[np.float64]
+    model: IdentifiedModel | Robot,
+    v: Validation,
+    noise: NDArray[np.float64],
+    folds: NDArray[np.intp] | None = None,
 ) -> DriveGains | None:
     """The gain per motor of the logged efforts the prediction ``v`` points to
     (:func:`~dynid.identification.drive_gains.drive_gains`; ``noise`` (n,) [N m] each
@@ -580,8 +602,10 @@ def residual_gains(
     (:func:`~dynid.identification.drive_gains.effort_columns`; a joint-side log per joint)
     fitted with the model's own columns and each motor's friction and rotor inertia
     (:func:`beside_columns`), their common scale the description's gravity torques at the
-    joints gravity loads. None for a robot's own parameters or a log without
-    accelerations."""
+    joints gravity loads; a motor named only where fitting its gain improves the prediction
+    of the held-out fold (``folds`` (M,): each sample's, the identification's recordings or
+    time blocks; default :data:`~dynid.identification.holdout.DEFAULT_FOLDS` contiguous
+    time blocks). None for a robot's own parameters or a log without accelerations."""
     log = v.log
     if isinstance(model, Robot) or log.ddq is None:
         return None
@@ -604,7 +628,8 @@ def residual_gains(
         G = np.zeros_like(W)
         G[..., :rigid] = Y[..., :rigid]
         gd = gravity_torques(robot, q) * gravity_loaded(robot, q)
-    found = drive_gains(W, log.tau[rows], noise, K, G, gd)
+    labels = None if folds is None else folds[rows]
+    found = drive_gains(W, log.tau[rows], noise, K, G, gd, labels)
     if found is None:
         return None
     if drive is not None and drive.effort == "current":

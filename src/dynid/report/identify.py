@@ -222,7 +222,44 @@ def _above_noise(held: dict) -> str:
         for j in np.argsort(-r)
         if levels[j] != "good"
     ]
-    return ", ".join(said) + (" (a systematic residual)" if said else "")
+    if not said:
+        return ""
+    gains = _gains_words(held.get("drive_gains"))
+    return ", ".join(said) + (
+        f" (a systematic residual: {gains})" if gains else " (a systematic residual)"
+    )
+
+
+def _gains_words(gains: object) -> str:
+    """The gains finding of heldout.json's ``drive_gains`` in a few words, its first
+    named factor first (``"the torque constants look off: that of motor 1 looks 0.667 times
+    the true one (multiply it by 1.5), and 1 more"``, as the summary says it), or ``""``
+    when it names none."""
+    if not isinstance(gains, dict):
+        return ""
+    named, factor = gains.get("named"), gains.get("factor")
+    if not (isinstance(named, list) and named and isinstance(factor, list)):
+        return ""
+    k = named[0]
+    if not (isinstance(k, int) and 0 <= k < len(factor) and is_number(factor[k])):
+        return ""
+    current = gains.get("effort") == "current"
+    unit = "motor" if current else str(gains.get("per", "joint"))
+    f = float(factor[k])
+    if not gains.get("scaled", True):
+        what = "torque constants" if current else "torques"
+        said = f"the {what} look off by different factors: {unit} {k + 1} by {f:.3g} of the others"
+    elif current:
+        said = (
+            f"the torque constants look off: that of motor {k + 1} looks {1 / f:.3g} times "
+            f"the true one (multiply it by {f:.3g})"
+        )
+    else:
+        said = (
+            f"the torques of {unit} {k + 1} read {1 / f:.3g} times the true ones (scale by {f:.3g})"
+        )
+    more = len(named) - 1
+    return said + (f", and {more} more" if more else "")
 
 
 def _held_ratios(held: dict, rms: list, noise: list) -> np.ndarray:
