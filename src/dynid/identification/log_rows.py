@@ -26,7 +26,7 @@ from ..regressors.terms import LinearFriction, ModelTerm, base_term_columns
 from ..regressors.torque import torque_regressor_prepared
 from .dataset import ModelColumns, RegressorBlock
 from .log import TorqueLog
-from .streaming import BLOCK_ROWS, streams
+from .streaming import BLOCK_ROWS, max_stack_bytes, streams
 from .velocity_noise import moving_joints
 
 #: Cycles of the cut-off frequency after which the zero-phase Butterworth low-pass has
@@ -49,12 +49,20 @@ __all__ = [
 ]
 
 
-#: The stepping columns of a term already filtered on a span of a log, while
-#: :func:`shared_steps` is active: key (:func:`_span_key`) -> (what the key's ids name,
-#: kept alive while the entry lives; the columns (m, n, p), read only).
-_SHARED: ContextVar[dict[Hashable, tuple[Any, NDArray[np.float64]]] | None] = ContextVar(
-    "_SHARED", default=None
-)
+class _Shared:
+    """The stepping columns of terms already filtered on spans of logs while
+    :func:`shared_steps` is active: key (:func:`_span_columns`) -> (what the key's ids
+    name, kept alive while the entry lives; the columns (m, n, p), read only), and the
+    bytes held: at most :func:`~dynid.identification.streaming.max_stack_bytes`, the
+    memory a stacked regressor may take (a log streamed in blocks keeps none)."""
+
+    def __init__(self) -> None:
+        self.held: dict[Hashable, tuple[Any, NDArray[np.float64]]] = {}
+        self.nbytes = 0
+        self.budget = max_stack_bytes()
+
+
+_SHARED: ContextVar[_Shared | None] = ContextVar("_SHARED", default=None)
 
 
 @contextmanager
@@ -66,7 +74,7 @@ def shared_steps() -> Iterator[None]:
     if _SHARED.get() is not None:
         yield
         return
-    token = _SHARED.set({})
+    token = _SHARED.set(_Shared())
     try:
         yield
     finally:
@@ -320,16 +328,17 @@ def _span_columns(
         except TypeError:  # a term that does not hash: computed each time
             keys.append(None)
     got: list[NDArray[np.float64] | None] = [
-        None if key is None or key not in shared else shared[key][1] for key in keys
+        None if key is None or key not in shared.held else shared.held[key][1] for key in keys
     ]
     missing = [i for i, g in enumerate(got) if g is None]
     if missing:
         for i, cols in zip(missing, compute(missing), strict=True):
             got[i] = cols
             key = keys[i]
-            if key is not None:
+            if key is not None and shared.nbytes + cols.nbytes <= shared.budget:
                 cols.flags.writeable = False
-                shared[key] = (refs, cols)
+                shared.held[key] = (refs, cols)
+                shared.nbytes += cols.nbytes
     return [g for g in got if g is not None]
 
 
