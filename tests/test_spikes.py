@@ -18,6 +18,7 @@ from dynid.friction.model import ClassicalFriction
 from dynid.friction.validation import own_friction
 from dynid.identification.selection import identify_recordings
 from dynid.identification.spikes import despiked
+from dynid.identification.structure import Structure
 from dynid.simulation.measurement import SensorNoise, sample_times
 from dynid.simulation.trajectories import random_fourier
 
@@ -74,9 +75,12 @@ def test_torque_spikes_do_not_bias_the_fit(panda, spiked_logs, estimator):
     recording it never saw to its noise, with either estimator, and a warning says how
     many samples were replaced."""
     logs, test, _, rows = spiked_logs
+    terms = Structure(True, ("viscous", "coulomb"))  # the truth's: the spikes, not the choice
     with warnings.catch_warnings(record=True) as got:
         warnings.simplefilter("always", DynidWarning)
-        model = identify_recordings(panda, logs, ["spiked.csv", "b.csv"], estimator=estimator)
+        model = identify_recordings(
+            panda, logs, ["spiked.csv", "b.csv"], estimator=estimator, structure=terms
+        )
     said = [str(w.message) for w in got if "replaced by the line" in str(w.message)]
     assert len(said) == 1 and f"spiked.csv: {rows.size} torque sample(s)" in said[0], said
     held = random_fourier(panda, np.random.default_rng(3))(sample_times(8.0, 500.0))

@@ -32,6 +32,8 @@ Pipeline used for torque logs (Gaz et al. 2019, Sec. VI; Swevers et al. 1997):
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -406,7 +408,7 @@ def lowpass(
         raise DataError(f"order must be >= 1; got {order}")
     import scipy.signal  # imported here: it costs most of ``import dynid`` otherwise
 
-    sos = scipy.signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos")
+    sos = _butter_sos(order, cutoff_hz, fs).copy()  # scipy's filter wants it writable
     minimum = 3 * (2 * len(sos) + 1)
     N = x.shape[axis]
     if N <= minimum:
@@ -478,6 +480,18 @@ def lowpass_noise_gain(
 
 #: Samples filtered at once by :func:`lowpass` (signals grouped up to this size).
 _FILTER_ELEMENTS = 1 << 18
+
+
+@functools.lru_cache(maxsize=64)
+def _butter_sos(order: int, cutoff_hz: float, fs: float) -> NDArray[np.float64]:
+    """The second-order sections of the low-pass Butterworth filter (read only), designed
+    once per order, cut-off [Hz] and rate [Hz]: the regressor's columns of one log are
+    filtered many times at the same ones."""
+    import scipy.signal  # imported here: it costs most of ``import dynid`` otherwise
+
+    sos = np.asarray(scipy.signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos"))
+    sos.flags.writeable = False
+    return sos
 
 
 class _CubicEnds:

@@ -7,9 +7,12 @@ Khalil), and the known rotor torques of a drive are subtracted from the targets.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+import dataclasses
+from collections.abc import Callable, Hashable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from functools import partial
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,7 +26,7 @@ from ..regressors.terms import LinearFriction, ModelTerm, base_term_columns
 from ..regressors.torque import torque_regressor_prepared
 from .dataset import ModelColumns, RegressorBlock
 from .log import TorqueLog
-from .streaming import BLOCK_ROWS, streams
+from .streaming import BLOCK_ROWS, max_stack_bytes, streams
 from .velocity_noise import moving_joints
 
 #: Cycles of the cut-off frequency after which the zero-phase Butterworth low-pass has
@@ -38,11 +41,59 @@ __all__ = [
     "friction_regressor",
     "log_blocks",
     "parallel_filtered",
+    "shared_steps",
     "still_columns",
     "stepped_columns",
     "still_friction",
     "term_regressor",
 ]
+
+
+class _Shared:
+    """The stepping columns of terms already filtered on spans of logs while
+    :func:`shared_steps` is active: key (:func:`_span_columns`) -> (what the key's ids
+    name, kept alive while the entry lives; the columns (m, n, p), read only), and the
+    bytes held: at most :func:`~dynid.identification.streaming.max_stack_bytes`, the
+    memory a stacked regressor may take (a log streamed in blocks keeps none)."""
+
+    def __init__(self) -> None:
+        self.held: dict[Hashable, tuple[Any, NDArray[np.float64]]] = {}
+        self.nbytes = 0
+        self.budget = max_stack_bytes()
+
+
+_SHARED: ContextVar[_Shared | None] = ContextVar("_SHARED", default=None)
+
+
+@contextmanager
+def shared_steps() -> Iterator[None]:
+    """Within the block, a term's stepping columns filtered on a span of a log are
+    computed once and read back by every later regressor holding that term (the
+    candidate structures' regressors share their friction terms): the same numbers, not
+    recomputed. Nested blocks share the outer one's; the columns are dropped at its end."""
+    if _SHARED.get() is not None:
+        yield
+        return
+    token = _SHARED.set(_Shared())
+    try:
+        yield
+    finally:
+        _SHARED.reset(token)
+
+
+def _value_key(x: Any) -> Hashable:
+    """A hashable key of a term's field: arrays by shape, type and bytes, dataclasses by
+    their fields, tuples item by item."""
+    if isinstance(x, np.ndarray):
+        return ("array", x.shape, x.dtype.str, x.tobytes())
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return (type(x).__qualname__,) + tuple(
+            _value_key(getattr(x, f.name)) for f in dataclasses.fields(x)
+        )
+    if isinstance(x, tuple | list):
+        return tuple(_value_key(v) for v in x)
+    hash(x)  # anything else must hash: TypeError otherwise (not shared)
+    return (type(x).__qualname__, x)
 
 
 class SteppingColumns(Protocol):
@@ -216,19 +267,79 @@ def stepped_filtered(
             tw, x = _joined((f,), lo, hi)
             grid = tw
             keep = slice(start + s * k - lo, start + (e - 1) * k + 1 - lo, k)
-        onto = None
-        if stamps is not None and tw.shape[0] > 1:  # where the torques were measured
-            i0 = max(int(np.searchsorted(stamps, grid[0], side="right")) - 1, 0)
-            i1 = int(np.searchsorted(stamps, grid[-1], side="left")) + 1
-            at = stamps[i0:i1]
-            x = CubicSpline(tw, x, axis=0)(at)
-            onto = partial(_interpolated, at, grid)
-        elif grid is not tw and k > 1 and tw.shape[0] > 1:
-            x = CubicSpline(tw, x, axis=0)(np.minimum(grid, tw[-1]))
-        states = (x[:, :n], x[:, n : 2 * n], x[:, 2 * n :])
-        got = [_filtered_columns(t, states, cutoff_hz, k * rate, keep, onto) for t in terms]
+
+        def compute(
+            which: list[int],
+            tw: NDArray[np.float64] = tw,
+            x: NDArray[np.float64] = x,
+            grid: NDArray[np.float64] = grid,
+            keep: slice = keep,
+        ) -> list[NDArray[np.float64]]:
+            """The columns of ``terms[which]`` on this span, from the states there."""
+            onto = None
+            if stamps is not None and tw.shape[0] > 1:  # where the torques were measured
+                i0 = max(int(np.searchsorted(stamps, grid[0], side="right")) - 1, 0)
+                i1 = int(np.searchsorted(stamps, grid[-1], side="left")) + 1
+                at = stamps[i0:i1]
+                x = CubicSpline(tw, x, axis=0)(at)
+                onto = partial(_interpolated, at, grid)
+            elif grid is not tw and k > 1 and tw.shape[0] > 1:
+                x = CubicSpline(tw, x, axis=0)(np.minimum(grid, tw[-1]))
+            states = (x[:, :n], x[:, n : 2 * n], x[:, 2 * n :])
+            rate_k = k * rate
+            return [
+                _filtered_columns(terms[i], states, cutoff_hz, rate_k, keep, onto) for i in which
+            ]
+
+        got = _span_columns(terms, logs, (s, e), cutoff_hz, k, stamps, fine, compute)
         out[s - a : e - a] = np.concatenate(got, axis=-1)[..., steps]
     return out
+
+
+def _span_columns(
+    terms: tuple[SteppingColumns, ...],
+    logs: tuple[TorqueLog | None, TorqueLog, TorqueLog | None],
+    span: tuple[int, int],
+    cutoff_hz: float,
+    k: int,
+    stamps: NDArray[np.float64] | None,
+    fine: tuple[TorqueLog, int] | None,
+    compute: Callable[[list[int]], list[NDArray[np.float64]]],
+) -> list[NDArray[np.float64]]:
+    """Each term's filtered columns on the prepared samples ``span`` of a log: those
+    :func:`shared_steps` holds read back, the others from ``compute`` (the indices of the
+    terms wanted -> their columns) and held."""
+    shared = _SHARED.get()
+    if shared is None:
+        return compute(list(range(len(terms))))
+    refs = (logs, stamps, fine)
+    where = (
+        tuple(id(g) for g in logs),
+        span,
+        float(cutoff_hz),
+        k,
+        id(stamps),
+        None if fine is None else (id(fine[0]), fine[1]),
+    )
+    keys: list[Hashable | None] = []
+    for t in terms:
+        try:
+            keys.append((type(t).__qualname__, _value_key(t), where))
+        except TypeError:  # a term that does not hash: computed each time
+            keys.append(None)
+    got: list[NDArray[np.float64] | None] = [
+        None if key is None or key not in shared.held else shared.held[key][1] for key in keys
+    ]
+    missing = [i for i, g in enumerate(got) if g is None]
+    if missing:
+        for i, cols in zip(missing, compute(missing), strict=True):
+            got[i] = cols
+            key = keys[i]
+            if key is not None and shared.nbytes + cols.nbytes <= shared.budget:
+                cols.flags.writeable = False
+                shared.held[key] = (refs, cols)
+                shared.nbytes += cols.nbytes
+    return [g for g in got if g is not None]
 
 
 def _filtered_columns(

@@ -88,6 +88,7 @@ from .judge import heldout_judge
 from .largest import Fitted, LeftOut, fit_largest, recording_bands
 from .least_squares import StdMethod, within_motion_caveat
 from .log import TorqueLog
+from .log_rows import shared_steps
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded, sign_confirmed
@@ -226,6 +227,7 @@ def _lacks(c: Candidate, best: Candidate) -> dict[str, float]:
     return {lab: r for lab, r in best.determined().items() if lab not in held}
 
 
+@shared_steps()
 def select_structure(
     robot: Robot,
     data: Recordings,
@@ -916,6 +918,7 @@ def _repaired(
     return here
 
 
+@shared_steps()
 def identify_recordings(
     robot: Robot,
     logs: Sequence[TorqueLog],

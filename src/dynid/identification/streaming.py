@@ -403,6 +403,17 @@ def normals_by_label(
     return normals_by_label_scaled(source, labels, weights)[0]
 
 
+def _rows_of(lab: NDArray[np.intp], j: int) -> slice | NDArray[np.bool_]:
+    """The rows labelled ``j``: a slice when they are contiguous (a fold of contiguous
+    rows: no copy of them made to select them), else a mask."""
+    sel = lab == j
+    first = int(np.argmax(sel))
+    count = int(np.count_nonzero(sel))
+    if sel[first : first + count].all():
+        return slice(first, first + count)
+    return sel
+
+
 def normals_by_label_scaled(
     source: BlockSource,
     labels: NDArray[np.intp],
@@ -436,7 +447,8 @@ def normals_by_label_scaled(
         if lab.size != y.size:
             raise ShapeError(f"labels hold {labels.size} rows; the blocks more")
         for j in np.unique(lab):
-            sel = lab == j
+            whole = W.flags.c_contiguous and y.flags.c_contiguous  # a view is alike a copy
+            sel = _rows_of(lab, j) if whole else lab == j
             Ws, ys = W[sel], y[sel]
             for s_ in range(sets):
                 Wj, yj = Ws, ys
