@@ -17,7 +17,9 @@ from dynid.io.observer_files import load_thresholds
 
 @pytest.fixture(scope="module")
 def logs(tmp_path_factory):
-    """A model identified from a 12 s log, a free log and a log with two contacts."""
+    """A model identified from a 12 s log, a free log and a log with two contacts. The
+    model's structure is fixed to the one identify's search chooses on that log (the same
+    coefficients, the search's record aside): the observer is the case, not the search."""
     d = tmp_path_factory.mktemp("observe")
     sim = ["simulate", "--robot", "panda", "--trajectory", "fourier", "-q"]
     assert main([*sim, "--duration", "12", "--seed", "1", "--out", str(d / "ident.csv")]) == 0
@@ -32,6 +34,8 @@ def logs(tmp_path_factory):
                 "--out",
                 str(d / "id"),
                 "--no-figures",  # (identify's figures are not read)
+                "--terms",
+                "viscous,smooth:300,stribeck:0.2,offset,-fsp1,-fv3,-fsp4,-fv5,-fv6",
                 "-q",
             ]
         )

@@ -241,10 +241,11 @@ def test_save_writes_the_page(tmp_path):
 
 
 # ---------------------------------------------------------------------- every command
-#: The commands that write a folder, each with a short run (output folder -> argv).
+#: The commands that write a folder, each with a short run (output folder -> argv); identify
+#: on a log with its structure fixed (the search's table: test_model_structure_table_...).
 COMMANDS = {
     "identify": ["identify", "--data", "{d}/s.csv"],
-    "identify-log": ["identify", "--data", "{d}/l6.csv"],
+    "identify-log": ["identify", "--data", "{d}/l6.csv", "--terms", "viscous,coulomb,offset"],
     "consistent": ["identify", "--data", "{d}/s.csv", "--consistent"],
     "friction": ["friction", "--model", "{d}/identify/identification.json", "--data", "{d}/l.csv"],
     "validate": [

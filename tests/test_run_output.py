@@ -221,7 +221,7 @@ def test_a_full_disk_leaves_no_new_folder_and_an_old_folder_as_it_was(data, tmp_
 
     out = tmp_path / "feasible"
     model = str(data / "model" / "identification.json")
-    r = _run("retrieve", "--model", model, "--objective", "euclidean", "--out", str(out), "-q")
+    r = _main("retrieve", "--model", model, "--objective", "euclidean", "--out", str(out), "-q")
     assert r.returncode in (0, 1), r.stderr  # 1: not consistent; its files are written
     before = _snapshot(out)
     # feasible.json (~9 kB) and robot.* fit, report.json (~11 kB) does not
@@ -246,10 +246,11 @@ def _wait_for(cond, timeout: float) -> bool:
 @pytest.mark.slow
 def test_sigkill_then_rerun_removes_the_stale_files(data, tmp_path):
     """A run killed with SIGKILL leaves its staging folder; the next run removes it and a
-    writer's temporary file of a killed older run, and writes the complete set."""
+    writer's temporary file of a killed older run, and writes the complete set (the runs
+    before and after the killed one in this process: what they do is the folder's)."""
     out = tmp_path / "res"
     args = ("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
-    assert _run(*args).returncode == 0
+    assert _main(*args).returncode == 0
     stale_tmp = out / ".feasible.json.k2j4x9.tmp.json"
     stale_tmp.write_text('{"half": ')
     before = _snapshot(out)
@@ -261,7 +262,7 @@ def test_sigkill_then_rerun_removes_the_stale_files(data, tmp_path):
     assert proc.returncode == -signal.SIGKILL
     assert _snapshot(out) == before  # nothing of the killed run in the folder
     assert len(_staging(tmp_path)) == 1
-    r = _run(*args)
+    r = _main(*args)
     assert r.returncode == 0, r.stderr
     assert _staging(tmp_path) == []
     assert not stale_tmp.exists()
@@ -269,14 +270,15 @@ def test_sigkill_then_rerun_removes_the_stale_files(data, tmp_path):
 
 
 def test_a_failing_run_never_removes_files_of_a_concurrent_run(data, tmp_path):
-    """Run A (identify --consistent, seconds) and run B (a bad data file, fails at once)
-    into one new folder: A's set is complete (issue 20: B's clean-up removed A's files)."""
+    """Run A (identify --consistent, seconds, a process) and run B (a bad data file, fails
+    at once, in this process) into one new folder: A's set is complete (issue 20: B's
+    clean-up removed A's files)."""
     out = tmp_path / "res"
     bad = tmp_path / "bad.csv"
     bad.write_text("q1,q2\n1,2\n")
     a = _dynid("identify", "--data", str(data / "s3.csv"), "--consistent", "--out", str(out), "-q")
     assert _wait_for(lambda: _staging(tmp_path), 30)
-    b = _run("identify", "--data", str(bad), "--consistent", "--out", str(out), "-q")
+    b = _main("identify", "--data", str(bad), "--consistent", "--out", str(out), "-q")
     assert b.returncode == 2
     _, err = a.communicate(timeout=120)
     assert a.returncode == 0, err
@@ -327,13 +329,13 @@ def test_a_file_out_is_staged_too(tmp_path):
     during the run leaves it untouched and no staging folder."""
     log = tmp_path / "log.csv"
     assert (
-        _run("simulate", "--duration", "1", "--rate", "100", "--out", str(log), "-q").returncode
+        _main("simulate", "--duration", "1", "--rate", "100", "--out", str(log), "-q").returncode
         == 0
     )
     before = log.read_bytes()
     proc = _dynid("simulate", "--duration", "400", "--rate", "1000", "--out", str(log), "-q")
     assert _wait_for(lambda: _staging(tmp_path), 30)
-    time.sleep(1.0)
+    time.sleep(0.3)  # into the simulation (400 s of it: minutes of work)
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 143, err
