@@ -1338,10 +1338,7 @@ def test_ctrl_c_stops_a_write_without_a_partial_file(tmp_path):
         "acquire-static", "--n", "400000", "--out", str(out),
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )  # fmt: skip
-    end = time.monotonic() + 60  # its staging folder: the command runs (minutes of work)
-    while not any(".dynid-" in p.name for p in tmp_path.iterdir()) and time.monotonic() < end:
-        time.sleep(0.05)
-    time.sleep(0.5)
+    time.sleep(4.0)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 130, err
