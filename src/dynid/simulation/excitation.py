@@ -353,7 +353,7 @@ def _classical_regressor(
     Y = torque_regressor_prepared(robot, traj.q, traj.dq, traj.ddq, robot.gravity)
     F = friction_regressor(np.asarray(traj.dq))
     r = len(base.independent)
-    W = np.empty(Y.shape[:-1] + (r + F.shape[-1],))
+    W: NDArray[np.float64] = np.empty((*Y.shape[:-1], r + F.shape[-1]))
     np.take(Y, base.independent, axis=-1, out=W[..., :r])  # twice as fast as Y[..., idx]
     W[..., r:] = F
     return W.reshape(-1, W.shape[-1])
