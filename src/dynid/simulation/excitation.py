@@ -335,14 +335,27 @@ class ExcitationResult:
         return tuple(a for a in m.get("closest", ()) if a.margin < -1e-9)
 
 
+def _first_max(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``a.max(axis=0)`` of a batch-first array (N, ...) reduced along a contiguous copy:
+    several times faster for N samples of a few columns, the same values."""
+    return np.ascontiguousarray(np.moveaxis(a, 0, -1)).max(axis=-1)
+
+
+def _first_min(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``a.min(axis=0)``, as :func:`_first_max`."""
+    return np.ascontiguousarray(np.moveaxis(a, 0, -1)).min(axis=-1)
+
+
 def _classical_regressor(
     robot: Robot, base: BaseParameters, traj: Trajectory
 ) -> NDArray[np.float64]:
     """``[Y_b, F]`` stacked sample-major (N n, r + 3 n)."""
-    Y = torque_regressor_prepared(robot, traj.q, traj.dq, traj.ddq, robot.gravity)[
-        ..., base.independent
-    ]
-    W = np.concatenate([Y, friction_regressor(np.asarray(traj.dq))], axis=-1)
+    Y = torque_regressor_prepared(robot, traj.q, traj.dq, traj.ddq, robot.gravity)
+    F = friction_regressor(np.asarray(traj.dq))
+    r = len(base.independent)
+    W: NDArray[np.float64] = np.empty((*Y.shape[:-1], r + F.shape[-1]))
+    np.take(Y, base.independent, axis=-1, out=W[..., :r])  # twice as fast as Y[..., idx]
+    W[..., r:] = F
     return W.reshape(-1, W.shape[-1])
 
 
@@ -509,14 +522,15 @@ class _Problem:
         limits and their margins."""
         Pq, Pd, Pa = self.B_lim
         q, dq, ddq = Pq @ c.T, Pd @ c.T, Pa @ c.T
-        span = q.max(axis=0) - q.min(axis=0)
+        q_lo, q_hi = _first_min(q), _first_max(q)
+        span = q_hi - q_lo
         with np.errstate(divide="ignore", invalid="ignore"):
             s = np.minimum.reduce(
                 [
                     np.ones(self.n),
                     (self.hi - self.lo) / span,
-                    self.vmax / np.abs(dq).max(axis=0),
-                    self.amax / np.abs(ddq).max(axis=0),
+                    self.vmax / _first_max(np.abs(dq)),
+                    self.amax / _first_max(np.abs(ddq)),
                 ]
             )
         # 1e-3 to spare: the peaks between the 100 Hz samples are higher by < 5e-4
@@ -524,7 +538,7 @@ class _Problem:
         if fraction != 1:
             s = s * fraction
         tol = 2.5e-4 * (self.hi - self.lo)  # inside the 1e-3 spared by the scaling
-        qmin, qmax = q.min(axis=0) * s, q.max(axis=0) * s
+        qmin, qmax = q_lo * s, q_hi * s
         return c * s[:, None], self.lo - qmin + tol, self.hi - qmax - tol
 
     def initial(
@@ -570,7 +584,7 @@ class _Problem:
         pen = 0.0
         if np.any(np.isfinite(self.tmax)):
             tr = self._traj(self.B_lim, c, q0, self.t_lim)
-            tau = np.abs(_motor_torques(self.robot, tr, self.drive)).max(axis=0)
+            tau = _first_max(np.abs(_motor_torques(self.robot, tr, self.drive)))
             with np.errstate(invalid="ignore"):
                 v = np.where(np.isfinite(self.tmax), (tau - self.tmax) / self.tmax, 0.0)
             pen += float(np.sum(np.maximum(v, 0.0) ** 2))
@@ -578,11 +592,11 @@ class _Problem:
         seg = capsule_segments(self.robot, qc)
         c_self, c_obstacle = _clearances(self.opts)
         if self.caps.pairs.size:
-            d = self_distances(self.robot, qc, self.caps, segments=seg).min(axis=0)
+            d = _first_min(self_distances(self.robot, qc, self.caps, segments=seg))
             pen += float(np.sum(np.maximum(c_self + 0.01 - d, 0.0) ** 2)) / 0.05**2
         if len(self.obstacles):
             d = obstacle_distances(self.robot, qc, self.obstacles, self.caps, segments=seg)
-            d = d.min(axis=0)
+            d = _first_min(d)
             pen += float(np.sum(np.maximum(c_obstacle + 0.01 - d, 0.0) ** 2)) / 0.05**2
         return 100.0 * pen
 

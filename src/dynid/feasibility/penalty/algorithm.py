@@ -89,9 +89,9 @@ def _refine(
     (the slow zig-zag of constraints switching at their target). Returns the point and
     the number of residual evaluations.
     """
-    import scipy.linalg  # scipy on first use (start-up time)
+    from scipy.linalg.lapack import dpotrs  # scipy on first use (start-up time)
 
-    e = problem.lsq_residual(z, xi)
+    e, sl = problem.lsq_residual_slacks(z, xi)
     cost = float(e @ e)
     nfev = 1
     lam = -1.0
@@ -99,10 +99,10 @@ def _refine(
     for _ in range(maxiter):
         if cost <= 1e-30:
             break
-        J = problem.lsq_jacobian(z, xi)
+        J = problem.lsq_jacobian(z, xi, slacks=sl)
         grad = J.T @ e
         H = J.T @ J
-        hmax = max(float(np.max(np.diag(H), initial=0.0)), 1e-300)
+        hmax = max(float(H.diagonal().max(initial=0.0)), 1e-300)
         if lam < 0:
             lam = 1e-3 * hmax
         accepted = False
@@ -112,13 +112,16 @@ def _refine(
             ok = True
             for _ in range(5):
                 free = ~fixed
+                Hf = H[free][:, free]
+                Hf.flat[:: Hf.shape[0] + 1] += lam  # H + lam E on the free variables
                 try:
-                    L = np.linalg.cholesky(H[np.ix_(free, free)] + lam * np.eye(int(free.sum())))
+                    L = np.linalg.cholesky(Hf)
                 except np.linalg.LinAlgError:
                     ok = False
                     break
                 step[:] = 0.0
-                step[free] = -scipy.linalg.cho_solve((L, True), grad[free], check_finite=False)
+                if L.shape[0]:  # cho_solve's LAPACK call, without its wrappers
+                    step[free] = -dpotrs(L, grad[free], lower=1)[0]
                 out = ((z <= 0.0) & (step < 0.0)) | ((z >= 1.0) & (step > 0.0))
                 if not out.any():
                     break
@@ -127,11 +130,11 @@ def _refine(
                 lam *= 10.0
                 continue
             z_new = np.clip(z + step, 0.0, 1.0)
-            e_new = problem.lsq_residual(z_new, xi)
+            e_new, sl_new = problem.lsq_residual_slacks(z_new, xi)
             nfev += 1
             c_new = float(e_new @ e_new)
             if c_new < cost:
-                z, e, cost = z_new, e_new, c_new
+                z, e, sl, cost = z_new, e_new, sl_new, c_new
                 lam = max(lam / 10.0, 1e-14 * hmax)
                 accepted = True
                 break

@@ -177,7 +177,10 @@ class PenaltyProblem:
     # ------------------------------------------------------------------ data term
     def residual(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
         """Scaled data residual ``A phi(p) - b`` (m,)."""
-        return self.A @ phi_from_params(self.p_from_z(z)).reshape(-1) - self.b
+        return self._residual_p(self.p_from_z(z))
+
+    def _residual_p(self, p: NDArray[np.float64]) -> NDArray[np.float64]:
+        return self.A @ phi_from_params(p).reshape(-1) - self.b
 
     def residual_jacobian(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
         """d residual / d z, shape (m, 10 n)."""
@@ -224,7 +227,9 @@ class PenaltyProblem:
     def slacks(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
         """Scaled signed violations ``(delta_j - h_j) / s_j`` (positive when violated;
         user constraints: their violation ``v >= 0``), :meth:`constraint_names` order."""
-        p = self.p_from_z(z)
+        return self._slacks_p(self.p_from_z(z))
+
+    def _slacks_p(self, p: NDArray[np.float64]) -> NDArray[np.float64]:
         lam = self._eig(p, False)
         sI = self.inertia_scale
         d = self.margin
@@ -241,7 +246,13 @@ class PenaltyProblem:
         """Scaled violation distances ``g_j = max(0, slack_j) >= 0`` (eq. 32)."""
         return np.maximum(self.slacks(z), 0.0)
 
-    def violation_jacobian(self, z: NDArray[np.float64], band: float = 0.0) -> NDArray[np.float64]:
+    def violation_jacobian(
+        self,
+        z: NDArray[np.float64],
+        band: float = 0.0,
+        *,
+        slacks: NDArray[np.float64] | None = None,
+    ) -> NDArray[np.float64]:
         """Jacobian of the violations w.r.t. ``z``, shape (n_constraints, 10 n).
 
         Rows of constraints with ``slack_j > -band`` (violated, or within ``band`` of
@@ -249,10 +260,11 @@ class PenaltyProblem:
         refinement a sticky active set: a constraint at its target is held there
         instead of being released and violated again by the next step. Eigenvalue
         derivatives ``d lambda = v^T dI v`` (simple eigenvalues); user constraints by
-        forward differences (only when violated).
+        forward differences (only when violated). ``slacks``: :meth:`slacks` at ``z`` when
+        the caller has them already.
         """
         z = np.asarray(z, dtype=np.float64)
-        sl = self.slacks(z)
+        sl = self.slacks(z) if slacks is None else slacks
         n, w = self.n, self.width
         p = self.p_from_z(z)
         lam, V = self._eig(p, True)
@@ -299,28 +311,44 @@ class PenaltyProblem:
     # ------------------------------------------------------------------ objectives
     def stage_cost(self, z: NDArray[np.float64], xi: float = 0.0) -> float:
         """Stage objective ``F = f_0 + xi * sum_j g_j^2`` (eq. 29; squared eq. 32 distances)."""
-        f = self.data_cost(z)
+        p = self.p_from_z(z)
+        r = self._residual_p(p)
+        f = float(r @ r) + self.offset
         if xi > 0.0:
-            g = self.violations(z)
+            g = np.maximum(self._slacks_p(p), 0.0)
             f += xi * float(g @ g)
         return f
 
     def lsq_residual(self, z: NDArray[np.float64], xi: float) -> NDArray[np.float64]:
         """Residual ``[A phi - b; sqrt(xi) g]``: ``||.||^2 + offset`` is :meth:`stage_cost`."""
-        r = self.residual(z)
+        return self.lsq_residual_slacks(z, xi)[0]
+
+    def lsq_residual_slacks(
+        self, z: NDArray[np.float64], xi: float
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+        """:meth:`lsq_residual` and the :meth:`slacks` it was made from (``None`` when
+        ``xi <= 0``: no penalty term), for :meth:`lsq_jacobian` at the same ``z``."""
+        p = self.p_from_z(z)
+        r = self._residual_p(p)
         if xi <= 0.0:
-            return r
-        return np.concatenate([r, np.sqrt(xi) * self.violations(z)])
+            return r, None
+        sl = self._slacks_p(p)
+        return np.concatenate([r, np.sqrt(xi) * np.maximum(sl, 0.0)]), sl
 
     def lsq_jacobian(
-        self, z: NDArray[np.float64], xi: float, band: float = 0.0
+        self,
+        z: NDArray[np.float64],
+        xi: float,
+        band: float = 0.0,
+        *,
+        slacks: NDArray[np.float64] | None = None,
     ) -> NDArray[np.float64]:
-        """Jacobian of :meth:`lsq_residual` w.r.t. ``z`` (``band``: see
+        """Jacobian of :meth:`lsq_residual` w.r.t. ``z`` (``band``, ``slacks``: see
         :meth:`violation_jacobian`)."""
         J = self.residual_jacobian(z)
         if xi <= 0.0:
             return J
-        return np.vstack([J, np.sqrt(xi) * self.violation_jacobian(z, band)])
+        return np.vstack([J, np.sqrt(xi) * self.violation_jacobian(z, band, slacks=slacks)])
 
 
 # ------------------------------------------------------------------------ builders
