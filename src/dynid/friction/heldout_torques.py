@@ -84,7 +84,7 @@ __all__ = [
 ]
 
 #: Samples the gains' fit uses at most (evenly spread).
-_GAIN_SAMPLES = 4_000
+_GAIN_SAMPLES = 2_000
 
 
 @dataclass(frozen=True, slots=True, eq=False)

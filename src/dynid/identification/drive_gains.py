@@ -408,12 +408,7 @@ def drive_gains(
     C = _noise_covariance(s, transmission)
     active = _linked(A, B, C, N)
     Qa = _column_space(np.concatenate([A, B[:, ~active]], axis=1))
-    Pa = B[:, active] - Qa @ (Qa.T @ B[:, active])
-    S = Pa.T @ Pa
-    import scipy.linalg  # here: the command's start loads no scipy
-
-    lam, V = scipy.linalg.eigh(S, C[np.ix_(active, active)])  # V' C V = I
-    g = V[:, 0] * np.sign(np.sum(V[:, 0]))
+    S, lam, V, g = _smallest(B[:, active], Qa, C[np.ix_(active, active)])
     dof = N * n - Qa.shape[1] - (int(active.sum()) - 1)
     var = max(float(lam[0]), 0.0) / max(dof, 1)  # per row, at g' C g = 1
     gap = np.maximum(lam[1:] - lam[0], 1e-300)
@@ -476,7 +471,6 @@ def _heldout(
     weighted residual's mean square with every gain as fitted and with motor ``k``'s held
     at 1 (the description's scale from ``G``, ``gd`` on the training rows, else the
     geometric mean), the parameters fitted again on the training rows."""
-    import scipy.linalg
 
     n = B.shape[0] // labels.size
     rows = np.repeat(labels, n)
@@ -487,11 +481,8 @@ def _heldout(
     X = X / np.where(scale > 0, scale, 1.0)
     for f in np.unique(labels):
         tr, te = rows != f, rows == f
-        Q = _column_space(X[tr])
         Ba = B[:, active]
-        P = Ba[tr] - Q @ (Q.T @ Ba[tr])
-        _, V = scipy.linalg.eigh(P.T @ P, C[np.ix_(active, active)])
-        g = V[:, 0] * np.sign(np.sum(V[:, 0]))
+        g = _smallest(Ba[tr], _column_space(X[tr]), C[np.ix_(active, active)])[3]
         full = np.full(B.shape[1], np.nan)
         full[active] = g
         ts = labels != f
@@ -515,6 +506,20 @@ def _heldout(
         return np.full(m, np.nan), np.full(m, np.nan)
     D = np.asarray(diffs)
     return np.mean(D, axis=0), np.std(D, axis=0, ddof=1) / np.sqrt(D.shape[0])
+
+
+def _smallest(
+    Ba: NDArray[np.float64], Q: NDArray[np.float64], C: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The efforts' normal matrix ``S`` with the orthonormal columns ``Q`` projected out of
+    ``Ba``, the generalized eigenvalues and eigenvectors of ``(S, C)`` (``V' C V = I``),
+    and the gains: the eigenvector of the smallest, its sign making them sum positive."""
+    import scipy.linalg  # here: the command's start loads no scipy
+
+    P = Ba - Q @ (Q.T @ Ba)
+    S = P.T @ P
+    lam, V = scipy.linalg.eigh(S, C)
+    return S, lam, V, V[:, 0] * np.sign(np.sum(V[:, 0]))
 
 
 def _fold_score(
