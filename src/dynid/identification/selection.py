@@ -49,7 +49,7 @@ import copy
 import re
 import warnings
 from collections.abc import Callable, Collection, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -315,9 +315,8 @@ def select_structure(
     skip: tuple[int, ...] = ()
     if len(data.names) > 2 and validation is None:
         judged, skip = _without_odd(judged, columns, groups, data.names, fit_rtol, notes)
-    # the regressor each candidate's columns are in; a per-joint structure's is that of
-    # the candidate its search began at (a smooth-sign Stribeck law without its bumps is
-    # a smooth law, in the Stribeck law's regressor)
+    # each candidate's regressor; a per-joint structure's that of the candidate its search
+    # began at (a smooth-sign Stribeck law without its bumps, in the Stribeck law's)
     where = {c: key for c, _, key in columns}
     by_group = {
         g: (m, t, without_recordings(m, skip) if skip else heldout_of(m))
@@ -325,11 +324,12 @@ def select_structure(
     }
     if per_joint:
         judged += _widths_per_joint(judged, by_group, robot.n, fit_rtol, where)
-    judged += _smooth_bumps(judged, cands, fit, groups, by_group, where, skip, fit_rtol)
-    judged += _refined_width(judged, fit, groups, by_group, where, skip, fit_rtol, notes)
+    off = _OffGrid(fit, groups, by_group, where, skip, fit_rtol)
+    judged += _smooth_bumps(judged, cands, off)
+    judged += _refined_width(judged, off, notes)
     if per_joint:
         judged += _per_joint(judged, by_group, robot.n, fit_rtol, where)
-    chosen = _refined_stribeck(judged, fit, groups, by_group, where, skip, fit_rtol, notes)
+    chosen = _refined_stribeck(judged, off, notes)
     notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
     best = min(_physical(judged), key=lambda c: c.score)
     determined = _kept_determined(chosen, best, judged, by_group, robot.n, fit_rtol, where)
@@ -546,19 +546,14 @@ def _widths_per_joint(
 def _smooth_bumps(
     judged: Sequence[Candidate],
     cands: Sequence[Structure],
-    fit: Callable[[list[Structure]], list[Fitted]],
-    groups: _Groups,
-    by_group: _Folds,
-    where: dict[Structure, _Key],
-    skip: tuple[int, ...],
-    rtol: float,
+    off: _OffGrid,
 ) -> list[Candidate]:
     """The Stribeck bump on the smooth sign at the width of the smooth law that predicts
     held-out data best (:func:`~.bumps.bump_widths`; one width or, from
     :func:`_widths_per_joint`, one per joint) at each Stribeck velocity of ``cands``,
     the widths walked along those of ``cands``' smooth laws: the candidates not judged
-    yet, each width's fitted in a regressor of its own (``fit``; recorded in ``groups``,
-    ``by_group`` and ``where``) and judged without the recordings ``skip``. None when
+    yet, each width's fitted in a regressor of its own and judged (:meth:`_OffGrid.judged`,
+    without the recordings ``off.skip``). None when
     ``cands`` hold no Stribeck law, no smooth law was judged, or the best predicts no
     better than the laws without a Coulomb term (beyond one standard error)."""
     smooth = [c for c in _physical(judged) if _plain_smooth(c.structure)]
@@ -572,7 +567,7 @@ def _smooth_bumps(
     if signless and not _better(start, min(signless, key=lambda c: c.score)):
         return []  # no Coulomb friction in the data: no bump on it either
     widths = sorted({c.width for c in cands if _plain_smooth(c) and isinstance(c.width, float)})
-    mine = {(c.structure, where.get(c.structure)): c for c in judged}
+    mine = {(c.structure, off.where.get(c.structure)): c for c in judged}
     new: list[Candidate] = []
 
     def at_width(w: float | tuple[float, ...]) -> list[Candidate]:
@@ -580,17 +575,7 @@ def _smooth_bumps(
         key = regressor_group(structures[0])
         if any(regressor_group(c) == key for c in cands):  # in the grid: judged already
             return [m for s in structures if (m := mine.get((s, key))) is not None]
-        out = []
-        for family, model, terms, held in fit(list(structures)):
-            own = (key[0], key[1], family)
-            groups[own] = (model, terms)
-            folds = without_recordings(model, skip) if skip else heldout_of(model)
-            by_group[own] = (model, terms, folds)
-            for c in held:
-                where[c] = own
-                out.append(
-                    _judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol)
-                )
+        out = off.judged(list(structures))
         new.extend(out)
         return out
 
@@ -598,24 +583,15 @@ def _smooth_bumps(
     return new
 
 
-def _refined_width(
-    judged: Sequence[Candidate],
-    fit: Callable[[list[Structure], str], list[Fitted]],
-    groups: _Groups,
-    by_group: _Folds,
-    where: dict[Structure, _Key],
-    skip: tuple[int, ...],
-    rtol: float,
-    notes: list[str],
-) -> list[Candidate]:
+def _refined_width(judged: Sequence[Candidate], off: _OffGrid, notes: list[str]) -> list[Candidate]:
     """The smooth Coulomb law of one width that predicts held-out data best, its width
     refined between its grid neighbours on the held-out error
     (:func:`~.shape_refinement.refined_shape`, from the scores of the same law at the
     grid's widths), once the Stribeck bumps are judged (from the grid's widths: a smooth
     law without its bump is fitted at a width rounded to make up for it, the start of the
     bump's walk, :mod:`~.bumps`, not its answer): the candidates judged at the
-    new widths (each width's fitted in a regressor of its own, recorded in ``groups``,
-    ``by_group`` and ``where``), said in ``notes`` when one predicts better than the
+    new widths (each width's fitted in a regressor of its own and recorded,
+    :meth:`_OffGrid.judged`), said in ``notes`` when one predicts better than the
     grid's; none when no such law was judged, the best predicts no better than the laws
     without a Coulomb term (beyond one standard error: no Coulomb friction in the data) or
     a law of the banded sign predicts better than it (beyond one standard error)."""
@@ -649,11 +625,7 @@ def _refined_width(
 
     def at(w: float) -> float | None:
         mine = replace(full, width=w)
-        new.extend(
-            _judged_apart(
-                [mine], f"{w:g}", "smooth width", fit, groups, by_group, where, skip, rtol
-            )
-        )
+        new.extend(off.judged([mine], "structure search, the smooth width", value=f"{w:g}"))
         return next((c.score for c in new if c.structure == mine and not c.skipped), None)
 
     assert isinstance(full.width, float)  # one width: the smooth laws of the grid
@@ -673,23 +645,14 @@ def _refined_width(
     return new
 
 
-def _refined_stribeck(
-    judged: list[Candidate],
-    fit: Callable[[list[Structure], str], list[Fitted]],
-    groups: _Groups,
-    by_group: _Folds,
-    where: dict[Structure, _Key],
-    skip: tuple[int, ...],
-    rtol: float,
-    notes: list[str],
-) -> Structure:
+def _refined_stribeck(judged: list[Candidate], off: _OffGrid, notes: list[str]) -> Structure:
     """The structure chosen (:func:`_chosen`) with its Stribeck velocity refined between
     its grid neighbours on the held-out error (:func:`~.shape_refinement.refined_shape`,
     driven by the scores of the chosen law without its coefficients left out at the grid's
     velocities): the candidates judged at the new velocities appended to ``judged`` (each
-    velocity's fitted in a regressor of its own, recorded in ``groups``, ``by_group`` and
-    ``where``), and the structure of lowest held-out error among the chosen and those at
-    its coefficients, dissipative, said in ``notes``; the chosen itself where it holds no
+    velocity's fitted in a regressor of its own and recorded, :meth:`_OffGrid.judged`),
+    and the structure of lowest held-out error among the chosen and those at its
+    coefficients, dissipative, said in ``notes``; the chosen itself where it holds no
     Stribeck law or its grid was not judged."""
     chosen = _chosen(judged)
     if "stribeck" not in chosen.friction:
@@ -704,11 +667,7 @@ def _refined_stribeck(
 
     def at(v: float) -> float | None:
         mine = [replace(full, vst=v), *([replace(chosen, vst=v)] if chosen.drop else [])]
-        new.extend(
-            _judged_apart(
-                mine, f"{v:g}", "Stribeck velocity", fit, groups, by_group, where, skip, rtol
-            )
-        )
+        new.extend(off.judged(mine, "structure search, the Stribeck velocity", value=f"{v:g}"))
         return next((c.score for c in new if c.structure == mine[0]), None)
 
     tried = refined_shape(scores, chosen.vst, at)
@@ -730,31 +689,39 @@ def _refined_stribeck(
     return best.structure
 
 
-def _judged_apart(
-    structures: list[Structure],
-    value: str,
-    what: str,
-    fit: Callable[[list[Structure], str], list[Fitted]],
-    groups: _Groups,
-    by_group: _Folds,
-    where: dict[Structure, _Key],
-    skip: tuple[int, ...],
-    rtol: float,
-) -> list[Candidate]:
-    """``structures`` (one shape parameter, ``what``, at a ``value`` off the grid) fitted
-    in a regressor of their own and judged on its folds (recordings ``skip`` left out),
-    the regressor recorded in ``groups``, ``by_group`` and ``where``, as the grid's are."""
-    out: list[Candidate] = []
-    first = structures[0]
-    for family, model, terms, held in fit(structures, f"structure search, the {what}"):
-        own = (first.armature, first.at, f"{family} {value}")
-        groups[own] = (model, terms)
-        folds = without_recordings(model, skip) if skip else heldout_of(model)
-        by_group[own] = (model, terms, folds)
-        for c in held:
-            where[c] = own
-            out.append(_judged(c, candidate_columns(c, model, terms), model, terms, folds, rtol))
-    return out
+@dataclass(frozen=True)
+class _OffGrid:
+    """What judging structures off the grid needs (a smooth width, a Stribeck velocity, a
+    bump's width): ``fit`` fits one regressor group (with its step's label), ``groups``,
+    ``by_group`` and ``where`` record each new regressor and its folds as the grid's are
+    recorded (updated in place), ``skip`` the recordings left out of the judgement and
+    ``rtol`` the fit's rank tolerance."""
+
+    fit: Callable[..., list[Fitted]]
+    groups: _Groups
+    by_group: _Folds
+    where: dict[Structure, _Key]
+    skip: tuple[int, ...]
+    rtol: float
+
+    def judged(self, structures: list[Structure], *label: str, value: str = "") -> list[Candidate]:
+        """``structures`` (one regressor group) fitted in a regressor of their own (``label``:
+        the step's, else ``fit``'s default) and judged on its folds (the recordings
+        ``skip`` left out); the regressor's key that of ``structures[0]`` with each
+        family's name, followed by ``value`` (the shape parameter off the grid) when
+        given."""
+        out: list[Candidate] = []
+        first = structures[0]
+        for family, model, terms, held in self.fit(structures, *label):
+            own = (first.armature, first.at, f"{family} {value}" if value else family)
+            self.groups[own] = (model, terms)
+            folds = without_recordings(model, self.skip) if self.skip else heldout_of(model)
+            self.by_group[own] = (model, terms, folds)
+            for c in held:
+                self.where[c] = own
+                use = candidate_columns(c, model, terms)
+                out.append(_judged(c, use, model, terms, folds, self.rtol))
+        return out
 
 
 def _plain_smooth(c: Structure) -> bool:
