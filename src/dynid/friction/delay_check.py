@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DynidError
+from ..identification.gravity_tilt import tilt_columns
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
@@ -42,24 +43,31 @@ def validations_delay(
 ) -> TorqueDelay | None:
     """The delay of the torques behind the positions in ``parts`` (one
     :class:`~dynid.friction.validation.Validation` per prepared piece, of ``model``), or
-    None when it cannot be read (too few samples, no prediction that changes)."""
+    None when it cannot be read (too few samples, no prediction that changes). Fitted
+    beside the tilt of the gravity vector's columns and, of an identified model, its own
+    (module docstring)."""
     t, predicted, error, columns = [], [], [], []
-    every = -(-sum(v.log.n_samples for v in parts) // ROWS)  # every k-th row fitted
+    every = max(-(-sum(v.log.n_samples for v in parts) // ROWS), 1)  # every k-th row fitted
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
     for v in parts:
         log = v.log
         hat = v.tau_model if v.tau_friction is None else v.tau_model + v.tau_friction
         t.append(log.t)
         predicted.append(v.tau_model)
         error.append(log.tau - hat)
+        rows = np.arange(0, log.n_samples, every)
+        tilt = tilt_columns(robot, log.q[rows])  # zero for a description without links
         if isinstance(model, IdentifiedModel):
             beside = beside_columns(model, log)
             if beside is not None:
-                columns.append(beside(np.arange(0, log.n_samples, max(every, 1))))
+                columns.append(np.concatenate([beside(rows), tilt], axis=-1))
+        else:
+            columns.append(tilt)
     if not t:
         return None
     cols: list[NDArray[np.float64]] | None = columns if len(columns) == len(t) else None
     lag = _lag(model, parts)
-    return torque_delay(t, predicted, error, cols, lag, every=max(every, 1))
+    return torque_delay(t, predicted, error, cols, lag, every=every)
 
 
 def logs_delay(

@@ -11,7 +11,10 @@ of the delay taken back: the coefficient is ``delta`` itself), the derivative ta
 within each prepared piece (never across a gap) of the rigid-body prediction (friction's
 steps at a reversal are no first-order term). One delay common to every joint (a bus)
 with its standard deviation over the pieces' serially correlated residual
-(:mod:`~dynid.identification.serial`: Newey-West), and each joint's alone for the report.
+(:mod:`~dynid.identification.serial`: Newey-West) or, when larger, over the spread of
+:data:`BLOCKS` contiguous time blocks' delays (a model error the residual holds, correlated
+over seconds, moves the delay from block to block more than the noise does), and each
+joint's alone for the report.
 
 The delay is named (:attr:`TorqueDelay.named`) when it stands :data:`SIGNIFICANT`
 standard deviations clear and explains at least :data:`SHARE` of the residual's weighted
@@ -36,6 +39,7 @@ from numpy.typing import NDArray
 from .serial import SerialMeat, serial_of_pieces
 
 __all__ = [
+    "BLOCKS",
     "SHARE",
     "SIGNIFICANT",
     "AppliedDelay",
@@ -49,6 +53,8 @@ __all__ = [
 SIGNIFICANT = 3.0
 #: Smallest share of the residual's weighted sum of squares the delay must explain.
 SHARE = 0.01
+#: Contiguous time blocks of the pieces whose delays' spread the standard deviation covers.
+BLOCKS = 8
 #: Fewest samples of a piece whose derivative is taken.
 _MIN_SAMPLES = 5
 
@@ -62,7 +68,8 @@ class TorqueDelay:
     delay_s : float
         The delay common to every joint [s] (positive: the torques late).
     std_s : float
-        Its standard deviation [s] (Newey-West within each piece).
+        Its standard deviation [s]: Newey-West within each piece, or the spread of
+        :data:`BLOCKS` time blocks' delays when larger.
     share : float
         The share of the residual's weighted sum of squares the common delay explains.
     joints_s, joints_std_s : tuple of float
@@ -280,4 +287,22 @@ def _fit(
     meat.add((x * r)[:, None])
     m = x.shape[0]
     var = float(meat.result()[0, 0]) / xx**2 * m / max(m - 1, 1)
+    var = max(var, _blocks_var(x * r, sizes, len(j)) / xx**2)
     return delta, float(np.sqrt(max(var, 0.0))), delta**2 * xx / yy
+
+
+def _blocks_var(score: NDArray[np.float64], sizes: list[int], rows: int) -> float:
+    """The variance of the scores' sum ``score`` (sum(sizes) * rows,) [s^-2 ...] over
+    :data:`BLOCKS` contiguous time blocks taken as independent (a cluster-robust
+    variance, ``G / (G - 1)`` corrected): each piece cut into blocks in proportion to its
+    samples ``sizes``, at least one; 0 with fewer than two blocks."""
+    total = sum(sizes)
+    labels, first = [], 0
+    for size in sizes:
+        k = max(1, min(size, round(BLOCKS * size / total)))
+        labels.append(first + np.minimum(np.arange(size) * k // size, k - 1))
+        first += k
+    if first < 2:
+        return 0.0
+    sums = np.bincount(np.repeat(np.concatenate(labels), rows), weights=score, minlength=first)
+    return float(sums @ sums) * first / (first - 1)
