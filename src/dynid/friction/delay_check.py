@@ -48,7 +48,7 @@ def validations_delay(
     (module docstring)."""
     t, predicted, error, columns = [], [], [], []
     every = max(-(-sum(v.log.n_samples for v in parts) // ROWS), 1)  # every k-th row fitted
-    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    robot = model.description if isinstance(model, IdentifiedModel) else model
     for v in parts:
         log = v.log
         hat = v.tau_model if v.tau_friction is None else v.tau_model + v.tau_friction
@@ -56,7 +56,7 @@ def validations_delay(
         predicted.append(v.tau_model)
         error.append(log.tau - hat)
         rows = np.arange(0, log.n_samples, every)
-        tilt = tilt_columns(robot, log.q[rows])  # zero for a description without links
+        tilt = tilt_columns(robot, log.q[rows])  # the description's links; zero without
         if isinstance(model, IdentifiedModel):
             beside = beside_columns(model, log)
             if beside is not None:
