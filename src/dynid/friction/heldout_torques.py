@@ -528,7 +528,10 @@ def residual_tilt(
     the springs ``springs`` names (:func:`residual_springs`, fitted beside a tilt, on the
     whole log of a time block) taken out first (a 20 N m/rad spring on a Panda shoulder had
     read as a tilt of 0.89 and 1.8 deg); of a robot's own parameters, on the residual as it
-    is. ``v`` is at the joints (a motor-side log or currents read through the drive). None
+    is. The tilt's columns are of the description's links
+    (:attr:`~dynid.identification.model.IdentifiedModel.description`: a model read back
+    from its file holds none in its robot, and a UR5 tilted 0.3 deg was told of springs).
+    ``v`` is at the joints (a motor-side log or currents read through the drive). None
     without accelerations."""
     log = v.log
     if log.ddq is None:
@@ -545,7 +548,7 @@ def residual_tilt(
         spring = np.zeros_like(tau)
         spring[:, named] = log.q[:, named] * springs.stiffness[named]
         tau, error = tau - spring, error - spring
-    return gravity_tilt(model.robot, log.q, error, noise, tau, columns)
+    return gravity_tilt(model.description, log.q, error, noise, tau, columns)
 
 
 def residual_springs(
@@ -558,10 +561,11 @@ def residual_springs(
     (:func:`~dynid.identification.residual_spring.residual_spring`; ``noise`` (n,) [N m]
     each joint's): the measured torques fitted with the identified model's own columns,
     each joint's viscous, Coulomb, offset and rotor-inertia columns, a tilt of the gravity
-    vector's (:func:`~dynid.identification.gravity_tilt.tilt_columns`: a tilted base is no
-    spring) and a spring per joint; the residual a spring must explain that of ``judged``
-    (a held-out time block of ``v``'s log; default ``v``). A joint whose residual over
-    ``v`` follows its velocity more than its position is named no spring
+    vector's (:func:`~dynid.identification.gravity_tilt.tilt_columns` of the description's
+    links: a tilted base is no spring) and a spring per joint; the residual a spring must
+    explain that of ``judged`` (a held-out time block of ``v``'s log; default ``v``). A
+    joint whose residual over ``v`` follows its velocity more than its position is named
+    no spring
     (:func:`~dynid.identification.residual_dependence.judged_springs`), judged over
     ``v``'s whole log: over a short time block the positions and velocities follow each
     other (a 20 N m/rad spring's residual over a Panda log's last 1.1 s followed both
@@ -575,7 +579,7 @@ def residual_springs(
         return None
 
     def columns(rows: NDArray[np.intp]) -> NDArray[np.float64]:
-        return np.concatenate([beside(rows), tilt_columns(model.robot, log.q[rows])], axis=-1)
+        return np.concatenate([beside(rows), tilt_columns(model.description, log.q[rows])], axis=-1)
 
     seen = v if judged is None else judged
     found = residual_spring(log.q, log.tau, seen.log.tau - seen.tau_hat, noise, columns)
