@@ -458,3 +458,38 @@ def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_ba
     assert col["collision --no-uncertainty (fixed, not applied here) [N m]"] == [
         number(x) for x in doc["collision"]
     ]
+
+
+def test_the_friction_recipe_carries_the_robot_and_log_options_given():
+    """Regression: the command the no-friction note prints left out the user's --tip (a
+    UR5 URDF with several leaves then failed, "pass --tip"); parsed by dynid friction's own
+    parser it holds every robot and log option observe was given, as given."""
+    import shlex
+
+    from dynid.cli.__main__ import build_parser
+    from dynid.cli.observe import _friction_recipe
+
+    parser = build_parser()
+    given = ["observe", "--params", "my arm.urdf", "--base", "base_link", "--tip", "tool0"]
+    given += ["--snap-angles", "--drive", "d.toml", "--columns", "tau=effort{i}"]
+    given += ["--units", "q=deg", "--q-start", "0.5,-1", "--max-gap", "0.05"]
+    given += ["--torque-delay", "3", "--drop-invalid", "--calibrate", "--data", "free"]
+    recipe = _friction_recipe(parser.parse_args([*given, "--out", "o"]))
+    command = recipe.removeprefix(" (").split(";")[0]
+    words = shlex.split(command)
+    assert words[:2] == ["dynid", "friction"]
+    fr = parser.parse_args(words[1:])
+    assert (fr.robot, fr.base, fr.tip, fr.snap_angles) == (
+        "my arm.urdf",
+        "base_link",
+        "tool0",
+        True,
+    )
+    assert (str(fr.drive), fr.columns, fr.units) == ("d.toml", "tau=effort{i}", "q=deg")
+    assert fr.q_start == (0.5, -1.0) and fr.max_gap == 0.05 and fr.drop_invalid
+    assert fr.torque_delay == pytest.approx(3e-3) and [str(d) for d in fr.data] == ["free"]
+    model = ["observe", "--model", "id.json", "--calibrate", "--data", "a.csv", "--out", "o"]
+    fr = parser.parse_args(
+        shlex.split(_friction_recipe(parser.parse_args(model))[2:].split(";")[0])[1:]
+    )
+    assert str(fr.model) == "id.json" and fr.robot is None and fr.tip is None
