@@ -493,3 +493,27 @@ def test_the_friction_recipe_carries_the_robot_and_log_options_given():
         shlex.split(_friction_recipe(parser.parse_args(model))[2:].split(";")[0])[1:]
     )
     assert str(fr.model) == "id.json" and fr.robot is None and fr.tip is None
+
+
+def test_a_detection_flagging_most_of_the_log_says_the_model_is_off(logs, tmp_path, capsys):
+    """Regression: a model 3 N m of Coulomb friction off the arm's (thresholds of the
+    exact model) raised events over most of the log with no word that this is the
+    model's error; now a note says what share the events cover and to check the model."""
+    from dynid import panda
+    from dynid.friction.model import ClassicalFriction
+    from dynid.io.robot.toml import save_toml
+
+    wrong = ClassicalFriction(np.zeros(7), np.full(7, 3.0), np.zeros(7))
+    save_toml(tmp_path / "off.toml", panda().with_friction(wrong))
+    p = ["observe", "--no-figures", "--data", str(logs / "free.csv")]
+    assert main([*p, "--params", "panda", "--calibrate", "--out", str(tmp_path / "c")]) == 0
+    th = ["--thresholds", str(tmp_path / "c" / "thresholds.json")]
+    capsys.readouterr()
+    assert (
+        main([*p, "--params", str(tmp_path / "off.toml"), *th, "--out", str(tmp_path / "d")]) == 0
+    )
+    doc = json.loads((tmp_path / "d" / "events.json").read_text())
+    share = 100.0 * sum(doc["flagged_s"]) / sum(doc["duration_s"])
+    (line,) = [x for x in capsys.readouterr().err.splitlines() if "events cover" in x]
+    assert share > 50.0 and f"events cover {share:.3g} % of the logs" in line
+    assert "the model's error" in line and "dynid validate" in line
