@@ -110,7 +110,7 @@ def _joint_table(doc: dict, cal: dict) -> str:
             "collision --no-uncertainty (fixed, not applied here) [N m]",
             doc.get("collision") if fixed else None,
         ),
-        ("largest |r| read [N m]", cal.get("peak")),
+        *_read_columns(doc, cal),
     ]
     columns = [(h, v) for h, v in given if isinstance(v, list) and _numbers(v)]
     n = len(columns[0][1])
@@ -121,6 +121,28 @@ def _joint_table(doc: dict, cal: dict) -> str:
         [esc(names[j])] + [number(v[j]) if j < len(v) else "" for _, v in columns] for j in range(n)
     ]
     return table(["joint", *(h for h, _ in columns)], rows, cls="calibration")
+
+
+def _read_columns(doc: dict, cal: dict) -> list[tuple[str, Any]]:
+    """The residual the calibration read per joint, as the summary names it: the ``|r|``
+    (or its quantile) the rule read past the standstill margin, ``contact / margin`` of
+    the file's rule; and the largest ``|r|`` (``peak``), where the margin applied named as
+    the raw one, with the margin on (a joint at rest reads it over its threshold's
+    base, and raises no alarm for it)."""
+    rule = doc.get("rule") if isinstance(doc.get("rule"), dict) else {}
+    contact, margin, q = doc.get("contact"), rule.get("margin"), rule.get("quantile", 1.0)
+    still = bool(rule.get("standstill_margin", False))
+    out: list[tuple[str, Any]] = []
+    if _numbers(contact) and is_number(margin) and margin > 0 and is_number(q):
+        read = "|r| read" if q == 1.0 else f"|r| quantile {q:g}"
+        read += " past the standstill margin" if still else ""
+        out.append(
+            (f"{read} (the contact level is {margin:g} x it) [N m]", [c / margin for c in contact])
+        )
+    raw = "largest raw |r|, standstill margin not taken off [N m]" if still else "largest |r| [N m]"
+    if still or q != 1.0 or not out:  # else the one read is the raw largest
+        out.append((raw, cal.get("peak")))
+    return out
 
 
 def _flagged(doc: Any) -> str:
