@@ -517,3 +517,46 @@ def test_a_detection_flagging_most_of_the_log_says_the_model_is_off(logs, tmp_pa
     (line,) = [x for x in capsys.readouterr().err.splitlines() if "events cover" in x]
     assert share > 50.0 and f"events cover {share:.3g} % of the logs" in line
     assert "the model's error" in line and "dynid validate" in line
+
+
+def test_a_wrench_damped_near_a_singular_configuration_is_said_per_event(tmp_path, capsys):
+    """Regression: with --frame, a push near the stretched-elbow singularity had its
+    wrench damped on most samples and only the CSV's damped column said so. Two pushes on
+    a simulated Panda whose elbow stretches (q4 = -0.1) then bends (q4 = -1.2): the first
+    event's share of damped samples, equal to the residual table's damped column over its
+    span, is said in the summary, events.json and the report; the second's is 0."""
+    from dynid.io.excitation import save_trajectory_csv
+    from dynid.simulation.trajectories import Trajectory
+
+    t = np.arange(0.0, 2.0, 1e-3)
+    w = np.pi
+    q = np.tile([0.0, 0.3, 0.0, 0.0, 0.0, 1.5, 0.8], (t.size, 1))
+    dq, ddq = np.zeros_like(q), np.zeros_like(q)
+    for j, a, c in ((0, 0.3, 0.0), (3, 0.55, -0.65)):  # joint 1 sways, the elbow bends
+        q[:, j] = c + a * np.sin(w * t + (np.pi / 2 if j == 3 else 0.0))
+        dq[:, j] = a * w * np.cos(w * t + (np.pi / 2 if j == 3 else 0.0))
+        ddq[:, j] = -a * w * w * np.sin(w * t + (np.pi / 2 if j == 3 else 0.0))
+    save_trajectory_csv(tmp_path / "traj.csv", Trajectory(t, q, dq, ddq))
+    sim = ["simulate", "--robot", "panda", "--trajectory", str(tmp_path / "traj.csv"), "-q"]
+    assert main([*sim, "--seed", "1", "--out", str(tmp_path / "free.csv")]) == 0
+    hit = ["--contact", "flange:0,0,-15:0.1,0.35", "--contact", "flange:0,0,-15:0.9,1.15"]
+    assert main([*sim, "--seed", "2", *hit, "--out", str(tmp_path / "hit.csv")]) == 0
+    p = ["observe", "--params", "panda", "--no-figures"]
+    cal = ["--data", str(tmp_path / "free.csv"), "--calibrate", "-q"]
+    assert main([*p, *cal, "--out", str(tmp_path / "cal")]) == 0
+    th = ["--thresholds", str(tmp_path / "cal" / "thresholds.json"), "--frame", "flange"]
+    capsys.readouterr()
+    assert main([*p, *th, "--data", str(tmp_path / "hit.csv"), "--out", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    events = json.loads((tmp_path / "o" / "events.json").read_text())["events"]
+    table = np.loadtxt(tmp_path / "o" / "residuals.csv", delimiter=",", comments="#", skiprows=3)
+    assert len(events) == 2
+    for e in events:
+        span = (table[:, 0] >= e["start"]) & (table[:, 0] <= e["end"])
+        assert e["damped_share"] == pytest.approx(np.mean(table[span, -1]), abs=1e-12)
+    first, second = (e["damped_share"] for e in events)
+    assert first > 0.5 and second == 0.0
+    assert f"wrench damped on {100 * first:.3g} %" in out and out.count("damped on") == 1
+    assert "the wrench there is unreliable" in out
+    page = html.unescape((tmp_path / "o" / "report.html").read_text())
+    assert f"event 1 {100 * first:.3g} %" in page and "the wrench there is unreliable" in page

@@ -117,6 +117,11 @@ class LogObservation:
         :data:`~dynid.observer.events.MAX_DROPPED`), when detecting.
     dropped_count : int
         Every such crossing.
+    damped : tuple of float or None
+        Of a detection with a wrench estimated at a frame: the share (0 to 1) of each
+        event's samples where the estimate was damped (near a singular configuration of
+        the joints that move the frame: the wrench there is unreliable), in the order of
+        ``events``; None: no wrench estimated.
     """
 
     path: Path
@@ -137,6 +142,7 @@ class LogObservation:
     score: ContactScore | None = None
     dropped: tuple[DroppedCrossing, ...] = ()
     dropped_count: int = 0
+    damped: tuple[float, ...] | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:

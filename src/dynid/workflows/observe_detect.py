@@ -55,6 +55,7 @@ __all__ = [
     "ResidualSink",
     "contact_labels",
     "counted_events",
+    "damped_shares",
     "detected_log",
     "observed_wrench",
     "scored",
@@ -198,6 +199,7 @@ def detected_log(
     strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
+    damped = None if frame is None else np.zeros(log.t.shape[0], dtype=bool)
     seen = model.friction
     if unmodelled is not None:
         unmodelled.new_log()
@@ -210,6 +212,8 @@ def detected_log(
             w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame, kind)
             if put is not None:
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
+            if w is not None and damped is not None:
+                damped[a:b] = w.damped
             if w is not None and keep is not None:
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
@@ -245,7 +249,21 @@ def detected_log(
         score=scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived),
         dropped=det.dropped,
         dropped_count=det.dropped_count,
+        damped=None if damped is None else damped_shares(log.t, events, damped),
     )
+
+
+def damped_shares(
+    t: NDArray, events: Sequence[ContactEvent], damped: NDArray[np.bool_]
+) -> tuple[float, ...]:
+    """The share (0 to 1) of each event's samples, ``start`` to ``end`` [s] of the log's
+    times ``t`` (N,), where the wrench estimate was ``damped`` (N,) (near a singular
+    configuration: unreliable there)."""
+    out = []
+    for e in events:
+        a, b = np.searchsorted(t, e.start, "left"), np.searchsorted(t, e.end, "right")
+        out.append(float(np.mean(damped[a:b])) if b > a else 0.0)
+    return tuple(out)
 
 
 def counted_events(
