@@ -205,7 +205,9 @@ def test_the_report_shows_the_residual_read_as_the_summary_does(free, tmp_path, 
     table = page[page.index('class="calibration"') :]
     table = table[: table.index("</table>")]
     heads = re.findall(r"<th>([^<]*)</th>", table)
-    k = heads.index("|r| read past the standstill margin (the contact level is 1.5 x it) [N m]")
+    k = heads.index(
+        "|r| read past the standstill margin (the fixed contact level is 1.5 x it) [N m]"
+    )
     assert "largest raw |r|, standstill margin not taken off [N m]" in heads
     rows = re.findall(r"<tr>(.*?)</tr>", table, flags=re.S)[1:]
     cells = [re.findall(r"<td>([^<]*)</td>", r)[k] for r in rows]

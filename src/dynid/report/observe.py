@@ -139,7 +139,7 @@ def _read_columns(doc: dict, cal: dict) -> list[tuple[str, Any]]:
         read += " past the standstill margin" if still else ""
         out.append(
             (
-                f"{read} (the contact level is {margin:g} x it) [N m]",
+                f"{read} (the fixed contact level is {margin:g} x it) [N m]",
                 [c / margin for c in contact or ()],
             )
         )
