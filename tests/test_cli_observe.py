@@ -458,3 +458,105 @@ def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_ba
     assert col["collision --no-uncertainty (fixed, not applied here) [N m]"] == [
         number(x) for x in doc["collision"]
     ]
+
+
+def test_the_friction_recipe_carries_the_robot_and_log_options_given():
+    """Regression: the command the no-friction note prints left out the user's --tip (a
+    UR5 URDF with several leaves then failed, "pass --tip"); parsed by dynid friction's own
+    parser it holds every robot and log option observe was given, as given."""
+    import shlex
+
+    from dynid.cli.__main__ import build_parser
+    from dynid.cli.observe import _friction_recipe
+
+    parser = build_parser()
+    given = ["observe", "--params", "my arm.urdf", "--base", "base_link", "--tip", "tool0"]
+    given += ["--snap-angles", "--drive", "d.toml", "--columns", "tau=effort{i}"]
+    given += ["--units", "q=deg", "--q-start", "0.5,-1", "--max-gap", "0.05"]
+    given += ["--torque-delay", "3", "--drop-invalid", "--calibrate", "--data", "free"]
+    recipe = _friction_recipe(parser.parse_args([*given, "--out", "o"]))
+    command = recipe.removeprefix(" (").split(";")[0]
+    words = shlex.split(command)
+    assert words[:2] == ["dynid", "friction"]
+    fr = parser.parse_args(words[1:])
+    assert (fr.robot, fr.base, fr.tip, fr.snap_angles) == (
+        "my arm.urdf",
+        "base_link",
+        "tool0",
+        True,
+    )
+    assert (str(fr.drive), fr.columns, fr.units) == ("d.toml", "tau=effort{i}", "q=deg")
+    assert fr.q_start == (0.5, -1.0) and fr.max_gap == 0.05 and fr.drop_invalid
+    assert fr.torque_delay == pytest.approx(3e-3) and [str(d) for d in fr.data] == ["free"]
+    model = ["observe", "--model", "id.json", "--calibrate", "--data", "a.csv", "--out", "o"]
+    fr = parser.parse_args(
+        shlex.split(_friction_recipe(parser.parse_args(model))[2:].split(";")[0])[1:]
+    )
+    assert str(fr.model) == "id.json" and fr.robot is None and fr.tip is None
+
+
+def test_a_detection_flagging_most_of_the_log_says_the_model_is_off(logs, tmp_path, capsys):
+    """Regression: a model 3 N m of Coulomb friction off the arm's (thresholds of the
+    exact model) raised events over most of the log with no word that this is the
+    model's error; now a note says what share the events cover and to check the model."""
+    from dynid import panda
+    from dynid.friction.model import ClassicalFriction
+    from dynid.io.robot.toml import save_toml
+
+    wrong = ClassicalFriction(np.zeros(7), np.full(7, 3.0), np.zeros(7))
+    save_toml(tmp_path / "off.toml", panda().with_friction(wrong))
+    p = ["observe", "--no-figures", "--data", str(logs / "free.csv")]
+    assert main([*p, "--params", "panda", "--calibrate", "--out", str(tmp_path / "c")]) == 0
+    th = ["--thresholds", str(tmp_path / "c" / "thresholds.json")]
+    capsys.readouterr()
+    assert (
+        main([*p, "--params", str(tmp_path / "off.toml"), *th, "--out", str(tmp_path / "d")]) == 0
+    )
+    doc = json.loads((tmp_path / "d" / "events.json").read_text())
+    share = 100.0 * sum(doc["flagged_s"]) / sum(doc["duration_s"])
+    (line,) = [x for x in capsys.readouterr().err.splitlines() if "events cover" in x]
+    assert share > 50.0 and f"events cover {share:.3g} % of the logs" in line
+    assert "the model's error" in line and "dynid validate" in line
+
+
+def test_a_wrench_damped_near_a_singular_configuration_is_said_per_event(tmp_path, capsys):
+    """Regression: with --frame, a push near the stretched-elbow singularity had its
+    wrench damped on most samples and only the CSV's damped column said so. Two pushes on
+    a simulated Panda whose elbow stretches (q4 = -0.1) then bends (q4 = -1.2): the first
+    event's share of damped samples, equal to the residual table's damped column over its
+    span, is said in the summary, events.json and the report; the second's is 0."""
+    from dynid.io.excitation import save_trajectory_csv
+    from dynid.simulation.trajectories import Trajectory
+
+    t = np.arange(0.0, 2.0, 1e-3)
+    w = np.pi
+    q = np.tile([0.0, 0.3, 0.0, 0.0, 0.0, 1.5, 0.8], (t.size, 1))
+    dq, ddq = np.zeros_like(q), np.zeros_like(q)
+    for j, a, c in ((0, 0.3, 0.0), (3, 0.55, -0.65)):  # joint 1 sways, the elbow bends
+        q[:, j] = c + a * np.sin(w * t + (np.pi / 2 if j == 3 else 0.0))
+        dq[:, j] = a * w * np.cos(w * t + (np.pi / 2 if j == 3 else 0.0))
+        ddq[:, j] = -a * w * w * np.sin(w * t + (np.pi / 2 if j == 3 else 0.0))
+    save_trajectory_csv(tmp_path / "traj.csv", Trajectory(t, q, dq, ddq))
+    sim = ["simulate", "--robot", "panda", "--trajectory", str(tmp_path / "traj.csv"), "-q"]
+    assert main([*sim, "--seed", "1", "--out", str(tmp_path / "free.csv")]) == 0
+    hit = ["--contact", "flange:0,0,-15:0.1,0.35", "--contact", "flange:0,0,-15:0.9,1.15"]
+    assert main([*sim, "--seed", "2", *hit, "--out", str(tmp_path / "hit.csv")]) == 0
+    p = ["observe", "--params", "panda", "--no-figures"]
+    cal = ["--data", str(tmp_path / "free.csv"), "--calibrate", "-q"]
+    assert main([*p, *cal, "--out", str(tmp_path / "cal")]) == 0
+    th = ["--thresholds", str(tmp_path / "cal" / "thresholds.json"), "--frame", "flange"]
+    capsys.readouterr()
+    assert main([*p, *th, "--data", str(tmp_path / "hit.csv"), "--out", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    events = json.loads((tmp_path / "o" / "events.json").read_text())["events"]
+    table = np.loadtxt(tmp_path / "o" / "residuals.csv", delimiter=",", comments="#", skiprows=3)
+    assert len(events) == 2
+    for e in events:
+        span = (table[:, 0] >= e["start"]) & (table[:, 0] <= e["end"])
+        assert e["damped_share"] == pytest.approx(np.mean(table[span, -1]), abs=1e-12)
+    first, second = (e["damped_share"] for e in events)
+    assert first > 0.5 and second == 0.0
+    assert f"wrench damped on {100 * first:.3g} %" in out and out.count("damped on") == 1
+    assert "the wrench there is unreliable" in out
+    page = html.unescape((tmp_path / "o" / "report.html").read_text())
+    assert f"event 1 {100 * first:.3g} %" in page and "the wrench there is unreliable" in page

@@ -267,6 +267,39 @@ def test_labels_follow_the_log_past_rows_dropped_and_a_column_not_numbers(pushes
     assert "(tau_ext > 0.1 N m;" in captured.out and "3 labelled, 3 detected" in captured.out
 
 
+def test_true_torques_follow_the_log_past_rows_dropped(pushes, capsys):
+    """Rows dropped for NaN (--drop-invalid) in a log scored by its true torques: tau_ext
+    realigned with the rows kept by time, so the score and RMS r - tau_ext stay (they
+    vanished silently when the row counts differed)."""
+    from dynid.io.columns import load_joint_columns
+    from dynid.io.torque_log import load_torque_log
+
+    d = pushes
+    lines = (d / "hit.csv").read_text().splitlines()
+    for k in (500, 2700):  # rows at 0.497 and 2.697 s, outside the pushes: NaN tau1
+        cells = lines[k].split(",")
+        cells[15] = "nan"
+        lines[k] = ",".join(cells)
+    (d / "nan.csv").write_text("\n".join(lines))
+    p = ["observe", "--params", "panda", "--no-figures", "--drop-invalid", "--thresholds"]
+    p += [str(d / "cal" / "thresholds.json")]
+    assert main([*p, "--data", str(d / "nan.csv"), "--out", str(d / "nan")]) == 0
+    out = capsys.readouterr().out
+    assert "3 labelled, 3 detected, 0 missed; 0 false alarm(s)" in out
+    assert "RMS r - tau_ext" in out
+    score = json.loads((d / "nan" / "events.json").read_text())["score"]
+    assert (score["labelled"], score["detected"]) == (3, 3)
+    from dynid.workflows.observe_detect import _stored_rows
+
+    t = load_torque_log(d / "hit.csv").t
+    kept = np.delete(t, [497, 2697])  # the header's three lines before row 0
+    rows = _stored_rows(t, kept)
+    ext = load_joint_columns(d / "hit.csv", "tau_ext", 7)
+    assert rows is not None
+    np.testing.assert_array_equal(ext[rows], np.delete(ext, [497, 2697], axis=0))
+    assert _stored_rows(t, kept + 1e-4) is None
+
+
 def test_missed_labelled_contacts_carry_the_true_torques_peak_where_it_is_known():
     """Regression (a label column beside simulate --contact's true torques gave missed
     contacts a peak of null; a log with labelled contacts and no event failed on an empty

@@ -184,3 +184,31 @@ def test_the_badge_of_thresholds_on_a_poor_or_unusable_model_takes_its_article(
     )
     badge = re.search(r'<span class="level">([^<]*)</span>', page)
     assert badge is not None and badge[1] == f"thresholds calibrated on {said} model"
+
+
+def test_the_report_shows_the_residual_read_as_the_summary_does(free, tmp_path, capsys):
+    """Regression: the report's "largest |r| read" was the raw peak (a UR5 joint's 0.309
+    N m, inside the standstill margin, over its own contact level beside 0 false alarms)
+    while the summary's "|r| read past margin" said 0.096. The report now shows the
+    summary's column (contact / margin of thresholds.json, equal to its printed values)
+    and names the raw peak as such."""
+    path, _ = free
+    out = tmp_path / "cal"
+    capsys.readouterr()
+    assert main(["observe", "--params", "panda", "--data", str(path), "--calibrate",
+                 "--no-figures", "--out", str(out)]) == 0  # fmt: skip
+    printed = capsys.readouterr().out.splitlines()
+    th = json.loads((out / "thresholds.json").read_text())
+    read = [float(x.split()[1]) for x in printed if re.match(r"joint\d ", x)]
+    np.testing.assert_allclose(read, np.array(th["contact"]) / th["rule"]["margin"], rtol=1e-3)
+    page = html.unescape((out / "report.html").read_text())
+    table = page[page.index('class="calibration"') :]
+    table = table[: table.index("</table>")]
+    heads = re.findall(r"<th>([^<]*)</th>", table)
+    k = heads.index(
+        "|r| read past the standstill margin (the fixed contact level is 1.5 x it) [N m]"
+    )
+    assert "largest raw |r|, standstill margin not taken off [N m]" in heads
+    rows = re.findall(r"<tr>(.*?)</tr>", table, flags=re.S)[1:]
+    cells = [re.findall(r"<td>([^<]*)</td>", r)[k] for r in rows]
+    assert cells == [number(c / 1.5) for c in th["contact"]]

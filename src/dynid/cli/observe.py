@@ -106,6 +106,7 @@ Examples:
 from __future__ import annotations
 
 import argparse
+import shlex
 from pathlib import Path
 from typing import Any
 
@@ -292,9 +293,29 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
 def _friction_recipe(args: argparse.Namespace) -> str:
     """The command line that identifies this model's friction, after a note on a model
-    without friction that asks for it."""
+    without friction that asks for it: the robot and the logs as this run read them (the
+    URDF chain's --base, --tip and --snap-angles, the drive, the column map, the log
+    options and the torque delay given), so that it runs as printed."""
     if args.model is None and str(args.params).endswith(".json"):
         return ""  # a feasible.json: its friction comes from identify, with the links
-    source = f"--model {args.model}" if args.model is not None else f"--robot {args.params}"
-    data = " ".join(str(d) for d in args.data)
-    return f" (dynid friction {source} --data {data} --out fr; then --friction fr/friction.json)"
+    words = ["dynid", "friction"]
+    if args.model is not None:
+        words += ["--model", str(args.model)]
+    else:  # --base, --tip and --snap-angles read the URDF of --robot
+        words += ["--robot", str(args.params)]
+        words += [
+            x for f in ("base", "tip") if getattr(args, f) for x in (f"--{f}", getattr(args, f))
+        ]
+        words += ["--snap-angles"] if args.snap_angles else []
+    given = {
+        "--drive": args.drive,
+        "--columns": args.columns,
+        "--units": args.units,
+        "--q-start": None if args.q_start is None else ",".join(f"{v:g}" for v in args.q_start),
+        "--max-gap": None if args.max_gap is None else f"{args.max_gap:g}",
+        "--torque-delay": None if args.torque_delay is None else f"{1e3 * args.torque_delay:g}",
+    }
+    words += [x for flag, v in given.items() if v is not None for x in (flag, str(v))]
+    words += ["--drop-invalid"] if args.drop_invalid else []
+    words += ["--data", *(str(d) for d in args.data), "--out", "fr"]
+    return f" ({shlex.join(words)}; then --friction fr/friction.json)"

@@ -949,13 +949,25 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         width = max(map(len, labels))
         for label, x in zip(labels, result.logs, strict=True):
             rows.append(f"  {label:<{width}}  " + "  ".join(f"{v:8.4g}" for v in x.largest()))
-    events = [(label, e) for x, label in zip(result.logs, labels, strict=True) for e in x.events]
+    events = [
+        (label, e, None if x.damped is None else x.damped[k])
+        for x, label in zip(result.logs, labels, strict=True)
+        for k, e in enumerate(x.events)
+    ]
     rows.append(f"{len(events)} event(s), {flagged_words(*result.flagged())}")
-    for log, e in events:
+    for log, e, damped in events:
         top = max(e.joints, key=lambda j: abs(e.peak[j - 1]))
         rows.append(
             f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
             f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
+            + (f"  {result.wrench.noun} damped on {100.0 * damped:.3g} %" if damped else "")
+        )
+    if any(d for *_, d in events):
+        rows.append(
+            f"damped: the share of the event's samples where the {result.wrench.noun} at "
+            f"{result.frame} was estimated near a singular configuration of the joints "
+            f"that move it (damped least squares): the {result.wrench.noun} there is "
+            "unreliable (the residual, and the detection, are not)"
         )
     rows += _dropped_lines(result, labels, names)
     rows += _score_lines(result, labels)

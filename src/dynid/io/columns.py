@@ -73,6 +73,7 @@ __all__ = [
     "load_mapped_torque_log",
     "load_joint_columns",
     "load_label_column",
+    "load_time_column",
 ]
 
 _DEFAULT = {
@@ -729,6 +730,27 @@ def load_joint_columns(path: str | Path, name: str, n: int) -> NDArray[np.float6
             return None
         raise
     return _vector(table, cmap, "tau", n)
+
+
+def load_time_column(path: str | Path) -> NDArray[np.float64] | None:
+    """The times ``t`` [s] (N,) of a log's rows as stored (NaN kept, no row dropped), the
+    column (CSV) or array (NPZ) ``t``, or None when the file has none: what aligns a signal
+    kept beside the log (:func:`load_joint_columns`) with the rows a reader kept.
+
+    Raises
+    ------
+    DataError
+        A malformed file.
+    """
+    try:
+        table = _read_table(Path(path), ColumnMap({"t": "t"}), ("t",))
+    except DataError as exc:
+        if "no column the map names" in str(exc):
+            return None
+        raise
+    if "t" not in table.columns:
+        return None
+    return np.asarray(table.columns["t"], dtype=np.float64).reshape(-1)
 
 
 def load_label_column(

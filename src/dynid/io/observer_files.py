@@ -46,7 +46,9 @@ joint, ``rule`` (``isolated`` or ``short``) and ``log``.
 ``damped`` (1 near a singular configuration of the joints that move the frame); the
 units line says what was estimated there: the wrench, or the force of a point contact
 (``--wrench force``: ``mx, my, mz`` written 0). ``events.json`` then says it too
-(``wrench``: the frame, the estimate and the components determined).
+(``wrench``: the frame, the estimate and the components determined), and each event its
+``damped_share`` (0 to 1: the share of its samples where the estimate was damped, near a
+singular configuration, where the wrench is unreliable).
 """
 
 from __future__ import annotations
@@ -244,6 +246,7 @@ EVENTS = Format(
                         "peak": Field("numbers", required=True, shape=(None,), unit=_NM),
                         "level": Field("string", required=True, choices=("contact", "collision")),
                         "log": Field("string"),
+                        "damped_share": Field("number", low=0.0, high=1.0),
                     }
                 ),
             ),
@@ -352,10 +355,13 @@ def save_events(
     meta: dict[str, Any] | None = None,
     logs: Sequence[str] | None = None,
     joints: Sequence[str] | None = None,
+    damped: Sequence[float] | None = None,
 ) -> Path:
     """Write ``events.json`` (schema ``dynid-events/1``; ``logs``: each event's log name,
     written as its ``log``; ``joints``: the model's joint names, written beside the
-    model's and each event's 1-based joints); returns the path."""
+    model's and each event's 1-based joints; ``damped``: each event's share of samples
+    where the wrench estimate was damped, written as its ``damped_share``); returns the
+    path."""
     doc = {
         "dynid_version": __version__,
         **({} if joints is None else {"joints": list(joints)}),
@@ -368,6 +374,7 @@ def save_events(
                 "peak": list(e.peak),
                 "level": e.level,
                 **({} if logs is None else {"log": logs[k]}),
+                **({} if damped is None else {"damped_share": damped[k]}),
             }
             for k, e in enumerate(events)
         ],
@@ -591,9 +598,12 @@ def save_observation(
             )  # fmt: skip
         )
     labels = log_labels([x.path for x in result.logs])
+    shares: list[float] | None = None if result.frame is None else []
     for x, label in zip(result.logs, labels, strict=True):
         events += x.events
         logs_of += [label] * len(x.events)
+        if shares is not None:
+            shares += x.damped if x.damped is not None else [0.0] * len(x.events)
     info = {
         "data": labels,
         "samples": [int(x.t.shape[0]) for x in result.logs],
@@ -607,7 +617,9 @@ def save_observation(
     }
     paths.insert(
         0,
-        save_events(out / "events.json", events, meta=info, logs=logs_of, joints=joints),
+        save_events(
+            out / "events.json", events, meta=info, logs=logs_of, joints=joints, damped=shares
+        ),
     )
     return paths
 

@@ -22,10 +22,11 @@ from .gain_noise import GainNoise
 from .model import ObserverModel
 from .scoring import ContactScore, combined
 from .thresholds import ModelFingerprint
-from .unmodelled import UnmodelledFriction, no_friction_note
+from .unmodelled import MOST_FLAGGED, UnmodelledFriction, no_friction_note
 from .wrench import FULL, WrenchEstimate, WrenchKind, underdetermined_note
 
 __all__ = [
+    "MOST_FLAGGED_TIME",
     "NO_FRICTION",
     "FigureSeries",
     "LogObservation",
@@ -116,6 +117,11 @@ class LogObservation:
         :data:`~dynid.observer.events.MAX_DROPPED`), when detecting.
     dropped_count : int
         Every such crossing.
+    damped : tuple of float or None
+        Of a detection with a wrench estimated at a frame: the share (0 to 1) of each
+        event's samples where the estimate was damped (near a singular configuration of
+        the joints that move the frame: the wrench there is unreliable), in the order of
+        ``events``; None: no wrench estimated.
     """
 
     path: Path
@@ -136,6 +142,7 @@ class LogObservation:
     score: ContactScore | None = None
     dropped: tuple[DroppedCrossing, ...] = ()
     dropped_count: int = 0
+    damped: tuple[float, ...] | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -264,6 +271,10 @@ class ObserveResult:
                 own = robot_friction_note(self.friction_source, self.model.friction)
             banded = banding_note(self.model.friction, [x.friction for x in self.logs])
             out += tuple(x for x in (own, banded) if x is not None)
+        u = self.unmodelled  # its note says the same of a model without friction
+        said = u is not None and u.overall is not None and u.flagged_share() > MOST_FLAGGED
+        if not said and (flagged := self.mostly_flagged_note()) is not None:
+            out += (flagged,)
         if (
             self.frame is not None
             and (note := underdetermined_note(self.model.robot, self.frame, self.wrench))
@@ -272,6 +283,26 @@ class ObserveResult:
             out += (note,)
         return out
 
+    def mostly_flagged_note(self) -> str | None:
+        """Of a detection whose events cover more than half of the logs
+        (:data:`MOST_FLAGGED_TIME`): a residual over the contact threshold through most of
+        the motion is the model's error, not contacts; None otherwise (a calibration)."""
+        if self.min_duration_s is None:
+            return None
+        flagged, logged = self.flagged()
+        if not (logged > 0 and flagged > MOST_FLAGGED_TIME * logged):
+            return None
+        return (
+            f"events cover {100.0 * flagged / logged:.3g} % of the logs: a residual over "
+            "the contact threshold through most of the motion is the model's error (friction "
+            "or other terms it misses, or thresholds calibrated with another model), not "
+            "contacts; check the model on a collision-free log with dynid validate"
+        )
+
+
+#: Share of the logs' duration that events may cover before the notes call it the
+#: model's error rather than contacts (:meth:`ObserveResult.mostly_flagged_note`).
+MOST_FLAGGED_TIME = 0.5
 
 #: How the note of a model that holds no friction begins (:attr:`ObserveResult.notes`).
 NO_FRICTION = "the model holds no friction"

@@ -19,13 +19,17 @@ to the external torque estimate while the joint moves. It is *seen* where the pa
 :data:`CHI2_SEEN`, the covariance scaled for the residual's serial correlation: the
 samples within ``2 / K_O`` of each other count once). Where it is not seen, the size
 still bounds what the data could hide: :attr:`UnmodelledFriction.bound` (the size plus
-three standard errors).
+three standard errors). A detection reads only the samples under the contact threshold;
+where those are a minority of the samples at speed (:data:`MOST_FLAGGED`), they say
+nothing of the friction (a residual over the threshold through most of the motion is
+itself the sign of a model that misses terms), and the same fit over every sample at
+speed, contacts included, is what the note gives (:attr:`UnmodelledFriction.overall`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,6 +38,7 @@ from ..identification.velocity_noise import velocity_noise_std
 
 __all__ = [
     "CHI2_SEEN",
+    "MOST_FLAGGED",
     "SETTLE",
     "SPEED",
     "FrictionTally",
@@ -54,6 +59,9 @@ CHI2_SEEN = 13.82
 ONE_WAY = 0.95
 #: Samples per joint at speed below which nothing is said of it.
 MIN_SAMPLES = 50
+#: Share of the samples at speed over the contact threshold (left out of the fit) above
+#: which the samples under it cannot judge the friction a model misses.
+MOST_FLAGGED = 0.5
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,6 +81,12 @@ class UnmodelledFriction:
         The friction stands out of the noise (module docstring).
     samples : ndarray of int, shape (n,)
         Samples read at speed.
+    at_speed : ndarray of int, shape (n,), or None
+        Samples at speed, those over the contact threshold (not read) included (None:
+        every sample at speed read).
+    overall : UnmodelledFriction or None
+        The same fit over every sample at speed, those over the threshold included (None:
+        none left out).
     """
 
     coulomb: NDArray[np.float64]
@@ -81,6 +95,15 @@ class UnmodelledFriction:
     se: NDArray[np.float64]
     seen: NDArray[np.bool_]
     samples: NDArray[np.int64]
+    at_speed: NDArray[np.int64] | None = None
+    overall: UnmodelledFriction | None = None
+
+    def flagged_share(self) -> float:
+        """The share of the samples at speed (every joint's pooled) over the contact
+        threshold, left out of the fit (0: none)."""
+        if self.at_speed is None or not np.any(self.at_speed):
+            return 0.0
+        return 1.0 - float(np.sum(self.samples)) / float(np.sum(self.at_speed))
 
     @property
     def bound(self) -> NDArray[np.float64]:
@@ -115,8 +138,9 @@ class FrictionTally:
     def __post_init__(self) -> None:
         n = self.n
         self.gain = np.broadcast_to(np.asarray(self.gain, dtype=np.float64), (n,)).copy()
-        self._AtA, self._Atr = np.zeros((n, 3, 3)), np.zeros((n, 3))
-        self._rr, self._count, self._dt = np.zeros(n), np.zeros(n, dtype=np.int64), []
+        # [0]: the samples read (under the threshold), [1]: every sample at speed
+        self._AtA, self._Atr = np.zeros((2, n, 3, 3)), np.zeros((2, n, 3))
+        self._rr, self._count, self._dt = np.zeros((2, n)), np.zeros((2, n), dtype=np.int64), []
         self.new_log()
 
     def new_log(self) -> None:
@@ -141,14 +165,20 @@ class FrictionTally:
             since = self._since_change(T, s, j)
             use = ok & (np.abs(V[:, j]) > max(SPEED, 5.0 * sigma[j]))
             use &= since >= SETTLE / self.gain[j]
+            self._put(1, j, s, V[:, j], R[:, j], use)
             if keep is not None:
                 use &= np.asarray(keep)[:, j]
-            A = np.stack([-s[use], -V[use, j], np.ones(np.count_nonzero(use))], axis=1)
-            y = R[use, j]
-            self._AtA[j] += A.T @ A
-            self._Atr[j] += A.T @ y
-            self._rr[j] += y @ y
-            self._count[j] += y.shape[0]
+            self._put(0, j, s, V[:, j], R[:, j], use)
+
+    def _put(self, k: int, j: int, s: NDArray, v: NDArray, r: NDArray, use: NDArray) -> None:
+        """Joint ``j``'s samples ``use`` into the normal equations ``k`` (0: read, 1: all
+        at speed): velocity signs ``s``, velocities ``v`` and residual ``r``."""
+        A = np.stack([-s[use], -v[use], np.ones(np.count_nonzero(use))], axis=1)
+        y = r[use]
+        self._AtA[k, j] += A.T @ A
+        self._Atr[k, j] += A.T @ y
+        self._rr[k, j] += y @ y
+        self._count[k, j] += y.shape[0]
 
     def _since_change(self, T: NDArray, s: NDArray, j: int) -> NDArray[np.float64]:
         """Time [s] since the sign of joint ``j``'s velocity last changed, at each sample
@@ -165,22 +195,30 @@ class FrictionTally:
         return out
 
     def result(self) -> UnmodelledFriction | None:
-        """The fit of every block added (None before any sample at speed)."""
-        if not np.any(self._count):
+        """The fit of every block added (None before any sample at speed); with samples
+        over the threshold left out, the fit over all of them too (``overall``)."""
+        if not np.any(self._count[1]):
             return None
+        read = self._fit(0)
+        if np.array_equal(self._count[0], self._count[1]):
+            return read
+        return replace(read, at_speed=self._count[1].copy(), overall=self._fit(1))
+
+    def _fit(self, k: int) -> UnmodelledFriction:
+        """The fit of the normal equations ``k`` (0: samples read, 1: all at speed)."""
         n = self.n
         fc, fv, size, se = (np.full(n, np.nan) for _ in range(4))
         seen = np.zeros(n, dtype=bool)
         dt = float(np.median(self._dt)) if self._dt else 0.0
         for j in range(n):
-            N = int(self._count[j])
+            N = int(self._count[k, j])
             if N < MIN_SAMPLES:
                 continue
-            G, b = self._AtA[j], self._Atr[j]
+            G, b = self._AtA[k, j], self._Atr[k, j]
             if abs(G[0, 2]) > ONE_WAY * N:  # moved one way only: no offset told apart
                 G, b = G[:2, :2], b[:2]
             x = np.linalg.lstsq(G, b, rcond=None)[0]
-            s2 = max(float(self._rr[j] - x @ b), 0.0) / max(N - G.shape[0], 1)
+            s2 = max(float(self._rr[k, j] - x @ b), 0.0) / max(N - G.shape[0], 1)
             inflation = max(1.0, 2.0 / (self.gain[j] * dt)) if dt > 0 else 1.0
             cov = s2 * inflation * np.linalg.pinv(G)
             Gf, xf, cf = G[:2, :2] / N, x[:2], cov[:2, :2]
@@ -190,13 +228,16 @@ class FrictionTally:
             se[j] = np.sqrt(max(float(grad @ cf @ grad), 0.0))
             chi2 = float(xf @ np.linalg.lstsq(cf, xf, rcond=None)[0]) if s2 > 0 else np.inf
             seen[j] = chi2 > CHI2_SEEN
-        return UnmodelledFriction(fc, fv, size, se, seen, self._count.copy())
+        return UnmodelledFriction(fc, fv, size, se, seen, self._count[k].copy())
 
 
 def no_friction_note(found: UnmodelledFriction | None, names: Sequence[str]) -> str:
     """The note of a model that holds no friction: whether the logs' residual at speed
     shows friction it misses, how large per joint [N m], and what to do."""
     head = "the model holds no friction"
+    if found is not None and (o := found.overall) is not None:
+        if found.flagged_share() > MOST_FLAGGED and np.isfinite(o.size).any():
+            return _mostly_flagged_note(found, o, names)
     if found is None or not np.any(np.isfinite(found.size)):
         return (
             f"{head}, and the logs never move a joint fast enough to measure what it misses: "
@@ -209,7 +250,8 @@ def no_friction_note(found: UnmodelledFriction | None, names: Sequence[str]) -> 
         top = max(float(found.bound[j]) for j in read)
         return (
             f"{head}, and the logs' residual at speed shows none above its noise (at most "
-            f"{top:.2g} N m RMS on any joint): no friction to add"
+            f"{top:.2g} N m RMS on any joint, on {int(np.sum(found.samples))} samples at "
+            "speed): no friction to add"
         )
     seen = [j for j in read if found.seen[j]]
     sizes = ", ".join(f"{names[j]} {found.size[j]:.2g}" for j in seen)
@@ -221,4 +263,24 @@ def no_friction_note(found: UnmodelledFriction | None, names: Sequence[str]) -> 
         + ". It reads as an external torque whenever those joints move, and thresholds "
         "calibrated on it grow by as much (contacts that size go unseen): identify the "
         "friction (`dynid friction` on a collision-free log) and pass it with --friction"
+    )
+
+
+def _mostly_flagged_note(
+    found: UnmodelledFriction, overall: UnmodelledFriction, names: Sequence[str]
+) -> str:
+    """The note of a model without friction whose residual lies over the contact
+    threshold on most samples at speed: the samples under it cannot judge; the fit over
+    every sample at speed, contacts included, says how large what it misses reads."""
+    joints = [j for j in range(len(names)) if np.isfinite(overall.size[j])]
+    shown = [j for j in joints if overall.seen[j]] or joints
+    sizes = ", ".join(f"{names[j]} {overall.size[j]:.2g}" for j in shown)
+    return (
+        f"the model holds no friction, and its residual lies over the contact threshold on "
+        f"{100.0 * found.flagged_share():.3g} % of the samples at speed: too few under it "
+        "to judge the friction it misses. Over every sample at speed, contacts included, "
+        f"it reads {sizes} N m (RMS while the joint moves): the model likely misses the "
+        "arm's friction (or other terms), which reads as contact whenever a joint moves; "
+        "identify the friction (`dynid friction` on a collision-free log) and pass it "
+        "with --friction"
     )

@@ -110,7 +110,7 @@ def _joint_table(doc: dict, cal: dict) -> str:
             "collision --no-uncertainty (fixed, not applied here) [N m]",
             doc.get("collision") if fixed else None,
         ),
-        ("largest |r| read [N m]", cal.get("peak")),
+        *_read_columns(doc, cal),
     ]
     columns = [(h, v) for h, v in given if isinstance(v, list) and _numbers(v)]
     n = len(columns[0][1])
@@ -121,6 +121,32 @@ def _joint_table(doc: dict, cal: dict) -> str:
         [esc(names[j])] + [number(v[j]) if j < len(v) else "" for _, v in columns] for j in range(n)
     ]
     return table(["joint", *(h for h, _ in columns)], rows, cls="calibration")
+
+
+def _read_columns(doc: dict, cal: dict) -> list[tuple[str, Any]]:
+    """The residual the calibration read per joint, as the summary names it: the ``|r|``
+    (or its quantile) the rule read past the standstill margin, ``contact / margin`` of
+    the file's rule; and the largest ``|r|`` (``peak``), where the margin applied named as
+    the raw one, with the margin on (a joint at rest reads it over its threshold's
+    base, and raises no alarm for it)."""
+    got = doc.get("rule")
+    rule: dict = got if isinstance(got, dict) else {}
+    contact, margin, q = doc.get("contact"), rule.get("margin"), rule.get("quantile", 1.0)
+    still = bool(rule.get("standstill_margin", False))
+    out: list[tuple[str, Any]] = []
+    if _numbers(contact) and is_number(margin) and margin > 0 and is_number(q):
+        read = "|r| read" if q == 1.0 else f"|r| quantile {q:g}"
+        read += " past the standstill margin" if still else ""
+        out.append(
+            (
+                f"{read} (the fixed contact level is {margin:g} x it) [N m]",
+                [c / margin for c in contact or ()],
+            )
+        )
+    raw = "largest raw |r|, standstill margin not taken off [N m]" if still else "largest |r| [N m]"
+    if still or q != 1.0 or not out:  # else the one read is the raw largest
+        out.append((raw, cal.get("peak")))
+    return out
 
 
 def _flagged(doc: Any) -> str:
@@ -167,6 +193,29 @@ def _scored(doc: Any) -> str | None:
 
 #: Dropped crossings a report names at most (events.json holds more).
 DROPPED_SHOWN = 5
+
+
+def _damped(doc: Any) -> str | None:
+    """The events whose wrench estimate was damped (``damped_share`` of ``events.json``:
+    near a singular configuration, where the wrench is unreliable) as a fact (HTML), or
+    None where none was."""
+    events = _events(doc)
+    if not events or not isinstance(doc, dict):
+        return None
+    got = doc.get("wrench")
+    wrench: dict = got if isinstance(got, dict) else {}
+    shares = [(k, e.get("damped_share")) for k, e in enumerate(events, 1) if isinstance(e, dict)]
+    hit = [(k, v) for k, v in shares if is_number(v) and v > 0]
+    if not hit:
+        return None
+    noun = "force" if wrench.get("estimate") == "force" else "wrench"
+    said = ", ".join(f"event {k} {100.0 * v:.3g} %" for k, v in hit)
+    return (
+        f"<b>Damped {esc(noun)}</b>: the {esc(noun)} at {esc(str(wrench.get('frame', '?')))} "
+        f"was estimated near a singular configuration (damped least squares) on {esc(said)} "
+        f"of the event's samples: the {esc(noun)} there is unreliable (the residual and the "
+        "detection are not)"
+    )
 
 
 def _dropped(doc: Any) -> tuple[int, str | None]:
@@ -273,6 +322,8 @@ def answer(run: RunFiles) -> Answer | None:
         facts.append(said)
     if (scored := _scored(run.docs.get(found["events.json"] or ""))) is not None:
         facts.append(scored)
+    if (damped := _damped(run.docs.get(found["events.json"] or ""))) is not None:
+        facts.append(damped)
     if events is None and calibrated is not None and found["residuals.png"] is not None:
         facts.append("The residual over the calibration with its thresholds: the figure below")
     notes = _notes(run)

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
-from ..io.columns import ColumnMap, load_joint_columns, load_label_column
+from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
 from ..observer.events import ContactEvent, EventDetector
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
@@ -55,6 +55,7 @@ __all__ = [
     "ResidualSink",
     "contact_labels",
     "counted_events",
+    "damped_shares",
     "detected_log",
     "observed_wrench",
     "scored",
@@ -92,13 +93,43 @@ class ResidualSink(Protocol):
 
 def true_torques(prep: PreparedLog, model: ObserverModel, mapped: bool) -> NDArray | None:
     """The true external torques ``tau_ext`` (N, n) [N m] stored beside a log of dynid's
-    (``dynid simulate --contact``), or None (none, a log read through a column map, rows
-    dropped so that they no longer align)."""
-    path, N = prep.path, prep.log.t.shape[0]
+    (``dynid simulate --contact``), one per row of the cleaned log: rows dropped while
+    reading (``--drop-invalid``) are matched by their times, as the labels are
+    (:func:`contact_labels`); or None (none, a log read through a column map).
+
+    Warns
+    -----
+    DynidWarning
+        True torques whose times are not the log's: no score and no error against them.
+    """
+    path, log_t = prep.path, prep.log.t
     if mapped or path.suffix.lower() not in (".csv", ".npz"):
         return None
     ext = load_joint_columns(path, "tau_ext", model.n)
-    return None if ext is None or ext.shape[0] != N else ext
+    if ext is None or ext.shape[0] == log_t.shape[0]:
+        return ext
+    t = load_time_column(path)
+    rows = None if t is None or t.shape[0] != ext.shape[0] else _stored_rows(t, log_t)
+    if rows is None:
+        warnings.warn(
+            f"{path.name}: the true external torques tau_ext ({ext.shape[0]} rows) do not "
+            f"align with the {log_t.shape[0]} rows kept: no score and no RMS r - tau_ext "
+            "against them",
+            DynidWarning,
+            stacklevel=2,
+        )
+        return None
+    return ext[rows]
+
+
+def _stored_rows(t: NDArray, log_t: NDArray) -> NDArray[np.intp] | None:
+    """The rows of a file's times ``t`` (N0,) [s] as stored (NaN kept) at the cleaned
+    log's times ``log_t`` (N,) [s], or None where some time of the log is not stored."""
+    (ok,) = np.nonzero(np.isfinite(t))
+    if ok.size == 0:
+        return None
+    k = np.clip(np.searchsorted(t[ok], log_t), 0, ok.size - 1)
+    return ok[k] if np.array_equal(t[ok][k], log_t) else None
 
 
 def contact_labels(prep: PreparedLog, columns: ColumnMap | None) -> Labels | None:
@@ -119,15 +150,14 @@ def contact_labels(prep: PreparedLog, columns: ColumnMap | None) -> Labels | Non
     name, t, flags = found
     log_t = prep.log.t
     if t.shape != log_t.shape or not np.array_equal(t, log_t):
-        ok = np.isfinite(t)
-        t, flags = t[ok], flags[ok]
-        k = np.clip(np.searchsorted(t, log_t), 0, max(t.size - 1, 0))
-        if t.size == 0 or not np.array_equal(t[k], log_t):
+        rows = _stored_rows(t, log_t)
+        if rows is None:
+            ok = int(np.count_nonzero(np.isfinite(t)))
             raise DataError(
-                f"the times of label {name!r} are not the log's ({t.size} rows against "
+                f"the times of label {name!r} are not the log's ({ok} rows against "
                 f"{log_t.size}); hint: one label per row of the log"
             )
-        flags = flags[k]
+        flags = flags[rows]
     return Labels(f"column {name!r}", _checks.frozen(np.asarray(flags, dtype=np.float64)))
 
 
@@ -169,6 +199,7 @@ def detected_log(
     strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
+    damped = None if frame is None else np.zeros(log.t.shape[0], dtype=bool)
     seen = model.friction
     if unmodelled is not None:
         unmodelled.new_log()
@@ -181,6 +212,8 @@ def detected_log(
             w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame, kind)
             if put is not None:
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
+            if w is not None and damped is not None:
+                damped[a:b] = w.damped
             if w is not None and keep is not None:
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
@@ -216,7 +249,21 @@ def detected_log(
         score=scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived),
         dropped=det.dropped,
         dropped_count=det.dropped_count,
+        damped=None if damped is None else damped_shares(log.t, events, damped),
     )
+
+
+def damped_shares(
+    t: NDArray, events: Sequence[ContactEvent], damped: NDArray[np.bool_]
+) -> tuple[float, ...]:
+    """The share (0 to 1) of each event's samples, ``start`` to ``end`` [s] of the log's
+    times ``t`` (N,), where the wrench estimate was ``damped`` (N,) (near a singular
+    configuration: unreliable there)."""
+    out = []
+    for e in events:
+        a, b = np.searchsorted(t, e.start, "left"), np.searchsorted(t, e.end, "right")
+        out.append(float(np.mean(damped[a:b])) if b > a else 0.0)
+    return tuple(out)
 
 
 def counted_events(
