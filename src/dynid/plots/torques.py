@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..friction.validation import Validation
+from .layout import tight_layout
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -122,7 +123,7 @@ def plot_torque_validation(
     axes[-1, 1].set_xlabel("time from the log's start [s]")
     if title:
         fig.suptitle(title, fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
+    tight_layout(fig, rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
     return fig
 
 
