@@ -21,6 +21,7 @@ from ..feasibility.convex import ConsistentResult
 from ..feasibility.penalty import RetrievalResult
 from ..feasibility.result import FeasibleResult
 from ..friction.validation import NewtonEulerValidation
+from .layout import tight_layout
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -121,7 +122,7 @@ def plot_newton_euler_validation(
         )
         top = 0.93
     fig.suptitle(title or "Validation of the feasible parameters (Newton-Euler)", fontsize=10)
-    fig.tight_layout(rect=(0, 0, 1, top))
+    tight_layout(fig, rect=(0, 0, 1, top))
     return fig
 
 

@@ -13,6 +13,7 @@ import numpy as np
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.laws.base import Friction
 from ..friction.model import FrictionModel, FrictionSum
+from .layout import tight_layout
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -141,12 +142,12 @@ def plot_friction_fit(
     if n < nrows * ncols:
         spare = axes[-1, -1]
         spare.legend(handles, labels, loc="center", fontsize=9, markerscale=6, frameon=False)
-        fig.tight_layout(rect=(0, 0, 1, 0.97 if title else 1.0))
+        tight_layout(fig, rect=(0, 0, 1, 0.97 if title else 1.0))
     else:
         fig.legend(
             handles, labels, loc="lower center", ncol=len(labels), markerscale=6, frameon=False
         )
-        fig.tight_layout(rect=(0, 0.05, 1, 0.97 if title else 1.0))
+        tight_layout(fig, rect=(0, 0.05, 1, 0.97 if title else 1.0))
     if title:
         fig.suptitle(title, fontsize=11)
     return fig

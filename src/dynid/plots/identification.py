@@ -62,7 +62,7 @@ def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> 
         lo, hi = _histogram_range(e[:, j], s)
         inside = (e[:, j] >= lo) & (e[:, j] <= hi)
         ax.hist(e[inside, j], bins=40, range=(lo, hi), density=True, color=COLOURS["model"],
-                alpha=0.6, label="residual")  # fmt: skip
+                alpha=0.6, histtype="stepfilled", label="residual")  # fmt: skip
         ax.set_xlim(lo, hi)
         if s > 0:
             x = np.linspace(lo, hi, 200)

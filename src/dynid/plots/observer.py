@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..observer.detection import ContactEvent
+from .layout import tight_layout
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -100,5 +101,5 @@ def plot_residuals(
     top = 1.0 - 0.45 / fig.get_figheight()  # the legend above the axes, over no data
     fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=7,
                frameon=False, bbox_to_anchor=(0.5, top))  # fmt: skip
-    fig.tight_layout(rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
+    tight_layout(fig, rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
     return fig

@@ -13,6 +13,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..friction.validation import Validation
+from .envelope import envelope_indices
+from .layout import tight_layout
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -24,10 +26,6 @@ __all__ = ["plot_rms_comparison", "plot_torque_validation", "plot_validation_rms
 _MEASURED = dict(color=COLOURS["measured"], lw=0.6, label="measured")
 _NO_FRICTION = dict(color=COLOURS["no_friction"], lw=1.1, label="model, no friction")
 _FRICTION = dict(color=COLOURS["model"], lw=1.1, ls="--", label="model + friction")
-
-
-def _stride(N: int, max_points: int) -> slice:
-    return slice(None, None, max(1, int(np.ceil(N / max_points))))
 
 
 def _gaps(t: NDArray[np.float64]) -> NDArray[np.intp]:
@@ -43,7 +41,7 @@ def plot_torque_validation(
     validation: Validation,
     *,
     joint_names: Sequence[str] | None = None,
-    max_points: int = 5000,
+    max_points: int = 1600,
     title: str | None = None,
     fig: Figure | None = None,
     t0: float | None = None,
@@ -57,7 +55,10 @@ def plot_torque_validation(
     joint_names : sequence of str, optional
         Row labels (default ``joint 1 .. n``).
     max_points : int
-        Samples drawn per line (evenly strided; metrics use every sample).
+        Samples drawn per line, about: the smallest and the largest of each of
+        ``max_points / 2`` bins of consecutive samples (:mod:`dynid.plots.envelope`; every
+        spike stays, about two points per pixel column of the torque panels at 100 dpi),
+        every sample of a shorter log; metrics use every sample.
     title : str, optional
     fig : Figure, optional
         Drawn into (cleared first); a new figure by default.
@@ -83,31 +84,32 @@ def plot_torque_validation(
     else:
         fig.clear()
     axes = fig.subplots(n, 2, sharex=True, squeeze=False, gridspec_kw={"width_ratios": [3, 2]})
-    s = _stride(log.n_samples, max_points)
     start = float(log.t[0]) if t0 is None else float(t0)
-    t = np.asarray(log.t[s], dtype=np.float64) - start  # from the log's start
-    cut = _gaps(t)
+    time = np.asarray(log.t, dtype=np.float64) - start  # from the log's start
+    cut = _gaps(time)
     e0 = log.tau - validation.tau_model
     e1 = None if validation.tau_friction is None else e0 - validation.tau_friction
-    t = np.insert(t, cut, np.nan)  # the line is broken at a gap between pieces
 
-    def at(y: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.insert(y[s], cut, np.nan)
+    def at(y: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The times and values of ``y`` drawn: its envelope, broken at the gaps."""
+        k = envelope_indices(y, max_points // 2, breaks=cut)
+        broken = np.searchsorted(k, cut)  # a NaN where a piece ends
+        return np.insert(time[k], broken, np.nan), np.insert(y[k], broken, np.nan)
 
     added = validation.added  # offsets are not friction
     for j in range(n):
         ax, axe = axes[j]
-        ax.plot(t, at(log.tau[:, j]), **_MEASURED)
-        ax.plot(t, at(validation.tau_model[:, j]), **_NO_FRICTION | {"label": f"model, no {added}"})
+        ax.plot(*at(log.tau[:, j]), **_MEASURED)
+        ax.plot(*at(validation.tau_model[:, j]), **_NO_FRICTION | {"label": f"model, no {added}"})
         if e1 is not None:
-            ax.plot(t, at(validation.tau_hat[:, j]), **_FRICTION | {"label": f"model + {added}"})
+            ax.plot(*at(validation.tau_hat[:, j]), **_FRICTION | {"label": f"model + {added}"})
         ax.set_ylabel(f"{names[j]}\n[N m]")
         ax.grid(alpha=0.3)
         rms = f"RMS [N m]\nno {added} {validation.without_friction.rms[j]:.3f}"
-        axe.plot(t, at(e0[:, j]), color=_NO_FRICTION["color"], lw=0.8)
+        axe.plot(*at(e0[:, j]), color=_NO_FRICTION["color"], lw=0.8)
         if e1 is not None and validation.with_friction is not None:
             rms += f"\n+ {added} {validation.with_friction.rms[j]:.3f}"
-            axe.plot(t, at(e1[:, j]), color=_FRICTION["color"], lw=0.6, alpha=0.8)
+            axe.plot(*at(e1[:, j]), color=_FRICTION["color"], lw=0.6, alpha=0.8)
         axe.axhline(0.0, color="0.5", lw=0.6)
         axe.grid(alpha=0.3)
         axe.yaxis.set_label_position("right")  # beside the data, not over it
@@ -122,7 +124,7 @@ def plot_torque_validation(
     axes[-1, 1].set_xlabel("time from the log's start [s]")
     if title:
         fig.suptitle(title, fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
+    tight_layout(fig, rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))
     return fig
 
 
