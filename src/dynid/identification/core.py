@@ -27,6 +27,9 @@ from __future__ import annotations
 import dataclasses
 import logging
 import warnings
+from collections.abc import Hashable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Any
 
 import numpy as np
@@ -43,6 +46,7 @@ from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import HeldOut, cross_validate
 from .info import IdentificationInfo, Route
 from .least_squares import LeastSquaresFit, StdMethod, checked_std, conditioning_advice
+from .log_rows import _value_key
 from .model import IdentifiedModel, IdentifiedTerm
 from .serial import Serial
 from .stacking import (
@@ -71,6 +75,7 @@ __all__ = [
     "identify",
     "informative_blocks",
     "model_columns",
+    "shared_bases",
     "stack_dataset",
 ]
 
@@ -105,12 +110,58 @@ def model_columns(
         raise OptionError(f"model terms named {twice} twice; each term needs its own name")
     p = 10 * robot.n + sum(len(t.labels) for t in terms if t.in_base)
     if base is None:
-        base = base_parameters(robot, kind=data.regressor_kind, rtol=rtol, terms=terms)
+        base = _structural_base(robot, data.regressor_kind, rtol, terms)
     elif base.n_std != p:
         raise ShapeError(
             f"base was built for {base.n_std} standard parameters; robot {robot.name!r} has {p}"
         )
     return ModelColumns(base=base, terms=tuple(terms), drive=drive)
+
+
+#: The base parameters :func:`model_columns` computed while :func:`shared_bases` is
+#: active: key -> (the robot, the base parameters).
+_BASES: ContextVar[dict[Hashable, tuple[Robot, BaseParameters]] | None] = ContextVar(
+    "_BASES", default=None
+)
+
+
+@contextmanager
+def shared_bases() -> Iterator[None]:
+    """Within the block, the structural base parameters of one robot, regressor kind, rank
+    tolerance and terms in the base are computed once by :func:`model_columns` and read
+    back by every later call (the candidate structures' regressors differ in their
+    friction, not in their base: 13 regressors of a Panda log, 2 bases); the same
+    numbers, each call its own arrays. Nested blocks share the outer one's; the bases are
+    dropped at its end."""
+    if _BASES.get() is not None:
+        yield
+        return
+    token = _BASES.set({})
+    try:
+        yield
+    finally:
+        _BASES.reset(token)
+
+
+def _structural_base(
+    robot: Robot, kind: RegressorKind, rtol: float | None, terms: tuple[ModelTerm, ...]
+) -> BaseParameters:
+    """:func:`~dynid.regressors.base.base_parameters` of ``robot`` (random states, seeded),
+    read from :func:`shared_bases` when it holds them."""
+    held = _BASES.get()
+    if held is None:
+        return base_parameters(robot, kind=kind, rtol=rtol, terms=terms)
+    try:  # what the base depends on: the robot (immutable), kind, rtol, terms in the base
+        extra = tuple((type(t).__qualname__, _value_key(t)) for t in terms if t.in_base)
+    except TypeError:  # a term that does not hash: computed each time
+        return base_parameters(robot, kind=kind, rtol=rtol, terms=terms)
+    key = (id(robot), kind, rtol, extra)
+    if key not in held or held[key][0] is not robot:
+        held[key] = (robot, base_parameters(robot, kind=kind, rtol=rtol, terms=terms))
+    b = held[key][1]
+    return dataclasses.replace(  # arrays of its own: a caller cannot change the held ones
+        b, independent=b.independent.copy(), dependent=b.dependent.copy(), K_d=b.K_d.copy()
+    )
 
 
 def fit_stack(

@@ -30,10 +30,10 @@ from .log_rows import log_blocks, still_columns, still_friction
 from .model_sign import opposite_sign
 from .prepare import (
     Preprocessing,
-    fine_states,
     grid_samples,
     measured_torques,
     prepare_log,
+    prepared_and_fine,
     resamples,
     trimmed_margins,
 )
@@ -272,15 +272,17 @@ def prepare_torque_log(
         decimate=k,
         torque_delay_s=torque_delay_s,
     )
-    prepared = prepare_log(jlog, prep)
     raw = stamps = None
     head = tail = fine = None
     start = 0
+    held = cutoff_hz is not None and k > 1  # the states the torques were filtered at
+    if held and grid_samples(jlog, prep) * (1 + 4 * n) * 8 <= MAX_FINE_BYTES:
+        prepared, fine, start = prepared_and_fine(jlog, prep)  # filtered once for both
+    else:
+        prepared = prepare_log(jlog, prep)
     if cutoff_hz is not None:  # the torques as measured at the same samples
         raw = measured_torques(jlog, prep)
-        if k > 1 and grid_samples(jlog, prep) * (1 + 4 * n) * 8 <= MAX_FINE_BYTES:
-            fine, start = fine_states(jlog, prep)  # the states the torques were filtered at
-        else:
+        if fine is None:
             head, tail = trimmed_margins(jlog, prep)
         stamps = jlog.t if resamples(jlog, prep) else None
     noise = velocity_noise_std(jlog.tau, jlog.t) if jlog.n_samples >= 3 else None

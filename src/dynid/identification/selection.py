@@ -74,7 +74,7 @@ from .candidates import (
     recording_oddness,
     without_recordings,
 )
-from .core import identify, model_columns
+from .core import identify, model_columns, shared_bases
 from .dissipation import (
     Violation,
     friction_columns,
@@ -228,6 +228,7 @@ def _lacks(c: Candidate, best: Candidate) -> dict[str, float]:
 
 
 @shared_steps()
+@shared_bases()
 def select_structure(
     robot: Robot,
     data: Recordings,

@@ -29,6 +29,7 @@ Rows are sample-major as everywhere (row ``k n + j`` of a stack is sample ``k``,
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
@@ -280,6 +281,18 @@ DISSIPATION_VMAX = 10.0
 _PART_UNIT |= {"viscous": "N m s/rad", "quadratic": "N m s^2/rad^2"}
 
 
+@functools.lru_cache(maxsize=256)
+def _friction_labels(
+    prefix: str, n: int, parts: tuple[str, ...], mask: tuple[bool, ...]
+) -> tuple[str, ...]:
+    """The labels of :attr:`LinearFriction.labels` (the structure search asks a term's
+    thousands of times): the parts per joint (motor), those of ``mask`` (empty: all)."""
+    every = [f"{prefix}{PART_LABELS[p]}{j + 1}" for j in range(n) for p in parts]
+    if not mask:
+        return tuple(every)
+    return tuple(lab for lab, h in zip(every, mask, strict=True) if h)
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class LinearFriction:
     """Friction linear in its coefficients, where the drive says (motors or joints).
@@ -375,10 +388,7 @@ class LinearFriction:
     @property
     def labels(self) -> tuple[str, ...]:
         """``fv1, fc1, fo1, fv2, ...`` (the parts held, per joint or motor)."""
-        every = [
-            f"{self.prefix}{PART_LABELS[p]}{j + 1}" for j in range(self.drive.n) for p in self.parts
-        ]
-        return tuple(lab for lab, h in zip(every, self._held, strict=True) if h)
+        return _friction_labels(self.prefix, self.drive.n, self.parts, self.mask)
 
     @property
     def units(self) -> tuple[str, ...]:
