@@ -92,9 +92,7 @@ def test_the_true_robot_over_two_recordings_with_gaps_is_at_the_noise_level(vali
     assert res.friction_source == "model" and res.files == ("rec1.csv", "rec2.csv")
 
 
-def test_the_validate_report_names_its_worst_joint_by_the_robots_name(
-    panda, validated, tmp_path
-):
+def test_the_validate_report_names_its_worst_joint_by_the_robots_name(panda, validated, tmp_path):
     """validation.json holds the robot's joint names, so that the page names the worst
     joint as the robot does (it said "Worst joint joint 1")."""
     from dynid.io.validation_json import save_validation_json
