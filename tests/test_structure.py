@@ -155,7 +155,7 @@ def test_exact_data_give_the_true_structure_at_round_off(panda):
     """Noise-free data with exact accelerations: the true structure (armature, viscous) is
     chosen and fits to round-off; the armature comes back as simulated."""
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
-    logs = recordings(panda, (21, 22), friction=fr, armature=ARMATURE, duration=4.0)
+    logs = recordings(panda, (21, 22), friction=fr, armature=ARMATURE, duration=3.0)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     assert model.info.selection["chosen"] == "links + armature + viscous"
     assert model.fit.relative_error_percent < 1e-7  # the final fit (QR)
