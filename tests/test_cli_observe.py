@@ -7,6 +7,7 @@ import html
 import json
 import logging
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -49,26 +50,63 @@ def logs(tmp_path_factory):
     return d
 
 
-def test_observe_calibrates_then_finds_both_simulated_contacts(logs, capsys):
+def _main_said(argv: list[str], spy: str | None = None) -> tuple[int, str, str, list]:
+    """``main(argv)``'s exit code, what it printed on stdout and stderr, and the results
+    the function ``spy`` (a dotted name the command calls) returned, for a module-scoped
+    fixture (capsys is the test's)."""
+    import contextlib
+    import io
+
+    out, err, seen = io.StringIO(), io.StringIO(), []
+    with contextlib.ExitStack() as stack:
+        if spy is not None:
+            module, name = spy.rsplit(".", 1)
+            real = getattr(__import__(module, fromlist=[name]), name)
+
+            def recorded(*a, **k):
+                seen.append(real(*a, **k))
+                return seen[-1]
+
+            stack.enter_context(pytest.MonkeyPatch.context()).setattr(spy, recorded)
+        stack.enter_context(contextlib.redirect_stdout(out))
+        stack.enter_context(contextlib.redirect_stderr(err))
+        code = main(argv)
+    return code, out.getvalue(), err.getvalue(), seen
+
+
+@pytest.fixture(scope="module")
+def calibrated(logs):
+    """The identified model calibrated on the free log with its figures (``cal``): what
+    it printed (the tests that read this calibration share one run)."""
+    model = ["--model", str(logs / "id" / "identification.json")]
+    cmd = ["observe", *model, "--data", str(logs / "free.csv"), "--calibrate"]
+    code, out, _, _ = _main_said([*cmd, "--out", str(logs / "cal")])
+    assert code == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def calibrated_without_velocities(logs):
+    """The identified model calibrated with its figures on the free log without its
+    velocity columns (``cal_q``): the exit code, what it printed on stdout and stderr and
+    the result of the observe_files call the command made (its series kept for the
+    figure)."""
+    _without_velocities(logs / "free.csv", logs / "free_q.csv")
+    model = logs / "id" / "identification.json"
+    cmd = ["observe", "--model", str(model), "--data", str(logs / "free_q.csv"), "--calibrate"]
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", ".*velocities derived", UserWarning)
+        said = _main_said([*cmd, "--out", str(logs / "cal_q")], "dynid.cli.observe.observe_files")
+    code, out, err, (result,) = said
+    return code, out, err, result
+
+
+def test_observe_calibrates_then_finds_both_simulated_contacts(logs, calibrated, capsys):
     """thresholds.json from the free log (with the model's uncertainty), then events.json
     (dynid-events/1) with the two contacts at their times, residuals.csv with the wrench at
     the flange, residuals.png, report.html."""
     d = logs
     model = ["--model", str(d / "id" / "identification.json")]
-    assert (
-        main(
-            [
-                "observe",
-                *model,
-                "--data",
-                str(d / "free.csv"),
-                "--calibrate",
-                "--out",
-                str(d / "cal"),
-            ]
-        )
-        == 0
-    )
     th = load_thresholds(d / "cal" / "thresholds.json")
     assert th.uses_uncertainty and th.n == 7 and np.all(th.collision == 2 * th.contact)
     out = d / "obs"
@@ -108,7 +146,7 @@ def test_observe_with_a_consistent_robot_raises_no_event_on_a_free_log(logs):
     assert json.loads((d / "obsp" / "events.json").read_text())["events"] == []
 
 
-def test_observe_refuses_thresholds_of_another_joint_count(logs, capsys):
+def test_observe_refuses_thresholds_of_another_joint_count(logs, calibrated, capsys):
     """Thresholds of 7 joints with a 7-joint model pass; edited to 6 joints they are refused
     with a message naming the file."""
     d = logs
@@ -275,23 +313,21 @@ def _without_velocities(src, dst, columns: int = 15) -> None:
 
 
 @pytest.mark.filterwarnings("ignore:.*velocities derived:UserWarning")
-def test_calibrating_on_a_log_without_velocities_draws_its_figure(logs, capsys):
+def test_calibrating_on_a_log_without_velocities_draws_its_figure(
+    logs, calibrated_without_velocities
+):
     """A log without velocity columns (the edges of its derived velocities not observed:
     NaN residual, NaN std) calibrated with an identified model's uncertainty and the
     figure: the command succeeds, writes thresholds.json and the figure, whose thresholds
     are NaN where the residual is (the std there was refused: exit 2, no file)."""
     from dynid.observer.thresholds import threshold_series
-    from dynid.workflows.observe import ObserveOptions, observe_files
 
-    _without_velocities(logs / "free.csv", logs / "free_q.csv")
-    model = logs / "id" / "identification.json"
+    code, _, err, result = calibrated_without_velocities
     out = logs / "cal_q"
-    cmd = ["observe", "--model", str(model), "--data", str(logs / "free_q.csv"), "--calibrate"]
-    assert main([*cmd, "--out", str(out)]) == 0
+    assert code == 0
     assert (out / "thresholds.json").exists() and (out / "residuals.png").stat().st_size > 10_000
-    assert "skipped" not in capsys.readouterr().err
-    opts = ObserveOptions(data=(logs / "free_q.csv",), model=model, calibrate=True)
-    x = observe_files(opts).logs[0]
+    assert "skipped" not in err
+    x = result.logs[0]  # the series the command computed (and drew)
     unseen = np.isnan(x.r).any(axis=1)
     assert unseen[0] and unseen[-1] and not unseen.all()
     th = load_thresholds(out / "thresholds.json")
@@ -338,7 +374,9 @@ def test_observe_says_when_the_model_holds_no_friction(logs, tmp_path, capsys):
     assert "no friction" not in capsys.readouterr().err
 
 
-def test_calibration_says_when_velocity_noise_times_the_gain_sets_the_thresholds(logs, capsys):
+def test_calibration_says_when_velocity_noise_times_the_gain_sets_the_thresholds(
+    logs, calibrated_without_velocities, capsys
+):
     """Regression: the docs said a larger --gain detects sooner, while on noisy velocities
     the thresholds grow with it (a Panda's joint 1: 0.72, 1.79, 5.6 N m at gains 20, 50,
     150). Calibrated at gains 20 and 100 on one free log, the joints the printout names
@@ -357,10 +395,8 @@ def test_calibration_says_when_velocity_noise_times_the_gain_sets_the_thresholds
     assert named[100] and set(named[20]) <= set(named[100]), named
     ratio = contact[100][named[100]] / contact[20][named[100]]
     assert np.all(ratio > 3.0), ratio  # in proportion to the gain (5) where noise sets it
-    _without_velocities(logs / "free.csv", logs / "free_q2.csv")
-    derived = ["observe", *model, "--data", str(logs / "free_q2.csv"), "--calibrate"]
-    assert main([*derived, "--out", str(logs / "cal_q2")]) == 0
-    assert "velocity noise x gain" not in capsys.readouterr().out
+    code, said_derived, _, _ = calibrated_without_velocities  # the same free log
+    assert code == 0 and "velocity noise x gain" not in said_derived
 
 
 def _answer(page: str) -> str:
@@ -414,20 +450,16 @@ def test_delays_of_derived_velocities_carry_their_caveat_beside_them(
     assert "zero-phase" not in line and "zero-phase" not in answer
 
 
-def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_base(logs, capsys):
+def test_the_calibration_gives_one_collision_level_while_moving_and_names_the_base(
+    logs, calibrated
+):
     """With the model's uncertainty the collision level while moving is collision_factor x
     (noise + k sigma_max), one number in thresholds.json, the printout and the report's
     table (not 2 x detectable there and the fixed collision elsewhere); the fixed levels
     beside it are named the base, without the uncertainty."""
     from dynid.report.html import number
 
-    d = logs
-    model = ["--model", str(d / "id" / "identification.json"), "--no-figures"]
-    capsys.readouterr()
-    out = d / "cal_levels"
-    assert main(["observe", *model, "--data", str(d / "free.csv"), "--calibrate",
-                 "--out", str(out)]) == 0  # fmt: skip
-    printed = capsys.readouterr().out
+    out, printed = logs / "cal", calibrated
     doc = json.loads((out / "thresholds.json").read_text())
     cal, rule, unc = doc["calibration"], doc["rule"], doc["uncertainty"]
     moving = np.array(unc["noise"]) + unc["k_sigma"] * np.array(cal["sigma_max"])

@@ -66,11 +66,21 @@ def files(panda, tmp_path_factory):
     return d
 
 
-def test_the_true_robot_over_two_recordings_with_gaps_is_at_the_noise_level(panda, files):
+@pytest.fixture(scope="module")
+def validated(panda, files):
+    """validate_files of the true robot on rec1 alone and on rec1 and rec2 (the tests that
+    read these validations share them)."""
+    return {
+        "rec1": validate_files(panda, files / "rec1.csv"),
+        "both": validate_files(panda, [files / "rec1.csv", files / "rec2.csv"]),
+    }
+
+
+def test_the_true_robot_over_two_recordings_with_gaps_is_at_the_noise_level(validated):
     """The true robot and friction over two recordings cut by gaps: every piece filtered
     on its own, the pooled RMS per joint is the sensor noise and each file says how many
     pieces and samples it gave."""
-    res = validate_files(panda, [files / "rec1.csv", files / "rec2.csv"])
+    res = validated["both"]
     val = res.validation
     np.testing.assert_allclose(val.errors.rms, NOISE, rtol=0.06)
     assert np.all(val.without_friction.rms > 2 * NOISE)  # the friction is there
@@ -82,13 +92,13 @@ def test_the_true_robot_over_two_recordings_with_gaps_is_at_the_noise_level(pand
     assert res.friction_source == "model" and res.files == ("rec1.csv", "rec2.csv")
 
 
-def test_the_validate_report_names_its_worst_joint_by_the_robots_name(panda, files, tmp_path):
+def test_the_validate_report_names_its_worst_joint_by_the_robots_name(panda, validated, tmp_path):
     """validation.json holds the robot's joint names, so that the page names the worst
     joint as the robot does (it said "Worst joint joint 1")."""
     from dynid.io.validation_json import save_validation_json
     from dynid.report import RunSummary, render_html_report
 
-    res = validate_files(panda, files / "rec1.csv")
+    res = validated["rec1"]
     assert res.metadata()["joint_names"] == list(panda.joint_names)
     p = save_validation_json(tmp_path / "validation.json", res.validation, **res.metadata())
     page = render_html_report(RunSummary(command="validate"), {p.name: p})
@@ -96,20 +106,20 @@ def test_the_validate_report_names_its_worst_joint_by_the_robots_name(panda, fil
     assert worst.split(":", 1)[0] in panda.joint_names
 
 
-def test_a_gap_bridged_across_ruins_what_the_pieces_keep(panda, files):
+def test_a_gap_bridged_across_ruins_what_the_pieces_keep(panda, files, validated):
     """The same recording with its 0.5 s gap bridged by interpolation (--max-gap 1): the
     filter and the derivatives run across the join and the error grows far above the
     noise; cut into pieces it stays at the noise."""
-    cut = validate_files(panda, files / "rec1.csv").validation
+    cut = validated["rec1"].validation
     bridged = validate_files(panda, files / "rec1.csv", ValidateOptions(max_gap_s=1.0))
     assert np.max(cut.errors.rms) < 1.1 * NOISE
     assert np.max(bridged.validation.errors.rms) > 3 * NOISE
 
 
-def test_pooled_errors_are_those_of_every_sample_together(panda, files):
+def test_pooled_errors_are_those_of_every_sample_together(validated):
     """Closed form: the pooled RMS per joint and relative error equal those computed over
     the concatenated per-sample errors of every piece; each recording's over its own."""
-    val = validate_files(panda, [files / "rec1.csv", files / "rec2.csv"]).validation
+    val = validated["both"].validation
     E = np.concatenate([v.log.tau - v.tau_hat for v in val.parts])
     T = np.concatenate([v.log.tau for v in val.parts])
     np.testing.assert_allclose(val.errors.rms, np.sqrt(np.mean(E**2, axis=0)), rtol=1e-12)

@@ -128,6 +128,18 @@ def logs(panda, tmp_path_factory):
     return d
 
 
+@pytest.fixture(scope="module")
+def rec1_model(logs, tmp_path_factory):
+    """The folder of identify's model of rec1.csv (the tests that judge other recordings
+    with it share one identification)."""
+    model = tmp_path_factory.mktemp("model")
+    argv = ["identify", "--robot", "panda", "--no-figures", "--out", str(model), "--data"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*argv, str(logs / "rec1.csv")]) == 0
+    return model
+
+
 def test_validate_of_the_true_robot_is_at_the_noise_floor(panda, logs):
     """The robot that made the logs: at the noise floor, and the noise read from the
     measured torques is the simulated sensor's (0.05 N m); the ratio, weighed sample by
@@ -219,16 +231,14 @@ def test_identify_refuses_a_recording_in_other_units_naming_it(panda, logs, tmp_
     assert len(err) == 1 and "error: mnm.csv: its torques (RMS) are 1" in err[0], err
 
 
-def test_torques_in_mNm_read_as_Nm_are_refused_on_every_command(panda, logs, tmp_path, capsys):
+def test_torques_in_mNm_read_as_Nm_are_refused_on_every_command(
+    panda, logs, rec1_model, tmp_path, capsys
+):
     """A recording in mN m without --units: identify fitted a model 1000 times too heavy,
     with a warning only, and reported it at the noise floor; now identify, validate,
     friction and observe each refuse it in one line with the hint --units tau=mNm, as a
     flipped sign or degrees, and --units tau=Nm (the unit said) reads it as it is."""
-    model = tmp_path / "model"
-    argv = ["identify", "--robot", "panda", "--no-figures", "--out", str(model), "--data"]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        assert main([*argv, str(logs / "rec1.csv")]) == 0
+    model = rec1_model
     mnm = _rewritten(load_torque_log(logs / "rec2.csv"), tmp_path / "mnm.csv", tau=1000.0)
     given = ["--model", str(model / "identification.json")]
     runs = {
@@ -262,15 +272,13 @@ def test_identify_names_the_recording_its_findings_are_about(panda, logs, tmp_pa
     assert str(refused.value).startswith("neg.csv: the measured torques are anti-correlated")
 
 
-def test_observe_checks_its_recordings_as_the_other_commands(panda, logs, tmp_path, capsys):
+def test_observe_checks_its_recordings_as_the_other_commands(
+    panda, logs, rec1_model, tmp_path, capsys
+):
     """observe calibrated its thresholds on a recording in mN m or in degrees beside good
     ones without a word (thresholds 1000 times too large); now each is refused, naming the
     file."""
-    model = tmp_path / "model"
-    argv = ["identify", "--robot", "panda", "--no-figures", "--out", str(model), "--data"]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        assert main([*argv, str(logs / "rec1.csv")]) == 0
+    model = rec1_model
     log = load_torque_log(logs / "rec2.csv")
     mnm = _rewritten(log, tmp_path / "mnm.csv", tau=1000.0)
     deg = _rewritten(log, tmp_path / "deg.csv", q=180.0 / np.pi)
@@ -305,13 +313,15 @@ def test_a_recording_too_short_to_filter_names_its_cut_off_readably(panda, logs,
 def test_extra_columns_are_noted_once_per_read(panda, logs, tmp_path, caplog):
     """A log with extra columns (a temperature, a label): used, the columns named in one
     note (the label, which observe scores against, not warned about); identify read it
-    again for its held-out figures and said it twice."""
+    again for its held-out figures and said it twice (its structure given: the search
+    reads no file)."""
     text = (logs / "rec1.csv").read_text().splitlines()
     h = next(i for i, s in enumerate(text) if s.startswith("t,"))
     rows = [s + f",{20 + 0.01 * k:.2f},x" for k, s in enumerate(text[h + 1 :])]
     body = [s for s in text[:h] if not s.startswith("# rows")] + [text[h] + ",temp,label"]
     (tmp_path / "extra.csv").write_text("\n".join(body + rows) + "\n")
-    argv = ["identify", "--robot", "panda", "--out", str(tmp_path / "i"), "--data"]
+    argv = ["identify", "--robot", "panda", "--terms", "viscous,coulomb"]
+    argv += ["--out", str(tmp_path / "i"), "--data"]
     with warnings.catch_warnings(), caplog.at_level(logging.WARNING, logger="dynid"):
         warnings.simplefilter("ignore", DynidWarning)
         assert main([*argv, str(tmp_path / "extra.csv")]) == 0

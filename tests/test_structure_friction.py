@@ -24,13 +24,18 @@ from dynid.model.drive import Drive
 
 from conftest import recordings
 
+#: seconds of each exact recording: enough for the links, the law and the per-joint
+#: coefficients to come back at round-off (the coupled drive's placement needs 4 s: on
+#: 3 s logs joint 7's friction at the joint and at the motor tie)
+DURATION = 3.0
+
 
 def test_stribeck_friction_is_identified_with_the_links_and_its_velocity_chosen(panda):
     """Exact data of an arm with Stribeck friction (v_st = 0.05 rad/s): the Stribeck law at
     0.05 rad/s is chosen among the candidates' velocities and its parameters come back."""
     P = np.column_stack([VISCOUS, np.full(7, 0.4), np.full(7, 0.9), np.full(7, 0.05), np.zeros(7)])
     fr = LawFriction(LAWS["stribeck"], P)
-    logs = recordings(panda, (61, 62), friction=fr, duration=4.0)
+    logs = recordings(panda, (61, 62), friction=fr, duration=DURATION)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     # the offsets, zero in the truth, are left out joint by joint
     assert model.info.selection["chosen"] == "links + viscous + coulomb + stribeck:0.05"
@@ -48,7 +53,7 @@ def test_quadratic_viscous_friction_is_identified_with_the_links(panda):
     evaluate it as that law."""
     P = np.column_stack([VISCOUS, np.full(7, 0.2), np.full(7, 0.3), np.zeros(7)])
     fr = LawFriction(LAWS["quadratic"], P)
-    logs = recordings(panda, (81, 82), friction=fr, duration=4.0)
+    logs = recordings(panda, (81, 82), friction=fr, duration=DURATION)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     assert model.info.selection["chosen"] == "links + viscous + quadratic + coulomb"
     assert model.friction.law == "quadratic"
@@ -94,7 +99,7 @@ def test_friction_structure_is_chosen_per_joint(panda):
     fc = np.array([0.6, 0.5, 0.4, 0.0, 0.0, 0.0, 0.0])
     fo = np.array([0.0, 0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
     fr = ClassicalFriction(VISCOUS, fc, fo)
-    logs = recordings(panda, (71, 72), friction=fr, duration=4.0)
+    logs = recordings(panda, (71, 72), friction=fr, duration=DURATION)
     model = identify_recordings(panda, logs, cutoff_hz=None)
     want = (
         "links + viscous + coulomb + offset"

@@ -273,8 +273,8 @@ QUIET = [
 
 
 def _quiet_case(argv: list[str]):
-    """One command of QUIET; identify on the log (its structure search run twice, about
-    10 s) is marked slow, which hands this file out among the first (tests/conftest.py)."""
+    """One command of QUIET; identify on the log (its structure search, about 5 s) is
+    marked slow, which hands this file out among the first (tests/conftest.py)."""
     slow = argv[:3] == ["identify", "--data", "{d}/log.csv"]
     return pytest.param(argv, id=" ".join(argv[:2]), marks=[pytest.mark.slow] if slow else [])
 
@@ -283,13 +283,20 @@ def _quiet_case(argv: list[str]):
 def test_quiet_silences_every_command(files, tmp_path, capsys, argv):
     """-q prints nothing (no table, summary, progress, note or warning) for every command;
     without it the same command prints its summary (identify without its figures, which
-    the quiet run drew: a second drawing of the log's cost about 1.5 s)."""
+    the quiet run drew: a second drawing of the log's cost about 1.5 s; on the log with
+    its structure given, the quiet run having silenced the search's progress: a second
+    search cost about 5 s; friction with its law given, the quiet run having silenced the
+    laws' comparison)."""
     argv = [a.format(d=files, t=tmp_path) for a in argv]
     assert main([*argv, "-q"]) in (0, 1)
     out, err = capsys.readouterr()
     assert (out, err) == ("", "")
     if argv[0] == "identify" and "--no-figures" not in argv:
         argv.append("--no-figures")
+    if argv[0] == "identify" and argv[2].endswith("log.csv"):
+        argv += ["--terms", "viscous,coulomb"]
+    if argv[0] == "friction":  # a law given: the quiet run silenced the laws' comparison
+        argv += ["--friction-model", "classical"]
     assert main(argv) in (0, 1)
     assert capsys.readouterr().out.strip()
 
