@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -62,6 +62,7 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
+from .gains_first import gains_first
 from .options import (
     Cutoff,
     check_band,
@@ -453,21 +454,25 @@ def _identify(
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     if kind == "torque_log":
         logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
-        fit = lambda: identify_recordings(  # noqa: E731
-            robot,
-            logs,
-            [p.name for p in paths],
-            structure=parsed_terms(opt.terms),
-            max_std_percent=opt.max_std_percent,
-            rtol=opt.rtol,
-            max_gap_s=opt.max_gap_s,
-            torque_delay_s=opt.torque_delay_s or 0.0,
-            drive=opt.drive,
-            estimator=opt.estimator,
-            std=opt.std or "hac",
-            cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
-            **heldout,
-        )
+
+        def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
+            return identify_recordings(
+                robot,
+                logs,
+                [p.name for p in paths],
+                structure=structure,
+                max_std_percent=opt.max_std_percent,
+                rtol=opt.rtol,
+                max_gap_s=opt.max_gap_s,
+                torque_delay_s=opt.torque_delay_s or 0.0,
+                drive=drive,
+                estimator=opt.estimator,
+                std=opt.std or "hac",
+                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
+                **heldout,
+            )
+
+        fit = lambda: _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, heldout)  # noqa: E731
         model = in_file(path, fit) if len(paths) == 1 else fit()
         held = _predicted_heldout(model, logs, heldout.get("validate_on"))
         _say_gravity_scale(robot, model, logs, opt.drive, held)
@@ -495,6 +500,31 @@ def _identify(
         if misfit is not None:
             warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
     return _record(model, opt.columns), held, delay
+
+
+def _searched(
+    fitted: Callable[[Structure | Literal["auto"], Drive | None], IdentifiedModel],
+    structure: Structure | Literal["auto"],
+    drive: Drive | None,
+    logs: Sequence[TorqueLog],
+    heldout: dict[str, Any],
+) -> IdentifiedModel:
+    """The model of ``structure``; chosen (``"auto"``) through a current log's drive, on
+    the efforts corrected by the torque constants' factors the richest structure names
+    first (:func:`~dynid.workflows.gains_first.gains_first`), then fitted to the efforts
+    as logged, its selection and a note saying so."""
+    first = None
+    if structure == "auto" and drive is not None:
+        first = gains_first(fitted, drive, logs, heldout.get("validate_on"))
+    if first is None:
+        return fitted(structure, drive)
+    model = fitted(first.structure, drive)
+    info = dataclasses.replace(
+        model.info,
+        selection=first.searched.info.selection,
+        notes=(*model.info.notes, first.note()),
+    )
+    return dataclasses.replace(model, info=info)
 
 
 def _with_torque_delay(
