@@ -62,7 +62,7 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
-from .gains_first import gains_first
+from .gains_first import CorrectedSearch, gains_first
 from .options import (
     Cutoff,
     check_band,
@@ -473,8 +473,10 @@ def _identify(
             )
 
         fit = lambda: _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, heldout)  # noqa: E731
-        model = in_file(path, fit) if len(paths) == 1 else fit()
+        model, first = in_file(path, fit) if len(paths) == 1 else fit()
         held = _predicted_heldout(model, logs, heldout.get("validate_on"))
+        if held is not None and first is not None:  # one judgement of the efforts' scale
+            held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
         _say_gravity_scale(robot, model, logs, opt.drive, held)
         model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
     else:
@@ -508,23 +510,24 @@ def _searched(
     drive: Drive | None,
     logs: Sequence[TorqueLog],
     heldout: dict[str, Any],
-) -> IdentifiedModel:
+) -> tuple[IdentifiedModel, CorrectedSearch | None]:
     """The model of ``structure``; chosen (``"auto"``) through a current log's drive, on
     the efforts corrected by the torque constants' factors the richest structure names
-    first (:func:`~dynid.workflows.gains_first.gains_first`), then fitted to the efforts
-    as logged, its selection and a note saying so."""
+    first (:func:`~dynid.workflows.gains_first.gains_first`, returned: its factors are
+    the held-out verdict's), then fitted to the efforts as logged, its selection and a
+    note saying so."""
     first = None
     if structure == "auto" and drive is not None:
         first = gains_first(fitted, drive, logs, heldout.get("validate_on"))
     if first is None:
-        return fitted(structure, drive)
+        return fitted(structure, drive), None
     model = fitted(first.structure, drive)
     info = dataclasses.replace(
         model.info,
         selection=first.searched.info.selection,
         notes=(*model.info.notes, first.note()),
     )
-    return dataclasses.replace(model, info=info)
+    return dataclasses.replace(model, info=info), first
 
 
 def _with_torque_delay(
