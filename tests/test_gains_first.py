@@ -19,7 +19,7 @@ import dynid
 from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
-from dynid.identification.drive_gains import _Factored, _column_space, drive_gains
+from dynid.identification.drive_gains import _column_space, _Factored, drive_gains
 from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
 from dynid.regressors.base import base_parameters

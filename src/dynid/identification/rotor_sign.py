@@ -13,12 +13,15 @@ times the true one, fitted without friction, gave ``Ia4 = -0.545 +- 0.088 kg m^2
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
+from ..exceptions import DynidWarning
 from ..model.drive import Drive
 from .model import IdentifiedModel
 
-__all__ = ["negative_inertias", "per_joint"]
+__all__ = ["negative_inertias", "per_joint", "warned_negative_inertias"]
 
 
 def per_joint(drive: Drive | None) -> bool:
@@ -59,6 +62,15 @@ def negative_inertias(model: IdentifiedModel) -> tuple[str, ...]:
                 f"{std:.2g}), which no rotor has: {cause}"
             )
     return tuple(said)
+
+
+def warned_negative_inertias(model: IdentifiedModel) -> tuple[str, ...]:
+    """:func:`negative_inertias` of ``model``, each also a
+    :class:`~dynid.exceptions.DynidWarning`; the sentences for the model's notes."""
+    said = negative_inertias(model)
+    for line in said:
+        warnings.warn(line, DynidWarning, stacklevel=3)
+    return said
 
 
 def _index(label: str) -> int | None:
