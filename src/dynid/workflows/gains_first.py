@@ -128,4 +128,10 @@ def gains_first(
     named = list(gains.named)
     factor[named] = gains.factor[named]
     corrected = dataclasses.replace(drive, torque_constant=drive.torque_constant * factor)
-    return CorrectedSearch(gains, corrected, fit("auto", corrected))
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        searched = fit("auto", corrected)
+    for w in said:  # the search's findings, but the rotor inertias of a model not kept
+        if not str(w.message).startswith("the identified rotor inertia"):
+            warnings.warn(w.message, w.category, stacklevel=2)
+    return CorrectedSearch(gains, corrected, searched)
