@@ -21,7 +21,12 @@ from ..exceptions import DynidWarning
 from ..model.drive import Drive
 from .model import IdentifiedModel
 
-__all__ = ["negative_inertias", "per_joint", "warned_negative_inertias"]
+__all__ = [
+    "negative_inertias",
+    "negative_rotor_inertias",
+    "per_joint",
+    "warned_negative_inertias",
+]
 
 
 def per_joint(drive: Drive | None) -> bool:
@@ -34,33 +39,42 @@ def per_joint(drive: Drive | None) -> bool:
     return bool(np.array_equal(np.abs(K), np.eye(K.shape[0])))
 
 
-def negative_inertias(model: IdentifiedModel) -> tuple[str, ...]:
-    """One sentence per rotor inertia of ``model`` identified below zero (a term's
-    ``inertia`` coefficients, kept and not regrouped), naming the joint (a motor of a
-    geared or coupled drive: the motor), the value, its standard deviation and the
-    likely cause (module docstring); empty for none."""
-    said = []
-    unit = "joint" if per_joint(model.drive) else "motor"
+def negative_rotor_inertias(model: IdentifiedModel) -> tuple[tuple[str, float, float], ...]:
+    """Each rotor inertia of ``model`` identified below zero (a term's ``inertia``
+    coefficients, kept and not regrouped): its label, value [kg m^2] and standard
+    deviation [kg m^2]; empty for none."""
+    found = []
     for t in model.terms.values():
         if t.term.inertia(np.zeros(len(t.labels))) is None:
             continue
         kept = np.asarray(t.kept, dtype=bool)
         for k in np.flatnonzero(kept & (np.asarray(t.values) < 0)):
-            value, std = float(t.values[k]), float(t.std[k])
-            index = _index(t.labels[k])
-            where = f"{t.labels[k]}" + ("" if index is None else f" of {unit} {index}")
-            if np.isfinite(std) and abs(value) > std:
-                cause = (
-                    "an effort read at the wrong scale on that "
-                    f"{unit} (its torque_constant or torque sensor's scale: see the held-out "
-                    "verdict's gains), or a term the model lacks taken up by it"
-                )
-            else:
-                cause = "within its standard deviation of zero: the log does not determine it"
-            said.append(
-                f"the identified rotor inertia {where} is negative ({value:.3g} kg m^2, std "
-                f"{std:.2g}), which no rotor has: {cause}"
+            found.append((t.labels[k], float(t.values[k]), float(t.std[k])))
+    return tuple(found)
+
+
+def negative_inertias(model: IdentifiedModel) -> tuple[str, ...]:
+    """One sentence per rotor inertia of ``model`` identified below zero
+    (:func:`negative_rotor_inertias`), naming the joint (a motor of a geared or coupled
+    drive: the motor), the value, its standard deviation and the likely cause (module
+    docstring); empty for none."""
+    said = []
+    unit = "joint" if per_joint(model.drive) else "motor"
+    for label, value, std in negative_rotor_inertias(model):
+        index = _index(label)
+        where = f"{label}" + ("" if index is None else f" of {unit} {index}")
+        if np.isfinite(std) and abs(value) > std:
+            cause = (
+                "an effort read at the wrong scale on that "
+                f"{unit} (its torque_constant or torque sensor's scale: see the held-out "
+                "verdict's gains), or a term the model lacks taken up by it"
             )
+        else:
+            cause = "within its standard deviation of zero: the log does not determine it"
+        said.append(
+            f"the identified rotor inertia {where} is negative ({value:.3g} kg m^2, std "
+            f"{std:.2g}), which no rotor has: {cause}"
+        )
     return tuple(said)
 
 

@@ -62,7 +62,7 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
-from .gains_first import CorrectedSearch, gains_first
+from .gains_first import gains_first, reason_to_judge_first
 from .options import (
     Cutoff,
     check_band,
@@ -472,11 +472,9 @@ def _identify(
                 **heldout,
             )
 
-        fit = lambda: _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, heldout)  # noqa: E731
-        model, first = in_file(path, fit) if len(paths) == 1 else fit()
-        held = _predicted_heldout(model, logs, heldout.get("validate_on"))
-        if held is not None and first is not None:  # one judgement of the efforts' scale
-            held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
+        separate = heldout.get("validate_on")
+        fit = lambda: _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)  # noqa: E731
+        model, held = in_file(path, fit) if len(paths) == 1 else fit()
         _say_gravity_scale(robot, model, logs, opt.drive, held)
         model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
     else:
@@ -509,25 +507,41 @@ def _searched(
     structure: Structure | Literal["auto"],
     drive: Drive | None,
     logs: Sequence[TorqueLog],
-    heldout: dict[str, Any],
-) -> tuple[IdentifiedModel, CorrectedSearch | None]:
-    """The model of ``structure``; chosen (``"auto"``) through a current log's drive, on
-    the efforts corrected by the torque constants' factors the richest structure names
-    first (:func:`~dynid.workflows.gains_first.gains_first`, returned: its factors are
-    the held-out verdict's), then fitted to the efforts as logged, its selection and a
-    note saying so."""
-    first = None
-    if structure == "auto" and drive is not None:
-        first = gains_first(fitted, drive, logs, heldout.get("validate_on"))
+    separate: TorqueLog | None,
+) -> tuple[IdentifiedModel, HeldOutTorques | None]:
+    """The model of ``structure`` and its held-out prediction; chosen (``"auto"``) through
+    a current log's drive and pointing to the torque constants
+    (:func:`~dynid.workflows.gains_first.reason_to_judge_first`), chosen again on the
+    efforts corrected by the factors the richest structure names
+    (:func:`~dynid.workflows.gains_first.gains_first`: its factors are the held-out
+    verdict's), fitted to the efforts as logged, its selection and a note saying so; the
+    first model's warnings said only when it is kept."""
+    current = drive is not None and drive.effort == "current"
+    if structure != "auto" or not current:
+        model = fitted(structure, drive)
+        return model, _predicted_heldout(model, logs, separate)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        model = fitted(structure, drive)
+        held = _predicted_heldout(model, logs, separate)
+    why = reason_to_judge_first(model, held)
+    first = None if why is None else gains_first(fitted, drive, logs, separate, why)
     if first is None:
-        return fitted(structure, drive), None
+        for w in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        return model, held
     model = fitted(first.structure, drive)
     info = dataclasses.replace(
         model.info,
         selection=first.searched.info.selection,
         notes=(*model.info.notes, first.note()),
+        extra={**model.info.extra, "gains_first": first.note()},
     )
-    return dataclasses.replace(model, info=info), first
+    model = dataclasses.replace(model, info=info)
+    held = _predicted_heldout(model, logs, separate)
+    if held is not None:  # one judgement of the efforts' scale
+        held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
+    return model, held
 
 
 def _with_torque_delay(
