@@ -20,7 +20,7 @@ present), as the held-out verdict judges them
 improves the prediction of held-out data); the named ones correct the drive's torque
 constants for a second search, and the structure it chooses is fitted to the efforts as
 logged, whose held-out verdict names the factors. Constants that are right leave a
-verdict at the noise, which fits no gains: the search runs once, as it did.
+verdict near the noise floor and gains that name nothing: the search runs once, as it did.
 """
 
 from __future__ import annotations
