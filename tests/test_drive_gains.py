@@ -79,14 +79,16 @@ def test_known_factors_come_back_within_their_noise(panda):
     said = found.sentence()
     assert said is not None and "the torques of joint 2 read 0.66" in said
     assert "scale them by 1.5 " in said and "joint 1 " not in said
-    motor = dataclasses.replace(found, effort="current").sentence()
+    joint = dataclasses.replace(found, effort="current").sentence()  # a joint-side drive
+    assert joint is not None and "torque_constant of joint 4 looks 1.43 times" in joint
+    assert "multiply it by 0.7 " in joint and "motor" not in joint
+    motor = dataclasses.replace(found, effort="current", per="motor").sentence()
     assert motor is not None and "torque_constant of motor 4 looks 1.43 times" in motor
-    assert "multiply it by 0.7 " in motor
     relative = drive_gains(W, logged, noise)  # no description: the factors' ratios alone
     assert relative is not None and not relative.scaled
     ratio = relative.factor / relative.factor[0]
     np.testing.assert_allclose(ratio[[1, 3, 5]], truth[[1, 3, 5]], rtol=0.02)
-    words = dataclasses.replace(relative, effort="current").sentence()
+    words = dataclasses.replace(relative, effort="current", per="motor").sentence()
     assert words is not None and "relative to each other" in words and "motor 2's by" in words
 
 

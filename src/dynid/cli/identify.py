@@ -35,7 +35,14 @@ determines to 20 % (a wrist armature whose torque the held-out error hardly sees
 under the choice). The summary prints the table of candidates
 (each smooth or Stribeck law at its best shape) and the choice, and the terms'
 coefficients per joint; identification.json records them all. --terms fixes the structure
-by hand (e.g. --terms armature,viscous,coulomb,offset).
+by hand (e.g. --terms armature,viscous,coulomb,offset). Through a --drive that logs
+currents, when the chosen structure's held-out error or the error its gains leave is over
+2 x the noise, its gains name a factor, or a rotor inertia is negative, the torque
+constants are judged with the richest structure (armature, viscous, coulomb, offset): the
+factors the held-out data confirm correct the currents for a second search, the structure
+chosen is fitted to the currents as logged, and the verdict names the factors (a note in
+the summary says why). A rotor inertia fitted below zero is a warning naming the joint and
+its likely cause.
 
 Checks that the data belong to --robot: a static data file that records another robot
 (name, joint count or kinematics) is an error; configurations outside the joint limits,

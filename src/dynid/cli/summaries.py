@@ -62,7 +62,8 @@ def _fitted_rows(info: IdentificationInfo) -> str:
 def format_identification(
     model: IdentifiedModel, *, width: int = 60, verdict_below: bool = False
 ) -> str:
-    """A readable summary: metrics, then one line per coefficient (expressions shortened).
+    """A readable summary: metrics (and, where a current log's torque constants were judged
+    before the structure search, why), then one line per coefficient (expressions shortened).
     ``verdict_below``: a held-out verdict is printed after it, the one ratio to the noise
     floor the summary gives (:func:`heldout_line`)."""
     fit, info = model.fit, model.info
@@ -111,6 +112,8 @@ def format_identification(
         + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
     )
     head += recordings_lines(info.recordings) + selection_lines(info.selection)
+    first = info.extra.get("gains_first")  # why the torque constants were judged first
+    head += [f"note: {first}"] if isinstance(first, str) else []
     lw = text_width("name", model.base.labels[: model.base.rank], 7)
     head.append(f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}  kept  expression")
     rows = []

@@ -29,7 +29,7 @@ import dataclasses
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,6 +65,7 @@ from ..identification.residual_dependence import (
     with_dependence_hint,
 )
 from ..identification.residual_spring import ResidualSpring, residual_spring
+from ..identification.rotor_sign import per_joint
 from ..identification.spikes import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from ..model.drive import Drive
@@ -636,9 +637,10 @@ def residual_gains(
     found = drive_gains(W, log.tau[rows], noise, K, G, gd, labels)
     if found is None:
         return None
+    per: Literal["joint", "motor"] = "joint" if per_joint(drive) else "motor"  # gear ratio 1
     if drive is not None and drive.effort == "current":
-        return dataclasses.replace(found, effort="current", per="motor" if motor else "joint")
-    return dataclasses.replace(found, per="motor") if motor else found
+        return dataclasses.replace(found, effort="current", per=per)
+    return dataclasses.replace(found, per=per)
 
 
 def beside_columns(

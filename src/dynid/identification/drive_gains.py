@@ -117,6 +117,12 @@ class DriveGains:
     heldout_se : ndarray, shape (m,), optional
         The standard error [-] of :attr:`heldout_gain`, of the differences paired over the
         folds.
+    heldout_std : ndarray, shape (m,), optional
+        Each motor's gain's standard deviation [-] from its spread over the folds (the
+        delete-a-fold jackknife of the gains fitted on every fold but one, at the scale of
+        :attr:`factor`): what the in-sample :attr:`cov` misses where the residual is not
+        white (model error a gain takes up differently in each part of the log); NaN
+        where not fitted; None without folds.
     """
 
     factor: NDArray[np.float64]
@@ -129,6 +135,7 @@ class DriveGains:
     per: Literal["joint", "motor"] = "joint"
     heldout_gain: NDArray[np.float64] | None = None
     heldout_se: NDArray[np.float64] | None = None
+    heldout_std: NDArray[np.float64] | None = None
 
     def ratio_std(self, k: int, r: int) -> float:
         """The standard deviation [-] of motor ``k``'s gain relative to motor ``r``'s,
@@ -158,10 +165,16 @@ class DriveGains:
     @property
     def determined(self) -> NDArray[np.bool_]:
         """The motors (m,) whose gain the data determine: fitted (not NaN) and of relative
-        standard deviation at most :data:`DETERMINED` (whether a determined gain is a
-        finding is :attr:`named`'s: judged on held-out data)."""
+        standard deviation at most :data:`DETERMINED`, in-sample (:attr:`std`) and over
+        the folds (:attr:`heldout_std`: a gain fitted to model error that differs along
+        the log spreads over the folds however small its in-sample standard deviation);
+        whether a determined gain is a finding is :attr:`named`'s, judged on held-out
+        data."""
         f = np.nan_to_num(self.factor, nan=0.0)
-        return np.isfinite(self.factor) & (self.std <= DETERMINED * np.abs(f))
+        std = self.std
+        if self.heldout_std is not None:
+            std = np.where(np.isnan(self.heldout_std), std, np.fmax(std, self.heldout_std))
+        return np.isfinite(self.factor) & (std <= DETERMINED * np.abs(f))
 
     @property
     def uneven(self) -> bool:
@@ -232,8 +245,8 @@ class DriveGains:
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: ``factor`` and ``std`` per motor (null where left out), ``scaled``,
         ``ratio_fixed``, ``ratio_fitted``, ``ratio_held`` (per motor), ``determined`` and
-        ``named`` (the motors' indices from 0), ``heldout_gain`` and ``heldout_se`` (per
-        motor; null without folds), ``effort`` and ``per``."""
+        ``named`` (the motors' indices from 0), ``heldout_gain``, ``heldout_se`` and
+        ``heldout_std`` (per motor; null without folds), ``effort`` and ``per``."""
 
         def listed(x: NDArray[np.float64] | None) -> list[float | None] | None:
             if x is None:
@@ -251,6 +264,7 @@ class DriveGains:
             "named": list(self.named),
             "heldout_gain": listed(self.heldout_gain),
             "heldout_se": listed(self.heldout_se),
+            "heldout_std": listed(self.heldout_std),
             "effort": self.effort,
             "per": self.per,
         }
@@ -258,13 +272,14 @@ class DriveGains:
     def sentence(self) -> str | None:
         """The finding in words, or None when :attr:`named` is empty: of currents, a
         drive's torque constants (``torque_constant of motor 2 looks 0.667 times the true
-        one: multiply it by 1.5``); of torques, the sensors' scales (``the torques of joint
+        one: multiply it by 1.5``; ``of joint 2`` where each motor turns its own joint one
+        to one, :attr:`per`); of torques, the sensors' scales (``the torques of joint
         2 read 0.667 times the true ones``); relative gains (:attr:`scaled` false) as the
         factors between the motors, their common one not known."""
         named, what, std = self.named, self.effort, self.std
         if not named:
             return None
-        unit = "motor" if what == "current" else self.per
+        unit = self.per
         said = (
             f"a gain per {unit} explains the residual (fitted with the model's columns, the "
             f"error falls from {self.ratio_fixed:.3g} to {self.ratio_fitted:.3g} x the noise): "
@@ -282,7 +297,7 @@ class DriveGains:
             )
         elif what == "current":
             said += "; ".join(
-                f"torque_constant of motor {k + 1} looks {1 / self.factor[k]:.3g} times the "
+                f"torque_constant of {unit} {k + 1} looks {1 / self.factor[k]:.3g} times the "
                 f"true one: multiply it by {self.factor[k]:.3g} (std {std[k]:.2g})"
                 for k in named
             )
@@ -430,16 +445,19 @@ def drive_gains(
     labels = _fold_labels(N, folds)
     G = None if gravity_columns is None else np.asarray(gravity_columns, dtype=np.float64)
     gd = None if gravity is None else np.asarray(gravity, dtype=np.float64)
-    gain, se = (None, None) if labels is None else _heldout(A, B, C, active, labels, G, gd)
+    gain = se = spread = None
+    if labels is not None:
+        gain, se, spread = _heldout(A, B, C, active, labels, G, gd, factor)
     found = DriveGains(
         factor, cov, scaled, float(np.sqrt(fixed)), float(np.sqrt(fitted)), held,
-        heldout_gain=gain, heldout_se=se,
+        heldout_gain=gain, heldout_se=se, heldout_std=spread,
     )  # fmt: skip
     sure = found.determined
     if scaled or not sure.any():
         return found
     mean = float(np.exp(np.mean(np.log(factor[sure]))))  # geometric mean 1 over the determined
-    return dataclasses.replace(found, factor=factor / mean, cov=cov / mean**2)
+    spread = None if spread is None else spread / mean
+    return dataclasses.replace(found, factor=factor / mean, cov=cov / mean**2, heldout_std=spread)
 
 
 def _fold_labels(samples: int, folds: ArrayLike | None) -> NDArray[np.intp] | None:
@@ -464,8 +482,12 @@ def _heldout(
     labels: NDArray[np.intp],
     G: NDArray[np.float64] | None,
     gd: NDArray[np.float64] | None,
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Per motor, :attr:`DriveGains.heldout_gain` and :attr:`DriveGains.heldout_se`: on
+    whole: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Per motor, :attr:`DriveGains.heldout_gain`, :attr:`DriveGains.heldout_se` and
+    :attr:`DriveGains.heldout_std` (the folds' gains at the scale of ``whole``, the gains
+    fitted on every row: the description's, else the same geometric mean over the active
+    motors; jackknife ``(K - 1) / K sum (g_f - mean g)^2`` over the ``K`` folds): on
     each fold, the gains (of the ``active`` motors; the others' efforts free columns beside
     the model's ``A``) and the parameters fitted on the other folds' rows, the fold's
     weighted residual's mean square with every gain as fitted and with motor ``k``'s held
@@ -476,36 +498,41 @@ def _heldout(
     rows = np.repeat(labels, n)
     motors = np.flatnonzero(active)
     diffs: list[NDArray[np.float64]] = []
+    gains: list[NDArray[np.float64]] = []
     X = np.concatenate([A, B[:, ~active]], axis=1)
     scale = np.linalg.norm(X, axis=0)
     X = X / np.where(scale > 0, scale, 1.0)
     for f in np.unique(labels):
         tr, te = rows != f, rows == f
         Ba = B[:, active]
-        g = _smallest(Ba[tr], _column_space(X[tr]), C[np.ix_(active, active)])[3]
+        fold = _Factored.of(X[tr])
+        g = _smallest(Ba[tr], fold.Q, C[np.ix_(active, active)])[3]
         full = np.full(B.shape[1], np.nan)
         full[active] = g
         ts = labels != f
-        factor, _ = _common_scale(
+        factor, scaled = _common_scale(
             full, A, B[tr], A[tr], None if G is None else G[ts], None if gd is None else gd[ts]
         )
         if not np.all(factor[active] > 0):
             continue
+        if not scaled:
+            factor = factor * np.exp(np.mean(np.log(whole[active] / factor[active])))
+        gains.append(factor)
         unit = g / factor[active]  # a gain of 1 at the scale of g, per motor (all equal)
-
-        inverse = np.linalg.pinv(X[tr], rcond=_RANK_RTOL)
-        base = _fold_score(Ba @ g, X, inverse, tr, te)
+        base = fold.score(Ba @ g, X, tr, te)
         d = np.full(B.shape[1], np.nan)
         for i, k in enumerate(motors):
             h = g.copy()
             h[i] = unit[i]
-            d[k] = _fold_score(Ba @ h, X, inverse, tr, te) - base
+            d[k] = fold.score(Ba @ h, X, tr, te) - base
         diffs.append(d)
     m = B.shape[1]
     if len(diffs) < 2:
-        return np.full(m, np.nan), np.full(m, np.nan)
-    D = np.asarray(diffs)
-    return np.mean(D, axis=0), np.std(D, axis=0, ddof=1) / np.sqrt(D.shape[0])
+        return np.full(m, np.nan), np.full(m, np.nan), np.full(m, np.nan)
+    D, F = np.asarray(diffs), np.asarray(gains)
+    K = F.shape[0]
+    spread = np.sqrt((K - 1) / K * np.sum((F - F.mean(axis=0)) ** 2, axis=0))
+    return np.mean(D, axis=0), np.std(D, axis=0, ddof=1) / np.sqrt(D.shape[0]), spread
 
 
 def _smallest(
@@ -522,18 +549,42 @@ def _smallest(
     return S, lam, V, V[:, 0] * np.sign(np.sum(V[:, 0]))
 
 
-def _fold_score(
-    y: NDArray[np.float64],
-    X: NDArray[np.float64],
-    inverse: NDArray[np.float64],
-    tr: NDArray[np.bool_],
-    te: NDArray[np.bool_],
-) -> float:
-    """The mean square [-] over the rows ``te`` of the weighted torques ``y`` less the
-    columns ``X`` fitted to them on the rows ``tr`` (``inverse``: ``X[tr]``'s
-    pseudo-inverse)."""
-    r = y[te] - X[te] @ (inverse @ y[tr])
-    return float(np.mean(r**2))
+@dataclass(frozen=True, slots=True, eq=False)
+class _Factored:
+    """A fold's training columns ``X[tr]`` factored once by pivoted QR (rank from the
+    diagonal at relative tolerance :data:`_RANK_RTOL`; the columns scaled beforehand):
+    ``X[tr][:, cols] = Q R``, ``Q`` (rows, r) orthonormal, ``R`` (r, r) upper triangular.
+    ``Q`` is the projection of :func:`_smallest`, ``R`` the least-squares solve of
+    :meth:`score` (the pseudo-inverse's fit where ``X[tr]`` has full column rank)."""
+
+    Q: NDArray[np.float64]
+    R: NDArray[np.float64]
+    cols: NDArray[np.intp]
+
+    @classmethod
+    def of(cls, X: NDArray[np.float64]) -> _Factored:
+        """The factors of ``X`` (rows, p)."""
+        import scipy.linalg  # here: the command's start loads no scipy
+
+        Q, R, piv = scipy.linalg.qr(X, mode="economic", pivoting=True)
+        d = np.abs(np.diag(R))
+        r = int(np.count_nonzero(d > _RANK_RTOL * max(float(d[0]) if d.size else 0.0, 1e-300)))
+        return cls(np.asarray(Q[:, :r]), np.asarray(R[:r, :r]), np.asarray(piv[:r]))
+
+    def score(
+        self,
+        y: NDArray[np.float64],
+        X: NDArray[np.float64],
+        tr: NDArray[np.bool_],
+        te: NDArray[np.bool_],
+    ) -> float:
+        """The mean square [-] over the rows ``te`` of the weighted torques ``y`` less the
+        columns ``X`` fitted to them on the rows ``tr`` (the rows factored)."""
+        import scipy.linalg
+
+        x = scipy.linalg.solve_triangular(self.R, self.Q.T @ y[tr])
+        r = y[te] - X[te][:, self.cols] @ x
+        return float(np.mean(r**2))
 
 
 def _held_ratios(

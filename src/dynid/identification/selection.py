@@ -93,6 +93,7 @@ from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded, sign_confirmed
 from .recordings import Recordings, prepare_recordings
+from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
 from .structural import absorbed_by
 from .structure import (
@@ -999,9 +1000,9 @@ def identify_recordings(
         raise _without_hint(exc, structure) from exc
     warn_unphysical(model, terms)
     heldout = _heldout_record(model, data if validation is None else validation)
-    info = replace(
-        model.info, combined=_combined(robot, data, structure, drive, model.base), heldout=heldout
-    )
+    combined = _combined(robot, data, structure, drive, model.base)
+    notes = (*model.info.notes, *warned_negative_inertias(model))
+    info = replace(model.info, combined=combined, heldout=heldout, notes=notes)
     extra = {**model.info.extra, "terms": list(structure.terms)}
     info = replace(info, selection=None if selection is None else selection.as_dict(), extra=extra)
     return replace(model, info=info)

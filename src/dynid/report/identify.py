@@ -244,14 +244,14 @@ def _gains_words(gains: object) -> str:
     if not (isinstance(k, int) and 0 <= k < len(factor) and is_number(factor[k])):
         return ""
     current = gains.get("effort") == "current"
-    unit = "motor" if current else str(gains.get("per", "joint"))
+    unit = str(gains.get("per", "motor" if current else "joint"))
     f = float(factor[k])
     if not gains.get("scaled", True):
         what = "torque constants" if current else "torques"
         said = f"the {what} look off by different factors: {unit} {k + 1} by {f:.3g} of the others"
     elif current:
         said = (
-            f"the torque constants look off: that of motor {k + 1} looks {1 / f:.3g} times "
+            f"the torque constants look off: that of {unit} {k + 1} looks {1 / f:.3g} times "
             f"the true one (multiply it by {f:.3g})"
         )
     else:

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -62,6 +62,7 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
+from .gains_first import gains_first, reason_to_judge_first
 from .options import (
     Cutoff,
     check_band,
@@ -453,23 +454,27 @@ def _identify(
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     if kind == "torque_log":
         logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
-        fit = lambda: identify_recordings(  # noqa: E731
-            robot,
-            logs,
-            [p.name for p in paths],
-            structure=parsed_terms(opt.terms),
-            max_std_percent=opt.max_std_percent,
-            rtol=opt.rtol,
-            max_gap_s=opt.max_gap_s,
-            torque_delay_s=opt.torque_delay_s or 0.0,
-            drive=opt.drive,
-            estimator=opt.estimator,
-            std=opt.std or "hac",
-            cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
-            **heldout,
-        )
-        model = in_file(path, fit) if len(paths) == 1 else fit()
-        held = _predicted_heldout(model, logs, heldout.get("validate_on"))
+
+        def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
+            return identify_recordings(
+                robot,
+                logs,
+                [p.name for p in paths],
+                structure=structure,
+                max_std_percent=opt.max_std_percent,
+                rtol=opt.rtol,
+                max_gap_s=opt.max_gap_s,
+                torque_delay_s=opt.torque_delay_s or 0.0,
+                drive=drive,
+                estimator=opt.estimator,
+                std=opt.std or "hac",
+                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
+                **heldout,
+            )
+
+        separate = heldout.get("validate_on")
+        fit = lambda: _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)  # noqa: E731
+        model, held = in_file(path, fit) if len(paths) == 1 else fit()
         _say_gravity_scale(robot, model, logs, opt.drive, held)
         model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
     else:
@@ -495,6 +500,48 @@ def _identify(
         if misfit is not None:
             warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
     return _record(model, opt.columns), held, delay
+
+
+def _searched(
+    fitted: Callable[[Structure | Literal["auto"], Drive | None], IdentifiedModel],
+    structure: Structure | Literal["auto"],
+    drive: Drive | None,
+    logs: Sequence[TorqueLog],
+    separate: TorqueLog | None,
+) -> tuple[IdentifiedModel, HeldOutTorques | None]:
+    """The model of ``structure`` and its held-out prediction; chosen (``"auto"``) through
+    a current log's drive and pointing to the torque constants
+    (:func:`~dynid.workflows.gains_first.reason_to_judge_first`), chosen again on the
+    efforts corrected by the factors the richest structure names
+    (:func:`~dynid.workflows.gains_first.gains_first`: its factors are the held-out
+    verdict's), fitted to the efforts as logged, its selection and a note saying so; the
+    first model's warnings said only when it is kept."""
+    current = drive is not None and drive.effort == "current"
+    if structure != "auto" or not current:
+        model = fitted(structure, drive)
+        return model, _predicted_heldout(model, logs, separate)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        model = fitted(structure, drive)
+        held = _predicted_heldout(model, logs, separate)
+    why = reason_to_judge_first(model, held)
+    first = None if why is None else gains_first(fitted, drive, logs, separate, why)
+    if first is None:
+        for w in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        return model, held
+    model = fitted(first.structure, drive)
+    info = dataclasses.replace(
+        model.info,
+        selection=first.searched.info.selection,
+        notes=(*model.info.notes, first.note()),
+        extra={**model.info.extra, "gains_first": first.note()},
+    )
+    model = dataclasses.replace(model, info=info)
+    held = _predicted_heldout(model, logs, separate)
+    if held is not None:  # one judgement of the efforts' scale
+        held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
+    return model, held
 
 
 def _with_torque_delay(
