@@ -463,3 +463,37 @@ def test_observer_refuses_bad_inputs_with_the_documented_errors():
         MomentumObserver(model, ObserverOptions(gain=(1.0, 2.0)))
     with pytest.raises(OptionError, match="contact window"):
         Contact("link5", (0.0, 0.0, 1.0), 2.0, 1.0)
+
+
+def test_the_std_filter_kernel_gives_lfilters_numbers_bit_for_bit():
+    """The compiled first-order filter of the residual's std is scipy.signal.lfilter with
+    ``b = [gam]``, ``a = [1, gam - 1]`` from the same state, bit for bit (NaN included),
+    its final state too; so is the fallback without the kernels."""
+    import scipy.signal
+
+    from dynid import _kernels
+    from dynid.observer.detection import _lfiltered
+
+    mod = _kernels.load("observer")
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        m, n, r = int(rng.integers(1, 200)), int(rng.integers(1, 8)), int(rng.integers(1, 40))
+        gam = -np.expm1(-rng.uniform(1.0, 200.0, n) * 1e-3)
+        x = rng.standard_normal((m, n, r)) * 10.0 ** rng.uniform(-4, 4)
+        x[rng.integers(0, m), 0, 0] = np.nan
+        z0 = rng.standard_normal((n, r))
+        want, zw = np.empty_like(x), np.empty_like(z0)
+        for j in range(n):
+            want[:, j, :], zf = scipy.signal.lfilter(
+                [gam[j]], [1.0, gam[j] - 1.0], x[:, j, :], axis=0, zi=z0[j][None]
+            )
+            zw[j] = zf[0]
+        got, z = np.empty_like(x), z0.copy()
+        _lfiltered(gam, x, z, got)
+        assert np.array_equal(got, want, equal_nan=True) and np.array_equal(z, zw, equal_nan=True)
+        if mod is not None:
+            got, z = np.empty_like(x), z0.copy()
+            mod.first_order_filter(gam, x, z, got)
+            assert np.array_equal(got, want, equal_nan=True) and np.array_equal(
+                z, zw, equal_nan=True
+            )

@@ -99,6 +99,15 @@ def jit(fn=None, **options):
         return numba.njit(fastmath=FASTMATH, **options)(fn)
 
 
+def exact(fn):
+    """:func:`jit` without ``contract``: no fused multiply-add, each product rounded as a C
+    loop of the same operations rounds it (a kernel bit-identical to a library's loop)."""
+    try:
+        return numba.njit(cache=True)(fn)
+    except RuntimeError:  # no writable cache location
+        return numba.njit()(fn)
+
+
 def inline(fn):
     """A helper inlined into its callers (numba ``inline="always"``)."""
     return numba.njit(inline="always", fastmath=FASTMATH)(fn)

@@ -45,7 +45,7 @@ import numpy as np
 
 from .chain import SINCOS_MAX as _SINCOS_MAX
 from .chain import STACK as _STACK
-from .chain import angles, finite, fixed, inline, jit, joint_at, joint_from, lean, stack
+from .chain import angles, exact, finite, fixed, inline, jit, joint_at, joint_from, lean, stack
 from .chain import sincos as _sincos
 from .dynamics import carry
 from .layout import C_AXIS, C_PHI, C_PRISMATIC
@@ -53,6 +53,7 @@ from .layout import C_AXIS, C_PHI, C_PRISMATIC
 __all__ = [
     "BLOCK",
     "FRICTION_WIDTH",
+    "first_order_filter",
     "first_order_lag",
     "momentum_terms",
     "momentum_terms_one",
@@ -235,6 +236,27 @@ def _update(D, n, S, t, p, u, po, uo, r, ro):
         r[ro + j] = rj
     S[1] = t
     return True
+
+
+@exact
+def first_order_filter(gam, x, zi, out):
+    """``x`` (m, n, r) through ``gam / (1 + (gam - 1) z^-1)`` along its first axis, ``gam``
+    (n,) a filter per joint, from the state ``zi`` (n, r) (updated) into ``out`` (m, n, r):
+    the transposed direct form ``y = gam x + z``, ``z = 0 x - (gam - 1) y``, the operations
+    of ``scipy.signal.lfilter([gam], [1, gam - 1])`` in its order, without fused
+    multiply-adds (the same numbers, bit for bit)."""
+    m, n, r = x.shape
+    for j in range(n):
+        g = gam[j]
+        a1 = g - 1.0
+        for c in range(r):
+            z = zi[j, c]
+            for k in range(m):
+                xk = x[k, j, c]
+                y = z + g * xk
+                out[k, j, c] = y
+                z = xk * 0.0 - y * a1
+            zi[j, c] = z
 
 
 @jit
