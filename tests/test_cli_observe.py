@@ -101,6 +101,17 @@ def calibrated_without_velocities(logs):
     return code, out, err, result
 
 
+@pytest.fixture(scope="module")
+def panda_thresholds(logs):
+    """thresholds.json of the robot's own parameters and friction (``--params panda``)
+    calibrated on the free log without figures (the tests that detect with them share one
+    run)."""
+    out = logs / "calp"
+    cal = ["observe", "--params", "panda", "-q", "--no-figures", "--calibrate"]
+    assert main([*cal, "--data", str(logs / "free.csv"), "--out", str(out)]) == 0
+    return out / "thresholds.json"
+
+
 def test_observe_calibrates_then_finds_both_simulated_contacts(logs, calibrated, capsys):
     """thresholds.json from the free log (with the model's uncertainty), then events.json
     (dynid-events/1) with the two contacts at their times, residuals.csv with the wrench at
@@ -132,16 +143,15 @@ def test_observe_calibrates_then_finds_both_simulated_contacts(logs, calibrated,
     assert "RMS r - tau_ext [N m]" in said.out and "ground truth" in said.out
 
 
-def test_observe_with_a_consistent_robot_raises_no_event_on_a_free_log(logs):
+def test_observe_with_a_consistent_robot_raises_no_event_on_a_free_log(logs, panda_thresholds):
     """--params panda (the robot's own parameters and friction): thresholds from one free
     log, no event on the same motion's log with other noise."""
     d = logs
     sim = ["simulate", "--robot", "panda", "--trajectory", "fourier", "-q", "--duration", "6"]
     assert main([*sim, "--seed", "2", "--noise", "0.06", "--out", str(d / "free2.csv")]) == 0
     p = ["observe", "--params", "panda", "-q"]
-    assert main([*p, "--data", str(d / "free.csv"), "--calibrate", "--out", str(d / "calp")]) == 0
-    assert load_thresholds(d / "calp" / "thresholds.json").k_sigma is None
-    th = ["--thresholds", str(d / "calp" / "thresholds.json")]
+    assert load_thresholds(panda_thresholds).k_sigma is None
+    th = ["--thresholds", str(panda_thresholds)]
     assert main([*p, *th, "--data", str(d / "free2.csv"), "--out", str(d / "obsp")]) == 0
     assert json.loads((d / "obsp" / "events.json").read_text())["events"] == []
 
@@ -407,7 +417,7 @@ def _answer(page: str) -> str:
 
 @pytest.mark.filterwarnings("ignore:.*of each piece:UserWarning")
 def test_delays_of_derived_velocities_carry_their_caveat_beside_them(
-    logs, tmp_path, capsys, caplog
+    logs, panda_thresholds, tmp_path, capsys, caplog
 ):
     """A log without velocity columns: the delays come from a zero-phase low-pass that sees
     ahead, and the printed score line, events.json's score and the report's delay sentence
@@ -420,10 +430,7 @@ def test_delays_of_derived_velocities_carry_their_caveat_beside_them(
     d = logs
     _without_velocities(d / "hit.csv", tmp_path / "hit_q.csv", columns=22)
     p = ["observe", "--params", "panda", "--no-figures"]
-    assert (
-        main([*p, "--data", str(d / "free.csv"), "--calibrate", "--out", str(tmp_path / "c")]) == 0
-    )
-    th = ["--thresholds", str(tmp_path / "c" / "thresholds.json")]
+    th = ["--thresholds", str(panda_thresholds)]
     said = {}
     for name in ("hit_q.csv", "hit.csv"):
         src = tmp_path / name if name == "hit_q.csv" else d / name
@@ -527,7 +534,9 @@ def test_the_friction_recipe_carries_the_robot_and_log_options_given():
     assert str(fr.model) == "id.json" and fr.robot is None and fr.tip is None
 
 
-def test_a_detection_flagging_most_of_the_log_says_the_model_is_off(logs, tmp_path, capsys):
+def test_a_detection_flagging_most_of_the_log_says_the_model_is_off(
+    logs, panda_thresholds, tmp_path, capsys
+):
     """Regression: a model 3 N m of Coulomb friction off the arm's (thresholds of the
     exact model) raised events over most of the log with no word that this is the
     model's error; now a note says what share the events cover and to check the model."""
@@ -538,8 +547,7 @@ def test_a_detection_flagging_most_of_the_log_says_the_model_is_off(logs, tmp_pa
     wrong = ClassicalFriction(np.zeros(7), np.full(7, 3.0), np.zeros(7))
     save_toml(tmp_path / "off.toml", panda().with_friction(wrong))
     p = ["observe", "--no-figures", "--data", str(logs / "free.csv")]
-    assert main([*p, "--params", "panda", "--calibrate", "--out", str(tmp_path / "c")]) == 0
-    th = ["--thresholds", str(tmp_path / "c" / "thresholds.json")]
+    th = ["--thresholds", str(panda_thresholds)]
     capsys.readouterr()
     assert (
         main([*p, "--params", str(tmp_path / "off.toml"), *th, "--out", str(tmp_path / "d")]) == 0
