@@ -368,8 +368,11 @@ def obstacle_capsule_distances(
     rad = model.radii[2:]
     out = []
     for pl in obstacles.planes:
-        nrm, p0 = np.asarray(pl.normal), np.asarray(pl.point)
-        out.append(np.einsum("...i,i->...", seg - p0, nrm).min(axis=-1) - rad)
+        nrm, p0 = pl.normal, pl.point
+        d = seg - np.asarray(p0)
+        # the products summed (x + z) + y, as numpy's einsum sums three: a third of its time
+        h = (d[..., 0] * nrm[0] + d[..., 2] * nrm[2]) + d[..., 1] * nrm[1]
+        out.append(np.minimum(h[..., 0], h[..., 1]) - rad)
     if obstacles.boxes:
         u = np.linspace(0.0, 1.0, BOX_SAMPLES)
         pts = seg[..., :1, :] + u[:, None] * (seg[..., 1:2, :] - seg[..., :1, :])  # (..., c, S, 3)
