@@ -11,7 +11,7 @@ import dataclasses
 from collections.abc import Callable, Hashable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from functools import partial
+from functools import lru_cache, partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -120,7 +120,14 @@ def friction_regressor(dq: NDArray[np.float64]) -> NDArray[np.float64]:
 
     ``F[..., j, 3 j : 3 j + 3] = (dq_j, sign(dq_j), 1)``; zero elsewhere.
     """
-    return LinearFriction(Drive.identity(dq.shape[-1])).torque_columns(dq, dq, dq)
+    return _joint_friction(dq.shape[-1]).torque_columns(dq, dq, dq)
+
+
+@lru_cache(maxsize=16)
+def _joint_friction(n: int) -> LinearFriction:
+    """The classical friction of ``n`` joints without a transmission, built once per ``n``
+    (frozen; checking its drive costs more than the columns of a short trajectory)."""
+    return LinearFriction(Drive.identity(n))
 
 
 def log_blocks(

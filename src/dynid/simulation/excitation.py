@@ -139,7 +139,7 @@ class ExcitationOptions:
     max_iter : int
         L-BFGS-B iterations (60).
     max_evaluations : int
-        Objective evaluations allowed to L-BFGS-B (6000; about 14 ms each for the Panda).
+        Objective evaluations allowed to L-BFGS-B (6000; about 2 ms each for the Panda).
     n_starts : int
         Random candidates the start is chosen from (16).
     fs_regressor, fs_limits, fs_collision : float
@@ -338,24 +338,42 @@ class ExcitationResult:
 def _first_max(a: NDArray[np.float64]) -> NDArray[np.float64]:
     """``a.max(axis=0)`` of a batch-first array (N, ...) reduced along a contiguous copy:
     several times faster for N samples of a few columns, the same values."""
-    return np.ascontiguousarray(np.moveaxis(a, 0, -1)).max(axis=-1)
+    return _samples_last(a).max(axis=-1)
 
 
 def _first_min(a: NDArray[np.float64]) -> NDArray[np.float64]:
     """``a.min(axis=0)``, as :func:`_first_max`."""
-    return np.ascontiguousarray(np.moveaxis(a, 0, -1)).min(axis=-1)
+    return _samples_last(a).min(axis=-1)
+
+
+def _samples_last(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A contiguous copy of ``a`` (N, ...) with the samples' axis last (a transpose of the
+    usual (N, k) without ``moveaxis``'s checks, called thousands of times)."""
+    return np.ascontiguousarray(a.T if a.ndim == 2 else np.moveaxis(a, 0, -1))
 
 
 def _classical_regressor(
     robot: Robot, base: BaseParameters, traj: Trajectory
 ) -> NDArray[np.float64]:
     """``[Y_b, F]`` stacked sample-major (N n, r + 3 n)."""
-    Y = torque_regressor_prepared(robot, traj.q, traj.dq, traj.ddq, robot.gravity)
-    F = friction_regressor(np.asarray(traj.dq))
-    r = len(base.independent)
-    W: NDArray[np.float64] = np.empty((*Y.shape[:-1], r + F.shape[-1]))
-    np.take(Y, base.independent, axis=-1, out=W[..., :r])  # twice as fast as Y[..., idx]
-    W[..., r:] = F
+    return _regressor_of(robot, base, np.asarray(traj.q), np.asarray(traj.dq), np.asarray(traj.ddq))
+
+
+def _regressor_of(
+    robot: Robot,
+    base: BaseParameters,
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """:func:`_classical_regressor` of validated (N, n) samples [rad, rad/s, rad/s^2]: the
+    base columns written by the regressor straight into the first ``r`` of a contiguous
+    (N, n, r + 3 n) array (no gather into a strided slice), the friction columns after."""
+    r, n = len(base.independent), q.shape[-1]
+    W = torque_regressor_prepared(
+        robot, q, dq, ddq, robot.gravity, columns=base.independent, width=r + 3 * n
+    )
+    W[..., r:] = friction_regressor(dq)
     return W.reshape(-1, W.shape[-1])
 
 
@@ -408,12 +426,23 @@ def _motor_torques(robot: Robot, tr: Trajectory, drive: Drive | None = None) -> 
     drive puts it: at the motors, ``K^T f(K dq)``, for a drive whose friction acts there,
     :func:`~dynid.friction.model.robot_friction`) and, with a drive of known rotor
     inertias, their reflected torques ``K^T diag(I_a) K ddq``."""
-    tau = rnea(robot, tr.q, tr.dq, tr.ddq)
+    return _torques_of(robot, np.asarray(tr.q), np.asarray(tr.dq), np.asarray(tr.ddq), drive)
+
+
+def _torques_of(
+    robot: Robot,
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    drive: Drive | None = None,
+) -> NDArray[np.float64]:
+    """:func:`_motor_torques` of validated (N, n) samples [rad, rad/s, rad/s^2]."""
+    tau = rnea(robot, q, dq, ddq)
     friction = robot.friction if drive is None else robot_friction(robot, drive)
     if friction is not None:
-        tau = tau + friction.torques(tr.dq)
+        tau = tau + friction.torques(dq)
     if drive is not None and drive.rotor_inertia is not None:
-        tau = tau + drive.rotor_torques(np.asarray(tr.ddq), drive.rotor_inertia)
+        tau = tau + drive.rotor_torques(ddq, drive.rotor_inertia)
     return tau
 
 
@@ -564,14 +593,20 @@ class _Problem:
             self.w_f, c[:, : self.L], c[:, self.L :], q0, self.opts.duration, self.opts.ramp
         )
 
-    def _traj(self, B: tuple, c: NDArray, q0: NDArray, t: NDArray) -> Trajectory:
+    def _samples(self, B: tuple, c: NDArray, q0: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        """Positions, velocities and accelerations (N, n each) [rad, rad/s, rad/s^2] on the
+        grid of basis ``B``: finite by construction, so no :class:`Trajectory` checks them
+        (thousands of evaluations)."""
         Pq, Pd, Pa = B
-        return Trajectory(t=t, q=q0 + Pq @ c.T, dq=Pd @ c.T, ddq=Pa @ c.T)
+        return q0 + Pq @ c.T, Pd @ c.T, Pa @ c.T
+
+    def regressor(self, c: NDArray, q0: NDArray) -> NDArray[np.float64]:
+        """``[Y_b, F]`` on the regressor's grid (:func:`_classical_regressor`)."""
+        return _regressor_of(self.robot, self.base, *self._samples(self.B_reg, c, q0))
 
     def criterion(self, c: NDArray, q0: NDArray) -> float:
         """The criterion on the regressor's grid (:func:`_criterion`)."""
-        tr = self._traj(self.B_reg, c, q0, self.t_reg)
-        return _criterion(_classical_regressor(self.robot, self.base, tr), self.opts.criterion)
+        return _criterion(self.regressor(c, q0), self.opts.criterion)
 
     def objective(self, x: NDArray[np.float64]) -> float:
         self.evaluations += 1
@@ -583,8 +618,8 @@ class _Problem:
     def penalty(self, c: NDArray, q0: NDArray) -> float:
         pen = 0.0
         if np.any(np.isfinite(self.tmax)):
-            tr = self._traj(self.B_lim, c, q0, self.t_lim)
-            tau = _first_max(np.abs(_motor_torques(self.robot, tr, self.drive)))
+            samples = self._samples(self.B_lim, c, q0)
+            tau = _first_max(np.abs(_torques_of(self.robot, *samples, self.drive)))
             with np.errstate(invalid="ignore"):
                 v = np.where(np.isfinite(self.tmax), (tau - self.tmax) / self.tmax, 0.0)
             pen += float(np.sum(np.maximum(v, 0.0) ** 2))
@@ -749,8 +784,7 @@ def optimise_excitation(
     def callback(xk: NDArray[np.float64]) -> None:
         # the unscaled condition number (the objective adds the penalties)
         c, q0 = prob.coefficients(xk)
-        tr = prob._traj(prob.B_reg, c, q0, prob.t_reg)
-        cond = float(_conds(_classical_regressor(robot, base, tr))[0])
+        cond = float(_conds(prob.regressor(c, q0))[0])
         history.append(cond)
         best.offer(xk)
         if progress is not None:
