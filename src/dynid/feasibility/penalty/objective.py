@@ -69,22 +69,25 @@ DEFAULT_MARGIN = 1e-6
 DEFAULT_SCALE_FLOOR = 1e-3
 
 _IU = np.array([0, 1, 2, 1, 3, 4, 2, 4, 5])  # (6,) -> 3x3 symmetric, row-major
+#: phi_from_params: I_xx, I_yy, I_zz gain m (c_b^2 + c_c^2); I_xy, I_xz, I_yz lose m c_a c_b
+_DIAG, _OFF = np.array([4, 7, 9]), np.array([5, 6, 8])
+_PAIR_A = np.array([1, 2, 0, 2, 0, 1, 0, 0, 1])
+_PAIR_B = np.array([1, 2, 0, 2, 0, 1, 1, 2, 2])
+_HALF_TRACE = np.array([0.5, 0.0, 0.0, 0.5, 0.0, 0.5])  # d(tr I / 2) / d(xx, xy, ..., zz)
 
 
 def phi_from_params(p: NDArray[np.float64]) -> NDArray[np.float64]:
     """Standard parameters (n, 10) from decision parameters (n, 10) (validated input)."""
     m, c = p[:, 0], p[:, 1:4]
     mc = m[:, None] * c
+    # (m c_a) c_b for the pairs (a, b) of _PAIR_A/_PAIR_B: the diagonal's two terms each,
+    # then the products of the products of inertia
+    mcc = mc[:, _PAIR_A] * c[:, _PAIR_B]
     phi = np.empty_like(p)
     phi[:, 0] = m
     phi[:, 1:4] = mc
-    phi[:, 4:] = p[:, 4:]
-    phi[:, 4] += mc[:, 1] * c[:, 1] + mc[:, 2] * c[:, 2]
-    phi[:, 5] -= mc[:, 0] * c[:, 1]
-    phi[:, 6] -= mc[:, 0] * c[:, 2]
-    phi[:, 7] += mc[:, 0] * c[:, 0] + mc[:, 2] * c[:, 2]
-    phi[:, 8] -= mc[:, 1] * c[:, 2]
-    phi[:, 9] += mc[:, 0] * c[:, 0] + mc[:, 1] * c[:, 1]
+    phi[:, _DIAG] = p[:, _DIAG] + (mcc[:, 0:6:2] + mcc[:, 1:6:2])
+    phi[:, _OFF] = p[:, _OFF] - mcc[:, 6:]
     return phi
 
 
@@ -230,17 +233,23 @@ class PenaltyProblem:
         return self._slacks_p(self.p_from_z(z))
 
     def _slacks_p(self, p: NDArray[np.float64]) -> NDArray[np.float64]:
+        n = self.n
         lam = self._eig(p, False)
         sI = self.inertia_scale
         d = self.margin
-        out = [d - 0.5 * (lam[:, 0] + lam[:, 1] - lam[:, 2]) / sI, d - lam[:, 0] / sI]
+        out = np.empty(self.n_constraints)
+        out[:n] = d - 0.5 * (lam[:, 0] + lam[:, 1] - lam[:, 2]) / sI
+        out[n : 2 * n] = d - lam[:, 0] / sI
+        k = 2 * n
         if self.total_mass is not None:
             lo, hi = self.total_mass
             M = float(p[:, 0].sum())
-            out.append(np.array([d - (M - lo) / hi, d - (hi - M) / hi]))
-        if self.extra:
-            out.append(np.array([max(0.0, float(uc.violation(p.copy()))) for uc in self.extra]))
-        return np.concatenate(out)
+            out[k], out[k + 1] = d - (M - lo) / hi, d - (hi - M) / hi
+            k += 2
+        for uc in self.extra:
+            out[k] = max(0.0, float(uc.violation(p.copy())))
+            k += 1
+        return out
 
     def violations(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
         """Scaled violation distances ``g_j = max(0, slack_j) >= 0`` (eq. 32)."""
@@ -277,15 +286,14 @@ class PenaltyProblem:
             x, y, zz = v[:, 0], v[:, 1], v[:, 2]
             return np.stack([x * x, 2 * x * y, 2 * x * zz, y * y, 2 * y * zz, zz * zz], axis=1)
 
-        half_tr = np.tile([0.5, 0.0, 0.0, 0.5, 0.0, 0.5], (n, 1))
-        dT = half_tr - d_lam(V[:, :, 2])  # d(tr/2 - lambda_max)
+        dT = _HALF_TRACE - d_lam(V[:, :, 2])  # d(tr/2 - lambda_max)
         dP = d_lam(V[:, :, 0])  # d lambda_min
-        for i in range(n):
-            cols = slice(10 * i + 4, 10 * i + 10)
-            if act[i]:
-                K[i, cols] = -dT[i] / sI[i]
-            if act[n + i]:
-                K[n + i, cols] = -dP[i] / sI[i]
+        Kl = K[: 2 * n].reshape(2 * n, n, 10)  # a view: row j, link i, field
+        links = np.arange(n)
+        on = act[:n]
+        Kl[links[on], links[on], 4:] = -dT[on] / sI[on, None]
+        on = act[n : 2 * n]
+        Kl[n + links[on], links[on], 4:] = -dP[on] / sI[on, None]
         k = 2 * n
         if self.total_mass is not None:
             hi = self.total_mass[1]
