@@ -69,20 +69,6 @@ DEFAULT_MARGIN = 1e-6
 DEFAULT_SCALE_FLOOR = 1e-3
 
 _IU = np.array([0, 1, 2, 1, 3, 4, 2, 4, 5])  # (6,) -> 3x3 symmetric, row-major
-#: phi_from_params: I_xx, I_yy, I_zz gain m (c_b^2 + c_c^2); I_xy, I_xz, I_yz lose m c_a c_b
-_DIAG, _OFF = np.array([4, 7, 9]), np.array([5, 6, 8])
-_PAIR_A = np.array([1, 2, 0, 2, 0, 1, 0, 0, 1])
-_PAIR_B = np.array([1, 2, 0, 2, 0, 1, 1, 2, 2])
-#: _phi_jacobian: its constant entries (d m / dm, d I / dI), then where each term goes
-_J_CONSTANT = np.zeros((10, 10))
-_J_CONSTANT[0, 0] = 1.0
-_J_CONSTANT[np.arange(4, 10), np.arange(4, 10)] = 1.0
-_COM = np.array([1, 2, 3])
-_DIAG_A, _DIAG_B = np.array([1, 0, 0]), np.array([2, 2, 1])
-_OFF_A, _OFF_B = np.array([0, 0, 1]), np.array([1, 2, 2])
-_TWICE_ROW, _TWICE_COL = np.array([4, 4, 7, 7, 9, 9]), np.array([2, 3, 1, 3, 1, 2])
-_MINUS_ROW, _MINUS_COL = np.array([5, 5, 6, 6, 8, 8]), np.array([1, 2, 1, 3, 2, 3])
-_MINUS_C = np.array([1, 0, 2, 0, 2, 1])
 _HALF_TRACE = np.array([0.5, 0.0, 0.0, 0.5, 0.0, 0.5])  # d(tr I / 2) / d(xx, xy, ..., zz)
 
 
@@ -90,28 +76,42 @@ def phi_from_params(p: NDArray[np.float64]) -> NDArray[np.float64]:
     """Standard parameters (n, 10) from decision parameters (n, 10) (validated input)."""
     m, c = p[:, 0], p[:, 1:4]
     mc = m[:, None] * c
-    # (m c_a) c_b for the pairs (a, b) of _PAIR_A/_PAIR_B: the diagonal's two terms each,
-    # then the products of the products of inertia
-    mcc = mc[:, _PAIR_A] * c[:, _PAIR_B]
     phi = np.empty_like(p)
     phi[:, 0] = m
     phi[:, 1:4] = mc
-    phi[:, _DIAG] = p[:, _DIAG] + (mcc[:, 0:6:2] + mcc[:, 1:6:2])
-    phi[:, _OFF] = p[:, _OFF] - mcc[:, 6:]
+    phi[:, 4:] = p[:, 4:]
+    phi[:, 4] += mc[:, 1] * c[:, 1] + mc[:, 2] * c[:, 2]
+    phi[:, 5] -= mc[:, 0] * c[:, 1]
+    phi[:, 6] -= mc[:, 0] * c[:, 2]
+    phi[:, 7] += mc[:, 0] * c[:, 0] + mc[:, 2] * c[:, 2]
+    phi[:, 8] -= mc[:, 1] * c[:, 2]
+    phi[:, 9] += mc[:, 0] * c[:, 0] + mc[:, 1] * c[:, 1]
     return phi
 
 
 def _phi_jacobian(p: NDArray[np.float64]) -> NDArray[np.float64]:
     """d phi_i / d p_i per link, shape (n, 10, 10)."""
-    m, c = p[:, 0], p[:, 1:4]
-    sq = c * c
-    J = np.repeat(_J_CONSTANT[None], p.shape[0], axis=0)
-    J[:, 1:4, 0] = c
-    J[:, _COM, _COM] = m[:, None]
-    J[:, _DIAG, 0] = sq[:, _DIAG_A] + sq[:, _DIAG_B]  # d I_aa / dm = c_b^2 + c_c^2
-    J[:, _OFF, 0] = -c[:, _OFF_A] * c[:, _OFF_B]  # d I_ab / dm = -c_a c_b
-    J[:, _TWICE_ROW, _TWICE_COL] = 2 * m[:, None] * c[:, _TWICE_COL - 1]  # 2 m c_b
-    J[:, _MINUS_ROW, _MINUS_COL] = -m[:, None] * c[:, _MINUS_C]  # -m c_b
+    n = p.shape[0]
+    m, cx, cy, cz = p[:, 0], p[:, 1], p[:, 2], p[:, 3]
+    J = np.zeros((n, 10, 10))
+    J[:, 0, 0] = 1.0
+    for a in range(3):
+        J[:, 1 + a, 0] = p[:, 1 + a]
+        J[:, 1 + a, 1 + a] = m
+    J[:, 4, 0] = cy * cy + cz * cz
+    J[:, 5, 0] = -cx * cy
+    J[:, 6, 0] = -cx * cz
+    J[:, 7, 0] = cx * cx + cz * cz
+    J[:, 8, 0] = -cy * cz
+    J[:, 9, 0] = cx * cx + cy * cy
+    J[:, 4, 2], J[:, 4, 3] = 2 * m * cy, 2 * m * cz
+    J[:, 5, 1], J[:, 5, 2] = -m * cy, -m * cx
+    J[:, 6, 1], J[:, 6, 3] = -m * cz, -m * cx
+    J[:, 7, 1], J[:, 7, 3] = 2 * m * cx, 2 * m * cz
+    J[:, 8, 2], J[:, 8, 3] = -m * cz, -m * cy
+    J[:, 9, 1], J[:, 9, 2] = 2 * m * cx, 2 * m * cy
+    idx = np.arange(4, 10)
+    J[:, idx, idx] = 1.0
     return J
 
 
