@@ -112,7 +112,7 @@ def _refine(
             ok = True
             for _ in range(5):
                 free = ~fixed
-                Hf = H[free][:, free]
+                Hf = H.copy() if free.all() else H[np.ix_(free, free)]
                 Hf.flat[:: Hf.shape[0] + 1] += lam  # H + lam E on the free variables
                 try:
                     L = np.linalg.cholesky(Hf)

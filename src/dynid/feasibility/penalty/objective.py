@@ -69,6 +69,7 @@ DEFAULT_MARGIN = 1e-6
 DEFAULT_SCALE_FLOOR = 1e-3
 
 _IU = np.array([0, 1, 2, 1, 3, 4, 2, 4, 5])  # (6,) -> 3x3 symmetric, row-major
+_HALF_TRACE = np.array([0.5, 0.0, 0.0, 0.5, 0.0, 0.5])  # d(tr I / 2) / d(xx, xy, ..., zz)
 
 
 def phi_from_params(p: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -230,17 +231,23 @@ class PenaltyProblem:
         return self._slacks_p(self.p_from_z(z))
 
     def _slacks_p(self, p: NDArray[np.float64]) -> NDArray[np.float64]:
+        n = self.n
         lam = self._eig(p, False)
         sI = self.inertia_scale
         d = self.margin
-        out = [d - 0.5 * (lam[:, 0] + lam[:, 1] - lam[:, 2]) / sI, d - lam[:, 0] / sI]
+        out = np.empty(self.n_constraints)
+        out[:n] = d - 0.5 * (lam[:, 0] + lam[:, 1] - lam[:, 2]) / sI
+        out[n : 2 * n] = d - lam[:, 0] / sI
+        k = 2 * n
         if self.total_mass is not None:
             lo, hi = self.total_mass
             M = float(p[:, 0].sum())
-            out.append(np.array([d - (M - lo) / hi, d - (hi - M) / hi]))
-        if self.extra:
-            out.append(np.array([max(0.0, float(uc.violation(p.copy()))) for uc in self.extra]))
-        return np.concatenate(out)
+            out[k], out[k + 1] = d - (M - lo) / hi, d - (hi - M) / hi
+            k += 2
+        for uc in self.extra:
+            out[k] = max(0.0, float(uc.violation(p.copy())))
+            k += 1
+        return out
 
     def violations(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
         """Scaled violation distances ``g_j = max(0, slack_j) >= 0`` (eq. 32)."""
@@ -277,15 +284,14 @@ class PenaltyProblem:
             x, y, zz = v[:, 0], v[:, 1], v[:, 2]
             return np.stack([x * x, 2 * x * y, 2 * x * zz, y * y, 2 * y * zz, zz * zz], axis=1)
 
-        half_tr = np.tile([0.5, 0.0, 0.0, 0.5, 0.0, 0.5], (n, 1))
-        dT = half_tr - d_lam(V[:, :, 2])  # d(tr/2 - lambda_max)
+        dT = _HALF_TRACE - d_lam(V[:, :, 2])  # d(tr/2 - lambda_max)
         dP = d_lam(V[:, :, 0])  # d lambda_min
-        for i in range(n):
-            cols = slice(10 * i + 4, 10 * i + 10)
-            if act[i]:
-                K[i, cols] = -dT[i] / sI[i]
-            if act[n + i]:
-                K[n + i, cols] = -dP[i] / sI[i]
+        Kl = K[: 2 * n].reshape(2 * n, n, 10)  # a view: row j, link i, field
+        links = np.arange(n)
+        on = act[:n]
+        Kl[links[on], links[on], 4:] = -dT[on] / sI[on, None]
+        on = act[n : 2 * n]
+        Kl[n + links[on], links[on], 4:] = -dP[on] / sI[on, None]
         k = 2 * n
         if self.total_mass is not None:
             hi = self.total_mass[1]
