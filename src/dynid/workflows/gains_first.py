@@ -80,12 +80,16 @@ class CorrectedSearch:
         efforts).
     why : str
         Why the constants were judged first (:func:`reason_to_judge_first`).
+    said : tuple of warnings.WarningMessage
+        The search's warnings but those of its rotor inertias (a model not kept), for the
+        caller to say once beside the kept model's own.
     """
 
     gains: DriveGains
     drive: Drive
     searched: IdentifiedModel
     why: str = ""
+    said: tuple[warnings.WarningMessage, ...] = ()
 
     @property
     def structure(self) -> Structure:
@@ -187,7 +191,5 @@ def gains_first(
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         searched = fit("auto", corrected)
-    for w in said:  # the search's findings, but the rotor inertias of a model not kept
-        if not str(w.message).startswith("the identified rotor inertia"):
-            warnings.warn(w.message, w.category, stacklevel=2)
-    return CorrectedSearch(gains, corrected, searched, why)
+    kept = tuple(w for w in said if not str(w.message).startswith("the identified rotor inertia"))
+    return CorrectedSearch(gains, corrected, searched, why, kept)

@@ -530,7 +530,10 @@ def _searched(
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return model, held
-    model = fitted(first.structure, drive)
+    with warnings.catch_warnings(record=True) as refitted:
+        warnings.simplefilter("always")
+        model = fitted(first.structure, drive)
+    _say_once((*first.said, *refitted))
     info = dataclasses.replace(
         model.info,
         selection=first.searched.info.selection,
@@ -542,6 +545,17 @@ def _searched(
     if held is not None:  # one judgement of the efforts' scale
         held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
     return model, held
+
+
+def _say_once(said: Sequence[warnings.WarningMessage]) -> None:
+    """Warn each of ``said`` whose category and text no earlier one had (the corrected
+    search and the refit of its structure find the same things)."""
+    seen: set[tuple[type[Warning], str]] = set()
+    for w in said:
+        key = (w.category, str(w.message))
+        if key not in seen:
+            seen.add(key)
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def _with_torque_delay(
