@@ -111,9 +111,10 @@ def format_identification(
         f"{len(groups['unidentifiable'])} unidentifiable"
         + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
     )
-    head += recordings_lines(info.recordings) + selection_lines(info.selection)
-    first = info.extra.get("gains_first")  # why the torque constants were judged first
-    head += [f"note: {first}"] if isinstance(first, str) else []
+    head += recordings_lines(info.recordings)
+    first = info.extra.get("gains_first")  # why the torque constants were judged first:
+    head += [f"note: {first}"] if isinstance(first, str) else []  # before the table it explains
+    head += selection_lines(info.selection)
     lw = text_width("name", model.base.labels[: model.base.rank], 7)
     head.append(f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}  kept  expression")
     rows = []
