@@ -153,7 +153,7 @@ def test_validate_of_a_model_asks_to_identify_again(panda, files, tmp_path, monk
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         got = validate_files(model, data)
-    assert "hint: identify it again with --torque-delay 5, then validate" in got.verdict.reason
+    assert "hint: identify it again with --torque-delay 5.00, then validate" in got.verdict.reason
     assert "beyond the 3.0 ms the logs were prepared with" in got.verdict.reason
 
 
@@ -162,9 +162,21 @@ def test_refit_hint_adds_the_applied_delay() -> None:
     a robot's (no refit) pairs the torques with --torque-delay."""
     d = TorqueDelay(0.001, 1e-5, 0.05, (), ())
     refit = d.sentence(0.002, refit=True)
-    assert "identify it again with --torque-delay 3," in refit
+    assert "identify it again with --torque-delay 3.00," in refit
     assert "beyond the 2.0 ms" in refit
-    assert "hint: --torque-delay 1 pairs" in d.sentence()
+    assert "hint: --torque-delay 1.00 pairs" in d.sentence()
+
+
+def test_a_delay_is_said_to_its_std_s_first_digit() -> None:
+    """2.056 +- 0.024 ms reads 2.06 +- 0.02 ms with the hint --torque-delay 2.06 (it read
+    2.1 ms, +- 0.02, and hinted 2.1); 2.4 +- 0.3 ms reads 2.4 +- 0.3; 12 +- 3 ms reads 12."""
+    said = TorqueDelay(0.002056, 0.000024, 0.05, (), ()).sentence()
+    assert "lag the positions by 2.06 ms (+- 0.02 ms;" in said, said
+    assert "hint: --torque-delay 2.06 pairs" in said, said
+    said = TorqueDelay(0.0024, 0.0003, 0.05, (), ()).sentence()
+    assert "by 2.4 ms (+- 0.3 ms;" in said and "--torque-delay 2.4 pairs" in said, said
+    said = TorqueDelay(-0.012, 0.003, 0.05, (), ()).sentence()
+    assert "lead the positions by 12 ms (+- 3 ms;" in said and "--torque-delay -12 pairs" in said
 
 
 def test_observe_says_the_model_s_delay(files, tmp_path, capsys) -> None:

@@ -45,6 +45,7 @@ __all__ = [
     "AppliedDelay",
     "TorqueDelay",
     "applied_delay",
+    "delay_decimals",
     "ms_text",
     "torque_delay",
 ]
@@ -99,9 +100,10 @@ class TorqueDelay:
         bends to the lag), so that the remedy is to identify again with it."""
         ms, sd = 1e3 * self.delay_s, 1e3 * self.std_s
         late = "lag" if ms > 0 else "lead"
-        whole = 1e3 * applied_s + ms
+        d = delay_decimals(sd)  # the delay to its std's first digit (2.06 +- 0.03, not 2.1)
+        whole = f"{1e3 * applied_s + ms:.{d}f}"
         said = (
-            f"the torques {late} the positions by {abs(ms):.2g} ms (+- {sd:.1g} ms; "
+            f"the torques {late} the positions by {abs(ms):.{d}f} ms (+- {sd:.{d}f} ms; "
             f"{100 * self.share:.2g} % of the residual; a filtered sensor or the bus)"
         )
         if applied_s:
@@ -109,13 +111,13 @@ class TorqueDelay:
         if refit:
             return (
                 f"{said}: the model's coefficients were fitted to torques this late (viscous "
-                f"friction first); hint: identify it again with --torque-delay {whole:.2g}, "
-                f"then validate the new model (validate --torque-delay {whole:.2g} only pairs "
+                f"friction first); hint: identify it again with --torque-delay {whole}, "
+                f"then validate the new model (validate --torque-delay {whole} only pairs "
                 "this log's torques with its positions)"
             )
         return (
             f"{said}: the fit bends to it (viscous friction first); hint: --torque-delay "
-            f"{whole:.2g} pairs the torques with the positions they belong to before filtering"
+            f"{whole} pairs the torques with the positions they belong to before filtering"
         )
 
     @property
@@ -146,6 +148,15 @@ class TorqueDelay:
                 1e3 * s if c else None for s, c in zip(self.joints_std_s, clear, strict=True)
             ]
         return rec
+
+
+def delay_decimals(std_ms: float) -> int:
+    """The decimals [-] that show a delay to the first significant digit of its standard
+    deviation ``std_ms`` [ms] (0.024 -> 2, 0.4 -> 1, 3 -> 0; at most 4): the summary's,
+    the report's and the hint's ``--torque-delay``."""
+    if not np.isfinite(std_ms) or std_ms <= 0.0:
+        return 2
+    return int(min(max(-np.floor(np.log10(float(f"{std_ms:.1g}"))), 0), 4))
 
 
 def ms_text(ms: float) -> str:

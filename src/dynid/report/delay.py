@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..identification.torque_delay import SIGNIFICANT
+from ..identification.torque_delay import SIGNIFICANT, delay_decimals
 from .html import esc, is_number, number, section, table
 
 __all__ = ["delay_facts", "delay_section"]
@@ -51,11 +51,12 @@ def delay_facts(doc: Any) -> list[str]:
     if rec is None:
         return []
     ms, sd = float(rec["delay_ms"]), float(rec["std_ms"])
+    d = delay_decimals(sd)  # as the summary says it
     return [
         f"<b>The torques {'lag' if ms > 0 else 'lead'} the positions by "
-        f"{number(abs(ms), 2)} ms</b> (std {number(sd, 1)} ms): the residual's other hints "
+        f"{abs(ms):.{d}f} ms</b> (std {sd:.{d}f} ms): the residual's other hints "
         "below may be this lag, which follows the joints' velocities and accelerations; "
-        f"--torque-delay {number(ms, 2)} takes it out before filtering"
+        f"--torque-delay {ms:.{d}f} takes it out before filtering"
     ]
 
 
