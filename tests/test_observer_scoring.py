@@ -249,12 +249,7 @@ def test_labels_follow_the_log_past_rows_dropped_and_a_column_not_numbers(pushes
     t = load_torque_log(d / "hit.csv").t
     flags = ((t >= 0.8) & (t <= 1.1)) | ((t >= 3.5) & (t <= 3.7))
     _with_column(d / "hit.csv", d / "holes.csv", "contact", flags.astype(float))
-    lines = (d / "holes.csv").read_text().splitlines()
-    for k in (500, 2700):  # rows at 0.497 and 2.697 s, outside the pushes: NaN tau1
-        cells = lines[k].split(",")
-        cells[15] = "nan"
-        lines[k] = ",".join(cells)
-    (d / "holes.csv").write_text("\n".join(lines))
+    _nan_tau1(d / "holes.csv", d / "holes.csv")
     p = ["observe", "--params", "panda", "--no-figures", "--drop-invalid", "--thresholds"]
     p += [str(d / "cal" / "thresholds.json")]
     assert main([*p, "--data", str(d / "holes.csv"), "--out", str(d / "holes")]) == 0
@@ -267,6 +262,17 @@ def test_labels_follow_the_log_past_rows_dropped_and_a_column_not_numbers(pushes
     assert "(tau_ext > 0.1 N m;" in captured.out and "3 labelled, 3 detected" in captured.out
 
 
+def _nan_tau1(src, dst):
+    """``src`` written to ``dst`` with tau1 NaN in the rows at 0.497 and 2.697 s (outside
+    the pushes)."""
+    lines = src.read_text().splitlines()
+    for k in (500, 2700):
+        cells = lines[k].split(",")
+        cells[15] = "nan"
+        lines[k] = ",".join(cells)
+    dst.write_text("\n".join(lines))
+
+
 def test_true_torques_follow_the_log_past_rows_dropped(pushes, capsys):
     """Rows dropped for NaN (--drop-invalid) in a log scored by its true torques: tau_ext
     realigned with the rows kept by time, so the score and RMS r - tau_ext stay (they
@@ -275,12 +281,7 @@ def test_true_torques_follow_the_log_past_rows_dropped(pushes, capsys):
     from dynid.io.torque_log import load_torque_log
 
     d = pushes
-    lines = (d / "hit.csv").read_text().splitlines()
-    for k in (500, 2700):  # rows at 0.497 and 2.697 s, outside the pushes: NaN tau1
-        cells = lines[k].split(",")
-        cells[15] = "nan"
-        lines[k] = ",".join(cells)
-    (d / "nan.csv").write_text("\n".join(lines))
+    _nan_tau1(d / "hit.csv", d / "nan.csv")
     p = ["observe", "--params", "panda", "--no-figures", "--drop-invalid", "--thresholds"]
     p += [str(d / "cal" / "thresholds.json")]
     assert main([*p, "--data", str(d / "nan.csv"), "--out", str(d / "nan")]) == 0
