@@ -216,3 +216,36 @@ def test_spikes_replaced_before_the_held_out_verdict_are_said_once(tmp_path):
         h.write_text(json.dumps(held | {"verdict": verdict | {"reason": said}}))
         box = _box(render_html_report(RunSummary(command="identify"), files))
         assert box.count("3 one-sample torque spike(s) replaced") == count, box
+
+
+def test_a_spring_the_verdict_does_not_name_stays_out_of_the_answer_box():
+    """A file whose fit names a spring on joint 3 while the verdict lists the joint and
+    gives a tilted base as the cause (as validate said of a tilted UR5 log 2 ms late):
+    no spring fact, as the summary says none; with the verdict's spring clause, the fact
+    and its hint; a joint past the joints the reason lists keeps its fact."""
+    from dynid.report.springs import spring_facts
+
+    names = ["j1", "j2", "j3"]
+    springs = {
+        "stiffness": [0.01, -0.06, 0.09],
+        "std": [0.01, 0.01, 0.01],
+        "torque": [0.001, 0.01, 0.02],
+        "systematic": [0.001, 0.02, 0.03],
+        "named": [2],
+    }
+    tilted = (
+        "error 0.489 %; joint(s) j2 at 2.96 x, j3 at 1.47 x their noise: effects outside "
+        "the model remain there; the gravity vector (base mounting) looks tilted by about "
+        "0.38 deg about x"
+    )
+    doc = {"joint_names": names, "springs": springs, "verdict": {"reason": tilted}}
+    assert spring_facts(doc) == []
+    named = "error 1 %; j3: a spring of about 0.09 N m/rad (add spring to --terms)"
+    doc["verdict"] = {"reason": named}
+    (fact,) = spring_facts(doc)
+    assert "A spring on j3" in fact and "What to do: add spring to --terms" in fact
+    doc["verdict"] = {
+        "reason": "error 1 %; j1 at 3 x their noise (2 more joint(s) above their noise)"
+    }
+    (fact,) = spring_facts(doc)
+    assert "A spring on j3" in fact and "What to do" not in fact

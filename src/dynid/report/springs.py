@@ -69,10 +69,22 @@ def _hint(doc: dict, name: str) -> str | None:
     return None
 
 
+def _explained(doc: dict, name: str) -> bool:
+    """Whether the verdict's reason names joint ``name`` without a spring: its error
+    listed while the reason gives another cause (a tilted base, a torque constant), which
+    the summary says instead of the spring; False where the reason stops before the joint
+    (``N more joint(s)``)."""
+    v = doc.get("verdict")
+    reason = v.get("reason") if isinstance(v, dict) else None
+    return isinstance(reason, str) and re.search(rf"\b{re.escape(name)}\b", reason) is not None
+
+
 def spring_facts(doc: Any) -> list[str]:
     """One fact (HTML) per joint whose residual the spring explains: its stiffness with its
     standard deviation [N m/rad] and what to do (the verdict's hint); none without a
-    ``springs`` record."""
+    ``springs`` record, and none for a joint the verdict explains otherwise (it names the
+    joint but no spring there: a tilted base read beside a 2 ms delay had put a spring of
+    0.09 N m/rad in the report that the summary never said)."""
     rec = _record(doc)
     if rec is None:
         return []
@@ -81,6 +93,9 @@ def spring_facts(doc: Any) -> list[str]:
     names = _names(doc, n)
     facts = []
     for j in _named(rec, n):
+        hint = _hint(doc, names[j])
+        if hint is None and _explained(doc, names[j]):
+            continue  # the verdict names the joint with another cause (a tilt): as it says
         k, s = float(rec["stiffness"][j]), float(rec["std"][j])
         fact = (
             f"<b>A spring on {esc(names[j])}</b> outside the model: stiffness "
@@ -89,7 +104,6 @@ def spring_facts(doc: Any) -> list[str]:
             f" N m RMS against {number(rec['systematic'][j], 3)} N m RMS of residual above "
             "the noise"
         )
-        hint = _hint(doc, names[j])
         facts.append(fact + (f". What to do: {esc(hint)}" if hint else ""))
     return facts
 
