@@ -502,9 +502,9 @@ def _heldout(
     X = np.concatenate([A, B[:, ~active]], axis=1)
     scale = np.linalg.norm(X, axis=0)
     X = X / np.where(scale > 0, scale, 1.0)
+    Ba = B[:, active]
     for f in np.unique(labels):
         tr, te = rows != f, rows == f
-        Ba = B[:, active]
         fold = _Factored.of(X[tr])
         g = _smallest(Ba[tr], fold.Q, C[np.ix_(active, active)])[3]
         full = np.full(B.shape[1], np.nan)
@@ -636,12 +636,7 @@ def _column_space(A: NDArray[np.float64]) -> NDArray[np.float64]:
     scaled columns (relative tolerance :data:`_RANK_RTOL` on the diagonal)."""
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
-    import scipy.linalg
-
-    Q, R, _ = scipy.linalg.qr(A / scale, mode="economic", pivoting=True)
-    d = np.abs(np.diag(R))
-    rank = int(np.count_nonzero(d > _RANK_RTOL * max(float(d[0]) if d.size else 0.0, 1e-300)))
-    return np.asarray(Q[:, :rank], dtype=np.float64)
+    return _Factored.of(A / scale).Q
 
 
 def _noise_covariance(
