@@ -9,7 +9,17 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "dynid"
 
 #: Layers in data-flow order (ARCHITECTURE.md, "Layers").
 LAYERS = [
-    {"exceptions", "_checks", "_kernels", "_parallel", "_times", "progress", "spatial", "signals"},
+    {
+        "exceptions",
+        "_checks",
+        "_kernels",
+        "_memo",
+        "_parallel",
+        "_times",
+        "progress",
+        "spatial",
+        "signals",
+    },
     {"model"},
     {"kinematics"},
     {"dynamics"},

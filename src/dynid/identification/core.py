@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._memo import scoped, value_key
 from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -46,7 +47,6 @@ from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import HeldOut, cross_validate
 from .info import IdentificationInfo, Route
 from .least_squares import LeastSquaresFit, StdMethod, checked_std, conditioning_advice
-from .log_rows import _value_key
 from .model import IdentifiedModel, IdentifiedTerm
 from .serial import Serial
 from .stacking import (
@@ -133,14 +133,8 @@ def shared_bases() -> Iterator[None]:
     friction, not in their base: 13 regressors of a Panda log, 2 bases); the same
     numbers, each call its own arrays. Nested blocks share the outer one's; the bases are
     dropped at its end."""
-    if _BASES.get() is not None:
+    with scoped(_BASES, dict):
         yield
-        return
-    token = _BASES.set({})
-    try:
-        yield
-    finally:
-        _BASES.reset(token)
 
 
 def _structural_base(
@@ -152,7 +146,7 @@ def _structural_base(
     if held is None:
         return base_parameters(robot, kind=kind, rtol=rtol, terms=terms)
     try:  # what the base depends on: the robot (immutable), kind, rtol, terms in the base
-        extra = tuple((type(t).__qualname__, _value_key(t)) for t in terms if t.in_base)
+        extra = tuple((type(t).__qualname__, value_key(t)) for t in terms if t.in_base)
     except TypeError:  # a term that does not hash: computed each time
         return base_parameters(robot, kind=kind, rtol=rtol, terms=terms)
     key = (id(robot), kind, rtol, extra)

@@ -7,7 +7,6 @@ Khalil), and the known rotor torques of a drive are subtracted from the targets.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Hashable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -18,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks, signals
+from .._memo import scoped, value_key
 from ..exceptions import DataError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -71,29 +71,8 @@ def shared_steps() -> Iterator[None]:
     computed once and read back by every later regressor holding that term (the
     candidate structures' regressors share their friction terms): the same numbers, not
     recomputed. Nested blocks share the outer one's; the columns are dropped at its end."""
-    if _SHARED.get() is not None:
+    with scoped(_SHARED, _Shared):
         yield
-        return
-    token = _SHARED.set(_Shared())
-    try:
-        yield
-    finally:
-        _SHARED.reset(token)
-
-
-def _value_key(x: Any) -> Hashable:
-    """A hashable key of a term's field: arrays by shape, type and bytes, dataclasses by
-    their fields, tuples item by item."""
-    if isinstance(x, np.ndarray):
-        return ("array", x.shape, x.dtype.str, x.tobytes())
-    if dataclasses.is_dataclass(x) and not isinstance(x, type):
-        return (type(x).__qualname__,) + tuple(
-            _value_key(getattr(x, f.name)) for f in dataclasses.fields(x)
-        )
-    if isinstance(x, tuple | list):
-        return tuple(_value_key(v) for v in x)
-    hash(x)  # anything else must hash: TypeError otherwise (not shared)
-    return (type(x).__qualname__, x)
 
 
 class SteppingColumns(Protocol):
@@ -331,7 +310,7 @@ def _span_columns(
     keys: list[Hashable | None] = []
     for t in terms:
         try:
-            keys.append((type(t).__qualname__, _value_key(t), where))
+            keys.append((type(t).__qualname__, value_key(t), where))
         except TypeError:  # a term that does not hash: computed each time
             keys.append(None)
     got: list[NDArray[np.float64] | None] = [
