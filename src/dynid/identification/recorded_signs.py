@@ -301,14 +301,29 @@ def _left_over(
 class _OwnTerms:
     """One group's least-squares fit in :func:`_own_terms`: its motors (joints), per motor
     the coefficients ``fv, fc, fo, Ia`` (4,) and their covariance (4, 4) (white-noise
-    formula), the residual sum of squares ``left`` [N^2 m^2], and per motor the mean of
-    ``|v|`` and of ``v^2`` at its velocities ``v``."""
+    formula), the residual sum of squares ``left`` [N^2 m^2], per motor the mean of
+    ``|v|`` and of ``v^2`` at its velocities ``v``, and per motor the power [W] its
+    friction dissipates with its standard deviation (:func:`_power`: with that of the
+    joints it turns that no motor turns alone, a coupled wrist's last)."""
 
     motors: list[int]
     coef: NDArray[np.float64]
     cov: NDArray[np.float64]
     left: float
     speed: NDArray[np.float64]
+    power: NDArray[np.float64]
+
+
+def _shared_joints(Kf: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The joints (n,) no motor turns alone where friction acts (``Kf``, motors x joints):
+    a coupled wrist's joint whose motor turns the joint before it too. Friction at such a
+    joint (a description's, at the joints) is no motor's friction, and the motors' own
+    terms alone leave it (two clean recordings of a coupled wrist left 0.2 to 0.4 of the
+    sum of squares of one recording's motor 6 negated)."""
+    alone = (Kf != 0).sum(axis=1) == 1
+    covered = (Kf[alone] != 0).any(axis=0)
+    out: NDArray[np.bool_] = ~covered & (Kf != 0).any(axis=0)
+    return out
 
 
 def _own_terms(
@@ -319,11 +334,14 @@ def _own_terms(
 ) -> list[_OwnTerms]:
     """Each joint's (motor's) own viscous, Coulomb, offset and armature coefficients fitted
     to the residuals ``r`` (N, n), group by group (:func:`_motor_groups`: a coupled wrist's
-    joints together), as :func:`_left_over` describes."""
+    joints together), as :func:`_left_over` describes; in a coupled group, beside the
+    motors', the viscous and Coulomb friction of the joints no motor turns alone
+    (:func:`_shared_joints`), at the joint."""
     n = r.shape[1]
     Kf = np.eye(n) if drive is None else drive.friction_transmission
     K = np.eye(n) if drive is None else drive.transmission
     v, a = dq @ Kf.T, ddq @ K.T
+    shared = _shared_joints(Kf)
     out = []
     for joints, motors in _motor_groups((K != 0) | (Kf != 0)):
         cols = []
@@ -331,6 +349,10 @@ def _own_terms(
             for f in (v[:, k], np.sign(v[:, k]), np.ones(len(r))):
                 cols.append(f[:, None] * Kf[k, joints])
             cols.append(a[:, k, None] * K[k, joints])
+        extra = [j for j in joints if shared[j]] if len(joints) > 1 else []
+        for j in extra:  # friction at a joint no motor turns alone
+            at = np.asarray(joints) == j
+            cols += [dq[:, j, None] * at, np.sign(dq[:, j, None]) * at]
         X = np.stack(cols, axis=-1).reshape(len(r) * len(joints), len(cols))
         y = r[:, joints].reshape(-1)
         coef = np.linalg.lstsq(X, y, rcond=None)[0]
@@ -340,8 +362,18 @@ def _own_terms(
         m = len(motors)
         blocks = np.array([cov[4 * i : 4 * i + 4, 4 * i : 4 * i + 4] for i in range(m)])
         speed = np.array([[np.mean(np.abs(v[:, k])), np.mean(v[:, k] ** 2)] for k in motors])
-        coefs = np.asarray(coef, dtype=np.float64).reshape(m, 4)
-        out.append(_OwnTerms(motors, coefs, blocks, left, speed))
+        grads = np.zeros((m, len(cols)))  # d power / d coef, per motor
+        for i, k in enumerate(motors):
+            grads[i, 4 * i : 4 * i + 2] = speed[i, 1], speed[i, 0]
+            for e, j in enumerate(extra):
+                if Kf[k, j] != 0:
+                    c = 4 * m + 2 * e
+                    grads[i, c : c + 2] = np.mean(dq[:, j] ** 2), np.mean(np.abs(dq[:, j]))
+        power = np.array(
+            [[g @ coef, math.sqrt(max(float(g @ cov @ g), 0.0))] for g in grads], dtype=np.float64
+        ).reshape(m, 2)
+        coefs = np.asarray(coef[: 4 * m], dtype=np.float64).reshape(m, 4)
+        out.append(_OwnTerms(motors, coefs, blocks, left, speed, power))
     return out
 
 
@@ -376,9 +408,9 @@ def _own_signs(
 
 def _power(g: _OwnTerms, i: int) -> tuple[float, float]:
     """The power [W] the friction fitted to motor ``g.motors[i]`` dissipates at its speeds
-    (``fc mean|v| + fv mean(v^2)``) and its standard deviation."""
-    grad = np.array([g.speed[i, 1], g.speed[i, 0], 0.0, 0.0])  # d power / d coef
-    return float(grad @ g.coef[i]), math.sqrt(grad @ g.cov[i] @ grad)
+    (``fc mean|v| + fv mean(v^2)``, with that of the joints it turns that no motor turns
+    alone at theirs) and its standard deviation."""
+    return float(g.power[i, 0]), float(g.power[i, 1])
 
 
 @dataclass(frozen=True, slots=True)
