@@ -526,7 +526,10 @@ def opposite_friction_among(
     power = any(mine[k][0] < -z * mine[k][1] for k in motors)
     inertia = any(mine[k][2] < -z * mine[k][3] for k in motors)
     said = [
-        f"the friction of {named} fitted to {names[r]} puts energy into the arm" if power else "",
+        f"the friction of {named}{_with_shared(robot, drive, motors)} fitted to {names[r]} puts "
+        "energy into the arm"
+        if power
+        else "",
         (
             "its rotor inertia fitted there"
             if power
@@ -550,8 +553,9 @@ def opposite_friction_among(
     )
     return (
         f"{names[r]}: the torques of {named} have the opposite sign to {against}: {what}, "
-        f"while {where}: {names[r]} was likely logged with another sign convention (the "
-        f"links barely load {named}, so the check against the model's torques cannot tell); "
+        f"while {where}: {names[r]} was likely logged with another sign convention "
+        f"({_unseen(robot, drive, motors)}, so the check against the model's torques cannot "
+        "tell); "
         f"hint: --units {flip_entries(motors, names[r] if len(names) > 1 else None)} reads it "
         "flipped"
     )
@@ -598,14 +602,21 @@ def _pooled_fits(
 
 
 def _told(
-    fits: Sequence[tuple[float, float, float, float]], order: Sequence[int], z: float
+    fits: Sequence[tuple[float, float, float, float]],
+    order: Sequence[int],
+    z: float,
+    residual: bool = True,
 ) -> int | None:
     """Of the hypotheses ``fits`` (per recording negated: :func:`_pooled_fits`' values),
     ``order`` (best first), the recording the model tells negated: its negation leaves at
-    most :data:`TOLD_SHARE` of the next's and its friction does not push; or, the two
-    alike, the one whose friction dissipates where the other's pushes (beyond ``z``
+    most :data:`TOLD_SHARE` of the next's and its friction does not push (where the
+    residual tells, ``residual``: a description's torques, or a third recording); or, the
+    two alike, the one whose friction dissipates where the other's pushes (beyond ``z``
     standard deviations and :data:`DISSIPATION_SHARE` of its scale); None when neither
-    tells."""
+    tells. Two recordings of a description without inertial parameters differ in what
+    they leave by the links' torques neither holds: a coupled wrist without friction,
+    motor 5 negated in one of two 3 s recordings, left 0.45 with the other negated, and
+    the right file was named by chance."""
     b, c = order[0], order[1]
 
     def sign(fit: tuple[float, ...]) -> int:
@@ -613,7 +624,7 @@ def _told(
         return 0 if abs(p) <= max(z * sd, DISSIPATION_SHARE * scale) else int(np.sign(p))
 
     pb, pc = sign(fits[b]), sign(fits[c])
-    if fits[b][0] <= TOLD_SHARE * fits[c][0]:
+    if residual and fits[b][0] <= TOLD_SHARE * fits[c][0]:
         return b if pb >= 0 else None
     if pb > 0 > pc:
         return b
@@ -683,7 +694,7 @@ def opposite_among_pooled(
         order = sorted(range(len(kept)), key=lambda r: fits[r][0])
         if not fits[order[0]][0] <= DISAGREE_SHARE * read[k][0]:
             continue
-        which = _told(fits, order, OWN_TERMS_SIGNIFICANCE)
+        which = _told(fits, order, OWN_TERMS_SIGNIFICANCE, bool(np.any(robot.phi)) or len(kept) > 2)
         pair = [have[r] for r in ([which] if which is not None else sorted(order[:2]))]
         mine, other = (order[0], order[1]) if which != order[1] else (order[1], order[0])
         said = (fits[order[0]][0] / read[k][0], fits[mine], fits[other], other)
@@ -717,11 +728,14 @@ def opposite_among_pooled(
     k, _, (left, mine, alt, j) = told[r][0]
     other = names[have[j]]
     ratio = mine[0] / alt[0]
+    tells = "the robot description's torques" if np.any(robot.phi) else "the recordings"
     agree = (
-        f"the robot description's torques agree with {other} (residual {ratio:.2g} of that "
-        f"with {other}'s negated instead)"
-        if ratio <= TOLD_SHARE
-        else f"the robot description's torques fit either about as well ({ratio:.2g})"
+        f"; {tells} agree with {other} (residual {ratio:.2g} of that with {other}'s negated "
+        "instead), and"
+        if ratio <= TOLD_SHARE and (np.any(robot.phi) or len(kept) > 2)
+        else f"; {tells} fit either about as well ({ratio:.2g}), and"
+        if np.any(robot.phi)
+        else ":"  # two recordings of a bare description: the friction alone tells
     )
     pushes = (
         f"with {other}'s negated instead it would put {-alt[1]:.3g} W into the arm"
@@ -732,7 +746,7 @@ def opposite_among_pooled(
         f"{names[r]}: the torques of {named(ks)} have the opposite sign to those of "
         f"{', '.join(others)}: one friction, rotor inertia and offset fit the recordings "
         f"{_times(left)} times better with {names[r]}'s {_columns(ks)} negated (residual "
-        f"{left:.2g} of that as read); {agree}, and the friction so fitted dissipates "
+        f"{left:.2g} of that as read){agree} the friction so fitted dissipates "
         f"{mine[1]:.3g} W ({pushes}): {names[r]} was "
         f"likely logged with another sign convention; hint: --units "
         f"{flip_entries(ks, names[r])} reads it flipped"
@@ -744,6 +758,63 @@ def _times(share: float) -> str:
     for a sentence ("18", "3.3")."""
     x = 1.0 / share if share > 0 else math.inf
     return f"{x:.2g}" if x < 10 else f"{x:,.0f}" if x < 1e6 else f"{x:.1e}"
+
+
+def _coupled(drive: Drive | None, k: int) -> tuple[list[int], list[int]]:
+    """The joints and motors (from 0) of motor ``k``'s group (:func:`_motor_groups`) when
+    a motor-side ``drive`` couples it (its torque reaches several joints, or a joint's
+    takes another motor's too: a coupled wrist), else none."""
+    if drive is None or drive.side != "motor":
+        return [], []
+    for joints, motors in _motor_groups(drive.transmission != 0):
+        if k in motors and len(motors) > 1:
+            return joints, motors
+    return [], []
+
+
+def _shared_of(drive: Drive | None, ks: Sequence[int]) -> list[int]:
+    """The joints (from 0) whose friction :func:`_own_terms` fits beside motors ``ks``'
+    own: those of a coupled wrist no motor turns alone that these turn."""
+    if drive is None or drive.side != "motor":
+        return []
+    Kf = drive.friction_transmission
+    shared = _shared_joints(Kf)
+    return sorted({j for k in ks for j in _coupled(drive, k)[0] if shared[j] and Kf[k, j] != 0})
+
+
+def _with_shared(robot: Robot, drive: Drive | None, ks: Sequence[int]) -> str:
+    """ " (with that of joint6, which no motor turns alone)": the joints whose friction
+    :func:`_own_terms` counts with motors ``ks``' (a coupled wrist's), or ""."""
+    if drive is None or drive.side != "motor":
+        return ""
+    js = _shared_of(drive, ks)
+    if not js:
+        return ""
+    return (
+        f" (with that of {', '.join(robot.joint_names[j] for j in js)}, which no motor turns alone)"
+    )
+
+
+def _unseen(robot: Robot, drive: Drive | None, ks: Sequence[int]) -> str:
+    """Why the check against the model's torques does not see motors (joints) ``ks``
+    negated: the links barely load them, or a coupled wrist's motor turns several joints,
+    none of whose torques its negation negates alone."""
+    groups = {tuple(_coupled(drive, k)[0]): _coupled(drive, k)[1] for k in ks}
+    groups.pop((), None)
+    if not groups:
+        who = ", ".join(f"motor {k + 1}" for k in ks)
+        if drive is None or drive.side != "motor":
+            who = ", ".join(robot.joint_names[k] for k in ks)
+        return f"the links barely load {who}"
+    said = "; ".join(
+        f"the torques of {' and '.join(robot.joint_names[j] for j in js)} take those of "
+        f"{' and '.join(f'motor {k + 1}' for k in ms)}"
+        for js, ms in groups.items()
+    )
+    return (
+        f"{said}, a coupled wrist: negating one motor's negates no joint's, and the links "
+        "barely load the wrist"
+    )
 
 
 def _columns(ks: Sequence[int]) -> str:
