@@ -169,3 +169,27 @@ def test_a_wrist_disagreement_nothing_tells_names_both_files():
     said = found[0].text
     assert said.startswith("the torques of motor 5 have opposite signs in a.csv and b.csv"), said
     assert "--units a.csv:tau5=-1 or --units b.csv:tau5=-1" in said, said
+
+
+def test_a_differential_wrist_motor_negated_in_one_of_two_recordings_names_that_file():
+    """A differential wrist (motors 5 and 6 each turn joints 5 and 6, whose viscous friction
+    the motors' spans): the clean pair names nothing, motor 6 negated in a.csv is named."""
+    K = np.diag([120.0, 120.0, 100.0, 70.0, 50.0, -50.0])
+    K[4, 5] = K[5, 4] = 50.0
+    drive = dataclasses.replace(_drive(), transmission=K)
+    robot = _arm()
+    t = sample_times(3.0, 200.0)
+    a, b = (
+        simulate_measurement(
+            robot,
+            random_fourier(robot, np.random.default_rng(s))(t),
+            rng=np.random.default_rng(s + 100),
+            noise=SensorNoise(tau_std=0.05, q_std=1e-4, dq_std=1e-3),
+            drive=drive,
+        )
+        for s in (21, 22)
+    )
+    assert recording_sign_findings(robot, [a, b], NAMES[:2], drive) == ()
+    found = recording_sign_findings(robot, [_negated(a, 5), b], NAMES[:2], drive)
+    assert [f.name for f in found] == ["a.csv"], found
+    assert "--units a.csv:tau6=-1 reads it flipped" in found[0].text, found[0].text

@@ -329,6 +329,32 @@ def _shared_joints(Kf: NDArray[np.float64]) -> NDArray[np.bool_]:
     return out
 
 
+#: A shared joint's viscous friction is fitted beside its group's motors' when the part of
+#: its map (``e_j e_j^T``) outside theirs (``Kf_k^T Kf_k``) and the shared joints' before
+#: keeps at least this share of its norm (a differential's is theirs: ``K^T K`` of two
+#: motors that each turn both joints spans ``1`` with the motors' viscous terms).
+SHARED_VISCOUS_INDEPENDENCE = 1e-6
+
+
+def _viscous_free(Kf: NDArray[np.float64], shared: Sequence[int]) -> list[bool]:
+    """Per joint of ``shared`` (positions in a group whose friction map is ``Kf``, motors x
+    joints): whether its viscous friction is independent of the motors' and the shared
+    joints' before it (:data:`SHARED_VISCOUS_INDEPENDENCE`); the others' column is zero."""
+    m = Kf.shape[1]
+    basis = [np.outer(row, row).ravel() for row in Kf if np.any(row)]
+    out = []
+    for j in shared:
+        e = np.zeros((m, m))
+        e[j, j] = 1.0
+        B = np.array([b / np.linalg.norm(b) for b in basis]).T
+        left = e.ravel() - B @ np.linalg.lstsq(B, e.ravel(), rcond=None)[0]
+        free = bool(np.linalg.norm(left) >= SHARED_VISCOUS_INDEPENDENCE)
+        out.append(free)
+        if free:
+            basis.append(e.ravel())
+    return out
+
+
 def _own_terms(
     r: NDArray[np.float64],
     dq: NDArray[np.float64],
@@ -353,9 +379,15 @@ def _own_terms(
                 cols.append(f[:, None] * Kf[k, joints])
             cols.append(a[:, k, None] * K[k, joints])
         extra = [j for j in joints if shared[j]] if len(joints) > 1 else []
-        for j in extra:  # friction at a joint no motor turns alone
+        viscous = _viscous_free(Kf[np.ix_(motors, joints)], [joints.index(j) for j in extra])
+        at_joint: list[tuple[int, float]] = []  # per column: its joint, its power per unit
+        for j, free in zip(extra, viscous, strict=True):  # a joint no motor turns alone
             at = np.asarray(joints) == j
-            cols += [dq[:, j, None] * at, np.sign(dq[:, j, None]) * at]
+            if free:
+                cols.append(dq[:, j, None] * at)
+                at_joint.append((j, float(np.mean(dq[:, j] ** 2))))
+            cols.append(np.sign(dq[:, j, None]) * at)
+            at_joint.append((j, float(np.mean(np.abs(dq[:, j])))))
         X = np.stack(cols, axis=-1).reshape(len(r) * len(joints), len(cols))
         y = r[:, joints].reshape(-1)
         coef = np.linalg.lstsq(X, y, rcond=None)[0]
@@ -368,10 +400,8 @@ def _own_terms(
         grads = np.zeros((m, len(cols)))  # d power / d coef, per motor
         for i, k in enumerate(motors):
             grads[i, 4 * i : 4 * i + 2] = speed[i, 1], speed[i, 0]
-            for e, j in enumerate(extra):
-                if Kf[k, j] != 0:
-                    c = 4 * m + 2 * e
-                    grads[i, c : c + 2] = np.mean(dq[:, j] ** 2), np.mean(np.abs(dq[:, j]))
+            for c, (j, unit) in enumerate(at_joint):
+                grads[i, 4 * m + c] = unit if Kf[k, j] != 0 else 0.0
         power = np.array(
             [[g @ coef, math.sqrt(max(float(g @ cov @ g), 0.0))] for g in grads], dtype=np.float64
         ).reshape(m, 2)
