@@ -176,6 +176,24 @@ def test_simulate_writes_the_log_of_the_api(tmp_path):
     assert res.log.n_samples < 200  # samples were dropped
 
 
+def test_simulate_without_friction_says_so_in_the_drive_line():
+    """A drive whose friction acts at the motors, simulated with friction "none": the
+    drive's line says no friction was simulated, not where friction acts; with the robot's
+    own friction it says where (at the motors)."""
+    from dynid.model.drive import Drive
+
+    drive = Drive.from_gears(50.0, n=7, side="motor", friction_at="motor")
+
+    def drive_line(friction):
+        options = SimulateOptions(duration_s=0.2, rate_hz=100.0, drive=drive, friction=friction)
+        notes = simulate_log(dynid.panda(), options).notes
+        return next(n for n in notes if n.startswith("drive:"))
+
+    assert "no friction simulated" in drive_line("none")
+    assert "friction at the motors" not in drive_line("none")
+    assert "friction at the motors" in drive_line("robot")
+
+
 # ---------------------------------------------------------------------- export
 def test_export_chooses_the_chain_of_a_urdf_with_several_leaves(tmp_path, capsys):
     """A URDF with a hand and two fingers has several leaves: export --params refuses it

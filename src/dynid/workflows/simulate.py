@@ -217,9 +217,12 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
                 field="contacts",
             )
     if opt.drive is not None:
-        notes.append(
-            f"drive: {opt.drive.describe()}; the log is written on the {opt.drive.side} side"
-        )
+        said_drive = opt.drive.describe()
+        if opt.friction == "none":  # the drive's place for friction holds none here
+            said_drive = said_drive.replace(
+                f"friction at the {opt.drive.friction_place}s", "no friction simulated"
+            )
+        notes.append(f"drive: {said_drive}; the log is written on the {opt.drive.side} side")
         if opt.friction == "robot" and (said := own_at_motors_note(robot, opt.drive)):
             notes.append(said)
     if robot.spring is not None and np.any(robot.spring.k):
