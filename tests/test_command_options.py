@@ -176,22 +176,23 @@ def test_simulate_writes_the_log_of_the_api(tmp_path):
     assert res.log.n_samples < 200  # samples were dropped
 
 
-def test_simulate_without_friction_says_so_in_the_drive_line():
-    """A drive whose friction acts at the motors, simulated with friction "none": the
-    drive's line says no friction was simulated, not where friction acts; with the robot's
-    own friction it says where (at the motors)."""
+def test_simulate_says_where_the_simulated_friction_acts_in_the_drive_line():
+    """A geared drive's line in simulate says where the simulated friction acts: none with
+    friction "none"; the Panda's own at the joints when the drive file leaves friction_at
+    out (a description's friction stays at the joints); at the motors when it says so."""
     from dynid.model.drive import Drive
 
-    drive = Drive.from_gears(50.0, n=7, side="motor", friction_at="motor")
-
-    def drive_line(friction):
+    def drive_line(friction, **kw):
+        drive = Drive.from_gears(50.0, n=7, side="motor", **kw)
         options = SimulateOptions(duration_s=0.2, rate_hz=100.0, drive=drive, friction=friction)
         notes = simulate_log(dynid.panda(), options).notes
         return next(n for n in notes if n.startswith("drive:"))
 
-    assert "no friction simulated" in drive_line("none")
-    assert "friction at the motors" not in drive_line("none")
-    assert "friction at the motors" in drive_line("robot")
+    none = drive_line("none", friction_at="motor")
+    assert "no friction simulated" in none and "friction at the motors" not in none
+    default = drive_line("robot")
+    assert "own friction at the joints" in default and "at the motors" not in default
+    assert "friction at the motors" in drive_line("robot", friction_at="motor")
 
 
 # ---------------------------------------------------------------------- export
