@@ -96,18 +96,33 @@ class CorrectedSearch:
         """The structure the search chose."""
         return Structure.parse(",".join(self.searched.info.extra.get("terms", ())))
 
+    def factors(self) -> str:
+        """The factors named, in words: ``joint 2's by 0.713, joint 4's by 1.42``."""
+        g = self.gains
+        return ", ".join(f"{g.per} {k + 1}'s by {g.factor[k]:.3g}" for k in g.named)
+
     def note(self) -> str:
         """One sentence for the model's notes and the summary: why the torque constants
         were judged first and the factors the search's efforts were corrected by."""
-        g = self.gains
-        unit = g.per
-        said = ", ".join(f"{unit} {k + 1}'s by {g.factor[k]:.3g}" for k in g.named)
+        said = self.factors()
         why = f" ({self.why})" if self.why else ""
         return (
             f"the torque constants were judged first{why} with the richest structure "
             f"({','.join(richest_structure(self.drive).terms)}) and the structure was chosen "
             f"on efforts corrected by their factors: {said}; the model is fitted to the "
             "efforts as logged"
+        )
+
+    def consistent_note(self) -> str:
+        """One sentence for the consistent fit's notes: the efforts it is fitted to (those
+        the factors correct) and the torque constants that read them, its drive's."""
+        kt = self.drive.torque_constant
+        said = "" if kt is None else " ".join(f"{x:.4g}" for x in kt)
+        why = f" ({self.why})" if self.why else ""
+        return (
+            f"the torque constants were judged first{why}: the consistent fit is fitted to "
+            f"the efforts corrected by their factors, {self.factors()}, read through "
+            f"torque_constant = [{said}] (its drive's), with the structure chosen on them"
         )
 
 

@@ -35,6 +35,7 @@ from ..feasibility.convex import (
     DEFAULT_SDP_MARGIN,
     ConsistentResult,
     SDPOptions,
+    consistent_from_identified,
     identify_consistent,
 )
 from ..friction.delay_check import logs_delay
@@ -62,7 +63,7 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
-from .gains_first import gains_first, reason_to_judge_first
+from .gains_first import CorrectedSearch, gains_first, reason_to_judge_first
 from .options import (
     Cutoff,
     check_band,
@@ -94,6 +95,7 @@ __all__ = [
     "IdentifyResult",
     "data_files",
     "identify_files",
+    "identify_logs",
     "parsed_terms",
 ]
 
@@ -395,15 +397,169 @@ def identify_files(
     """
     opt = options or IdentifyOptions()
     paths = data_files(data)
-    if opt.consistent:
-        prior = opt.prior
-        if not isinstance(prior, Robot) and prior is not None:
-            prior = load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
-        result, held = _identify_consistent(robot, paths, opt, prior)
-        assert result.identified is not None  # _identify_consistent sets it
-        return IdentifyResult(result.identified, result, tuple(paths), held)
-    model, held, delay = _identify(robot, paths, opt)
-    return IdentifyResult(model, None, tuple(paths), held, delay)
+    prior = _prior(robot, opt)
+    path = paths[0]
+    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
+    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
+    kind = data_kind(path, cmap)
+    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
+    if kind != "torque_log":
+        _one_static_file(paths, opt)
+        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
+        if opt.consistent:
+            result = _consistent_static(robot, path, data, opt, prior)
+            return IdentifyResult(result.identified, result, tuple(paths))
+        return IdentifyResult(_static(robot, path, data, opt), None, tuple(paths))
+    logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
+    names = [p.name for p in paths]
+    got = _fit_logs(robot, logs, names, opt, heldout, prior, path if len(paths) == 1 else None)
+    return dataclasses.replace(got, model=_record(got.model, opt.columns), files=tuple(paths))
+
+
+def identify_logs(
+    robot: Robot,
+    logs: TorqueLog | Sequence[TorqueLog],
+    options: IdentifyOptions | None = None,
+    *,
+    names: Sequence[str] | None = None,
+    validate_on: TorqueLog | None = None,
+) -> IdentifyResult:
+    """What ``dynid identify`` does with torque logs once it has read them: the model's
+    structure chosen on held-out data (or ``options.terms``), a current log's torque
+    constants judged first when the structure chosen points to them
+    (:mod:`~dynid.workflows.gains_first`), the held-out prediction and its verdict, the
+    torques' delay, and with ``options.consistent`` the physically consistent fit of the
+    same structure; :func:`identify_files` reads its files and calls this.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot the logs belong to.
+    logs : TorqueLog or sequence of TorqueLog
+        One or more recordings (SI units, read through ``options.drive`` when given).
+    options : IdentifyOptions, optional
+        As :func:`identify_files`; the options of files (``columns``, ``drop_invalid``,
+        ``q_start``, ``validate_on``) are refused: read the files with them, or give the
+        separate log as ``validate_on``.
+    names : sequence of str, optional
+        One name per recording, for messages and the record.
+    validate_on : TorqueLog, optional
+        A separate recording the held-out judgement is made on.
+
+    Returns
+    -------
+    IdentifyResult
+        ``files`` empty.
+
+    Raises
+    ------
+    OptionError
+        An option of files, or ``folds`` with several recordings.
+    DataError, RankDeficientError
+        As :func:`~dynid.identification.selection.identify_recordings`.
+    """
+    opt = options or IdentifyOptions()
+    for name in ("columns", "drop_invalid", "q_start", "validate_on"):
+        if getattr(opt, name) not in (None, False):
+            raise OptionError(
+                "applies to files (identify_files); with logs already read, read them with "
+                "it (or give the separate log as validate_on)",
+                field=name,
+            )
+    logs = [logs] if isinstance(logs, TorqueLog) else list(logs)
+    if opt.folds is not None and len(logs) > 1:
+        raise OptionError(
+            f"sets time blocks of one recording; with {len(logs)} recordings each one is "
+            "left out in turn (the folds are the recordings)",
+            field="folds",
+        )
+    kw: dict[str, Any] = {} if opt.folds is None else {"folds": opt.folds}
+    if validate_on is not None:
+        kw["validate_on"] = validate_on
+    return _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
+
+
+def _prior(robot: Robot, opt: IdentifyOptions) -> Robot | None:
+    """The consistent fit's prior (``opt.prior`` read: :func:`~.prior.load_prior`)."""
+    prior = opt.prior
+    if opt.consistent and not isinstance(prior, Robot) and prior is not None:
+        return load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
+    return prior if isinstance(prior, Robot) else None
+
+
+def _fit_logs(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None,
+    opt: IdentifyOptions,
+    heldout: dict[str, Any],
+    prior: Robot | None,
+    where: Path | None = None,
+) -> IdentifyResult:
+    """The torque-log route of :func:`identify_files` and :func:`identify_logs` on the
+    logs read (``heldout``: the held-out judgement's ``folds``/``validate_on``; ``where``:
+    the one file an error is said in): the search (:func:`_searched`), the gravity
+    scale's warning, and either the consistent fit of the model the search kept
+    (:func:`_consistent_of`) or the torques' delay."""
+
+    def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
+        return identify_recordings(
+            robot,
+            logs,
+            names,
+            structure=structure,
+            max_std_percent=opt.max_std_percent,
+            rtol=opt.rtol,
+            max_gap_s=opt.max_gap_s,
+            torque_delay_s=opt.torque_delay_s or 0.0,
+            drive=drive,
+            estimator=opt.estimator,
+            std=opt.std or "hac",  # the consistent fit's data term is the residual itself
+            cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
+            **heldout,
+        )
+
+    separate = heldout.get("validate_on")
+
+    def run() -> IdentifyResult:
+        model, held, first = _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
+        _say_gravity_scale(robot, model, logs, opt.drive, held)
+        if opt.consistent:
+            result = _consistent_of(robot, model, held, first, logs, separate, opt, prior)
+            return IdentifyResult(model, result, (), held)
+        model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
+        return IdentifyResult(model, None, (), held, delay)
+
+    return run() if where is None else in_file(where, run)
+
+
+def _consistent_of(
+    robot: Robot,
+    model: IdentifiedModel,
+    held: HeldOutTorques | None,
+    first: CorrectedSearch | None,
+    logs: Sequence[TorqueLog],
+    separate: TorqueLog | None,
+    opt: IdentifyOptions,
+    prior: Robot | None,
+) -> ConsistentResult:
+    """The one-step consistent fit of the search's model
+    (:func:`~dynid.feasibility.convex.fit.consistent_from_identified`, as
+    :func:`~dynid.feasibility.convex.fit.identify_consistent` makes it): of ``model``, or
+    where the torque constants were judged first (``first``), of the corrected search's
+    model, fitted to the efforts its factors correct (its drive, the drive's torque
+    constants times them, is the result's; a note names the factors); least squares'
+    own held-out residual said where the consistent fit's judgement rejects it
+    (:func:`_with_outside_model_note`)."""
+    fitted = model if first is None else first.searched
+    result = consistent_from_identified(
+        robot, fitted, kind="log", prior=prior, total_mass=opt.total_mass, options=opt.sdp()
+    )
+    if first is not None:
+        result = dataclasses.replace(result, notes=(first.consistent_note(), *result.notes))
+        if result.heldout is not None and not result.heldout.accepted:
+            held = _predicted_heldout(fitted, logs, separate)
+    return _with_outside_model_note(result, held, robot.joint_names)
 
 
 def _predicted_heldout(
@@ -442,64 +598,28 @@ def _say_gravity_scale(
         warnings.warn(found, DynidWarning, stacklevel=4)
 
 
-def _identify(
-    robot: Robot, paths: list[Path], opt: IdentifyOptions
-) -> tuple[IdentifiedModel, HeldOutTorques | None, TorqueDelay | None]:
-    """The unconstrained fit of :func:`identify_files` and, from torque logs, its
-    held-out prediction and the torques' delay its residual points to."""
-    path = paths[0]
-    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
-    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
-    kind = data_kind(path, cmap)
-    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
-    if kind == "torque_log":
-        logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
-
-        def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
-            return identify_recordings(
-                robot,
-                logs,
-                [p.name for p in paths],
-                structure=structure,
-                max_std_percent=opt.max_std_percent,
-                rtol=opt.rtol,
-                max_gap_s=opt.max_gap_s,
-                torque_delay_s=opt.torque_delay_s or 0.0,
-                drive=drive,
-                estimator=opt.estimator,
-                std=opt.std or "hac",
-                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
-                **heldout,
-            )
-
-        separate = heldout.get("validate_on")
-        fit = lambda: _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)  # noqa: E731
-        model, held = in_file(path, fit) if len(paths) == 1 else fit()
-        _say_gravity_scale(robot, model, logs, opt.drive, held)
-        model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
-    else:
-        held = delay = None
-        _one_static_file(paths, opt)
-        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
-        outside = limit_violations(robot, data.q)
-        if outside is not None:
-            warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=3)
-        model = in_file(
-            path,
-            lambda: identify_static(
-                robot,
-                data,
-                max_std_percent=opt.max_std_percent,
-                rtol=opt.rtol,
-                std=opt.std or "robust",
-                drive=opt.drive,
-                estimator=opt.estimator,
-            ),
-        )
-        misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
-        if misfit is not None:
-            warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
-    return _record(model, opt.columns), held, delay
+def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> IdentifiedModel:
+    """The unconstrained fit of static data ``data`` read from ``path``; configurations
+    outside the joint limits and a relative error far above the recorded noise warned."""
+    outside = limit_violations(robot, data.q)
+    if outside is not None:
+        warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=3)
+    model = in_file(
+        path,
+        lambda: identify_static(
+            robot,
+            data,
+            max_std_percent=opt.max_std_percent,
+            rtol=opt.rtol,
+            std=opt.std or "robust",
+            drive=opt.drive,
+            estimator=opt.estimator,
+        ),
+    )
+    misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
+    if misfit is not None:
+        warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
+    return _record(model, opt.columns)
 
 
 def _searched(
@@ -508,8 +628,9 @@ def _searched(
     drive: Drive | None,
     logs: Sequence[TorqueLog],
     separate: TorqueLog | None,
-) -> tuple[IdentifiedModel, HeldOutTorques | None]:
-    """The model of ``structure`` and its held-out prediction; chosen (``"auto"``) through
+) -> tuple[IdentifiedModel, HeldOutTorques | None, CorrectedSearch | None]:
+    """The model of ``structure``, its held-out prediction and the corrected search
+    (None: not run, or no factor named); chosen (``"auto"``) through
     a current log's drive and pointing to the torque constants
     (:func:`~dynid.workflows.gains_first.reason_to_judge_first`), chosen again on the
     efforts corrected by the factors the richest structure names
@@ -519,7 +640,7 @@ def _searched(
     current = drive is not None and drive.effort == "current"
     if structure != "auto" or not current:
         model = fitted(structure, drive)
-        return model, _predicted_heldout(model, logs, separate)
+        return model, _predicted_heldout(model, logs, separate), None
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         model = fitted(structure, drive)
@@ -529,7 +650,7 @@ def _searched(
     if first is None:
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        return model, held
+        return model, held, None
     with warnings.catch_warnings(record=True) as refitted:
         warnings.simplefilter("always")
         model = fitted(first.structure, drive)
@@ -544,7 +665,7 @@ def _searched(
     held = _predicted_heldout(model, logs, separate)
     if held is not None:  # one judgement of the efforts' scale
         held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
-    return model, held
+    return model, held, first
 
 
 def _say_once(said: Sequence[warnings.WarningMessage]) -> None:
@@ -659,69 +780,26 @@ def _with_outside_model_note(
     return result if said is None else dataclasses.replace(result, notes=(said, *result.notes))
 
 
-def _identify_consistent(
-    robot: Robot, paths: list[Path], opt: IdentifyOptions, prior: Robot | None
-) -> tuple[ConsistentResult, HeldOutTorques | None]:
-    """The one-step consistent fit of :func:`identify_files`
-    (:func:`~dynid.feasibility.convex.fit.identify_consistent`), the data read and checked
-    as for the unconstrained fit, and (torque logs) the unconstrained fit's held-out
-    prediction.
-
-    Torque logs (one or more, ``max_gap_s`` honoured): the model's structure is chosen on
-    held-out data as the unconstrained fit chooses it (or given by ``terms``), and the
-    convex problem keeps each of its terms physical as the term declares (the Python
-    API's call, so that both give the same parameters); ``folds``/``validate_on`` choose
-    the held-out judgement of the prior weight and of the fit. ``identified`` of the
-    result holds the unconstrained fit.
-    """
-    path = paths[0]
-    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
-    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
-    kind = data_kind(path, cmap)
-    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
-    common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())
-    if kind == "torque_log":
-        separate = heldout.get("validate_on")
-        logs = _read_logs(robot, paths, cmap, opt, separate)
-
-        def fit() -> ConsistentResult:
-            return identify_consistent(
-                robot,
-                logs,
-                names=[p.name for p in paths],
-                structure=parsed_terms(opt.terms),
-                rtol=opt.rtol,
-                drive=opt.drive,
-                estimator=opt.estimator,
-                std=opt.std,
-                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
-                max_gap_s=opt.max_gap_s,
-                **heldout,
-                **common,
-            )
-
-        result = in_file(path, fit) if len(paths) == 1 else fit()
-        unconstrained = result.identified
-        held = None if unconstrained is None else _predicted_heldout(unconstrained, logs, separate)
-        if unconstrained is not None:
-            _say_gravity_scale(robot, unconstrained, logs, opt.drive, held)
-        result = _with_outside_model_note(result, held, robot.joint_names)
-    else:
-        held = None
-        _one_static_file(paths, opt)
-        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
-        result = in_file(
-            path,
-            lambda: identify_consistent(
-                robot,
-                data,
-                rtol=opt.rtol,
-                drive=opt.drive,
-                estimator=opt.estimator,
-                std=opt.std,
-                **common,
-            ),
-        )
+def _consistent_static(
+    robot: Robot, path: Path, data: Any, opt: IdentifyOptions, prior: Robot | None
+) -> ConsistentResult:
+    """The one-step consistent fit of static data ``data`` read from ``path``
+    (:func:`~dynid.feasibility.convex.fit.identify_consistent`); ``identified`` of the
+    result holds the unconstrained fit, with the column map the data were read with."""
+    result = in_file(
+        path,
+        lambda: identify_consistent(
+            robot,
+            data,
+            rtol=opt.rtol,
+            drive=opt.drive,
+            estimator=opt.estimator,
+            std=opt.std,
+            prior=prior,
+            total_mass=opt.total_mass,
+            options=opt.sdp(),
+        ),
+    )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    return dataclasses.replace(result, identified=_record(result.identified, opt.columns)), held
+    return dataclasses.replace(result, identified=_record(result.identified, opt.columns))

@@ -56,6 +56,7 @@ from ..friction.pooled import joined_validation
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
+from ..identification.drive_gains import DriveGains
 from ..identification.floor_verdict import (
     judged_prediction,
     opposite_sign,
@@ -235,6 +236,12 @@ class ValidateResult:
     applied_delay : AppliedDelay, optional
         The delay the recordings were prepared with and where it came from (given, or the
         model's record); None: none applied.
+    gains : DriveGains, optional
+        The gain per motor of the logged efforts the residual points to, judged on the
+        recordings' contiguous time blocks held out in turn as identify's held-out verdict
+        judges them (:func:`~dynid.friction.heldout_torques.residual_gains`; its named
+        motors' factors the verdict's reason names, in place of a spring or a tilt); judged
+        on a current log even beside a sign finding; None: not judged (a good verdict).
     """
 
     validation: RecordingsValidation
@@ -256,6 +263,7 @@ class ValidateResult:
     reversed_columns: tuple[tuple[str, str], ...] = ()
     torque_delay: TorqueDelay | None = None
     applied_delay: AppliedDelay | None = None
+    gains: DriveGains | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -270,7 +278,9 @@ class ValidateResult:
         reversed, with the ``--units`` that reads them; when there is one),
         ``verdict`` (``level``, ``label``, ``reason``), ``joint_names`` (when known) and
         ``springs`` (the stiffness per joint the residual points to, when judged:
-        :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`) and
+        :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`),
+        ``drive_gains`` (the gains per motor, when judged:
+        :meth:`~dynid.identification.drive_gains.DriveGains.as_dict`) and
         ``torque_delay`` (the torques' lag behind the positions, when named:
         :meth:`~dynid.identification.torque_delay.TorqueDelay.as_dict`) and
         ``torque_delay_used`` (the delay the recordings were prepared with and its source,
@@ -302,6 +312,7 @@ class ValidateResult:
             **({"reversed_columns": dict(self.reversed_columns)} if self.reversed_columns else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
+            **({"drive_gains": self.gains.as_dict()} if self.gains is not None else {}),
             **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
             **({"torque_delay_used": a.as_dict()} if (a := self.applied_delay) else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
@@ -396,11 +407,14 @@ def validate_files(
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
     # a torque of the opposite sign leaves twice the torque, which no term of the model
-    # explains: what the residual follows is not diagnosed (it read as an offset)
+    # explains: what the residual follows is not diagnosed (it read as an offset); a
+    # current log's gains per motor are judged all the same (a gain of -1 is a sign)
     dependence = not beyond and not opposite
-    verdict, springs = _with_hints(
+    current = placed is not None and placed.effort == "current"
+    verdict, springs, gains = _with_hints(
         model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model),
         offsets=offsets_of(model), left_out=friction_left_out(model),
+        gains_too=not beyond and current,
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
@@ -425,6 +439,7 @@ def validate_files(
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=springs,
+        gains=gains,
         torque_delay=delay, applied_delay=applied,
     )  # fmt: skip
 
@@ -476,7 +491,8 @@ def _with_hints(
     terms: frozenset[str] = frozenset(),
     offsets: Mapping[int, tuple[str, bool]] | None = None,
     left_out: Mapping[int, tuple[str, ...]] | None = None,
-) -> tuple[Verdict, ResidualSpring | None]:
+    gains_too: bool = False,
+) -> tuple[Verdict, ResidualSpring | None, DriveGains | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
@@ -488,20 +504,22 @@ def _with_hints(
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
     with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`; in
     their place, a gain per motor of the logged efforts that explains the residual,
-    :func:`~dynid.friction.heldout_torques.residual_gains`), the
-    hint of a
-    cut-off too high for derived states, and that of an error at low speed; and the
-    springs fitted (None: not judged)."""
+    :func:`~dynid.friction.heldout_torques.residual_gains`, judged with ``dependence``
+    False too where ``gains_too``: a current log, whose factors a sign finding does not
+    explain), the hint of a cut-off too high for derived states, and that of an error at
+    low speed; and the springs and the gains fitted (None: not judged)."""
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     springs = None
-    whole = joined_validation(val.parts) if dependence and verdict.level != "good" else None
+    judged = (dependence or gains_too) and verdict.level != "good"
+    whole = joined_validation(val.parts) if judged else None
     gains = None if whole is None else residual_gains(model, whole, noise.total)
     said = None if gains is None else gains.sentence()
     if said is not None:  # the efforts' scale per motor explains it: no spring, no tilt
         verdict = with_hint(verdict, said)
     elif dependence:
+        whole = whole if dependence else None
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
@@ -517,7 +535,7 @@ def _with_hints(
             verdict, reason=f"{verdict.reason}; a floor raised because {high}"
         )
     # the low-speed hint's "above the noise": the sensors' (its module docstring)
-    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs
+    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs, gains
 
 
 @dataclass(frozen=True, slots=True)
