@@ -16,6 +16,13 @@ command applies, so that the Python API behaves as the command does.
   last time block, every recording predicted by the fit of the others, or the
   ``validate_on`` log, every sample) is made
   from the logs read for the fit, each file read once, and returned with the model.
+* Torque logs once read go through :func:`identify_logs`, the entry point of a caller that
+  holds :class:`~dynid.identification.log.TorqueLog` objects: the structure search, a
+  current log's torque constants judged first (:mod:`~dynid.workflows.gains_first`), and
+  the consistent fit of the model the search kept; where the constants were judged first,
+  that is the corrected search's model, fitted to the efforts its factors correct (its
+  drive's torque constants times them), while the least-squares model is fitted to the
+  efforts as logged, whose held-out verdict names the factors.
 
 Every refusal of an option is an :class:`~dynid.exceptions.OptionError` carrying the
 option's field; the command line names it by its flag.
@@ -405,15 +412,26 @@ def identify_files(
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
     if kind != "torque_log":
         _one_static_file(paths, opt)
-        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
-        if opt.consistent:
-            result = _consistent_static(robot, path, data, opt, prior)
-            return IdentifyResult(result.identified, result, tuple(paths))
-        return IdentifyResult(_static(robot, path, data, opt), None, tuple(paths))
-    logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
-    names = [p.name for p in paths]
-    got = _fit_logs(robot, logs, names, opt, heldout, prior, path if len(paths) == 1 else None)
-    return dataclasses.replace(got, model=_record(got.model, opt.columns), files=tuple(paths))
+        static = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
+        if not opt.consistent:
+            return IdentifyResult(_static(robot, path, static, opt), None, tuple(paths))
+        consistent, unconstrained = _consistent_static(robot, path, static, opt, prior)
+        return IdentifyResult(unconstrained, consistent, tuple(paths))
+    separate = heldout.get("validate_on")
+    logs = _read_logs(robot, paths, cmap, opt, separate)
+    read = dataclasses.replace(  # the logs read with the file options; the prior loaded
+        opt, columns=None, drop_invalid=False, q_start=None, validate_on=None, prior=prior
+    )
+
+    def fit() -> IdentifyResult:
+        return identify_logs(robot, logs, read, names=[p.name for p in paths], validate_on=separate)
+
+    got = in_file(path, fit) if len(paths) == 1 else fit()
+    result = got.consistent
+    if result is not None and result.identified is not None:
+        result = dataclasses.replace(result, identified=_record(result.identified, opt.columns))
+    model = _record(got.model, opt.columns)
+    return IdentifyResult(model, result, tuple(paths), got.heldout, got.torque_delay)
 
 
 def identify_logs(
@@ -494,11 +512,9 @@ def _fit_logs(
     opt: IdentifyOptions,
     heldout: dict[str, Any],
     prior: Robot | None,
-    where: Path | None = None,
 ) -> IdentifyResult:
-    """The torque-log route of :func:`identify_files` and :func:`identify_logs` on the
-    logs read (``heldout``: the held-out judgement's ``folds``/``validate_on``; ``where``:
-    the one file an error is said in): the search (:func:`_searched`), the gravity
+    """The torque-log route of :func:`identify_logs` (``heldout``: the held-out
+    judgement's ``folds``/``validate_on``): the search (:func:`_searched`), the gravity
     scale's warning, and either the consistent fit of the model the search kept
     (:func:`_consistent_of`) or the torques' delay."""
 
@@ -520,17 +536,13 @@ def _fit_logs(
         )
 
     separate = heldout.get("validate_on")
-
-    def run() -> IdentifyResult:
-        model, held, first = _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
-        _say_gravity_scale(robot, model, logs, opt.drive, held)
-        if opt.consistent:
-            result = _consistent_of(robot, model, held, first, logs, separate, opt, prior)
-            return IdentifyResult(model, result, (), held)
-        model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
-        return IdentifyResult(model, None, (), held, delay)
-
-    return run() if where is None else in_file(where, run)
+    model, held, first = _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
+    _say_gravity_scale(robot, model, logs, opt.drive, held)
+    if opt.consistent:
+        result = _consistent_of(robot, model, held, first, logs, separate, opt, prior)
+        return IdentifyResult(model, result, (), held)
+    model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
+    return IdentifyResult(model, None, (), held, delay)
 
 
 def _consistent_of(
@@ -782,10 +794,10 @@ def _with_outside_model_note(
 
 def _consistent_static(
     robot: Robot, path: Path, data: Any, opt: IdentifyOptions, prior: Robot | None
-) -> ConsistentResult:
+) -> tuple[ConsistentResult, IdentifiedModel]:
     """The one-step consistent fit of static data ``data`` read from ``path``
-    (:func:`~dynid.feasibility.convex.fit.identify_consistent`); ``identified`` of the
-    result holds the unconstrained fit, with the column map the data were read with."""
+    (:func:`~dynid.feasibility.convex.fit.identify_consistent`) and its unconstrained fit
+    (``identified``), with the column map the data were read with."""
     result = in_file(
         path,
         lambda: identify_consistent(
@@ -802,4 +814,5 @@ def _consistent_static(
     )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    return dataclasses.replace(result, identified=_record(result.identified, opt.columns))
+    model = _record(result.identified, opt.columns)
+    return dataclasses.replace(result, identified=model), model

@@ -397,8 +397,7 @@ def validate_files(
 
     val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
     val = _banded(run, friction) if val is None else val  # friction as observe evaluates it
-    errors = _finite(val, rec.names, label, opt)
-    names = robot.joint_names
+    errors, names = _finite(val, rec.names, label, opt), robot.joint_names
     inputs = _input_noise(model, val.friction, val)
     verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
     verdict = _worst_recording(val, verdict, rec.names, names, inputs)
@@ -407,15 +406,12 @@ def validate_files(
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
     # a torque of the opposite sign leaves twice the torque, which no term of the model
-    # explains: what the residual follows is not diagnosed (it read as an offset); a
-    # current log's gains per motor are judged all the same (a gain of -1 is a sign)
-    dependence = not beyond and not opposite
-    current = placed is not None and placed.effort == "current"
+    # explains: what the residual follows is not diagnosed (a current log's gains are)
+    current = not beyond and placed is not None and placed.effort == "current"
     verdict, springs, gains = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model),
-        offsets=offsets_of(model), left_out=friction_left_out(model),
-        gains_too=not beyond and current,
-    )  # fmt: skip
+        model, verdict, val, rec.logs, noise, names, dependence=not beyond and not opposite,
+        terms=held_terms(model), offsets=offsets_of(model), left_out=friction_left_out(model),
+        gains_too=current)  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
@@ -438,9 +434,7 @@ def validate_files(
         sign_map=sign_map,
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
-        springs=springs,
-        gains=gains,
-        torque_delay=delay, applied_delay=applied,
+        springs=springs, gains=gains, torque_delay=delay, applied_delay=applied,
     )  # fmt: skip
 
 
