@@ -21,8 +21,7 @@ command applies, so that the Python API behaves as the command does.
   current log's torque constants judged first (:mod:`~dynid.workflows.gains_first`), and
   the consistent fit of the model the search kept; where the constants were judged first,
   that is the corrected search's model, fitted to the efforts its factors correct (its
-  drive's torque constants times them), while the least-squares model is fitted to the
-  efforts as logged, whose held-out verdict names the factors.
+  drive's torque constants times them), whose held-out verdict names the factors.
 
 Every refusal of an option is an :class:`~dynid.exceptions.OptionError` carrying the
 option's field; the command line names it by its flag.
@@ -346,10 +345,15 @@ class IdentifyResult:
     Attributes
     ----------
     model : IdentifiedModel
-        The unconstrained fit (with the column map its data were read with).
+        The unconstrained fit (with the column map its data were read with); of a current
+        log whose torque constants were judged first, the corrected search's model,
+        fitted to the efforts the factors correct (its drive holds the corrected
+        constants; its held-out verdict names the factors).
     consistent : ConsistentResult or None
         With ``consistent``: the physically consistent link parameters (``feasible``
-        says whether they satisfy every constraint).
+        says whether they satisfy every constraint); where the torque constants were
+        judged first, of the corrected search's model, fitted to the efforts the factors
+        correct (``drive``: the corrected constants; a note names the factors).
     files : tuple of Path
         The data files read, in order.
     heldout : HeldOutTorques or None
@@ -539,7 +543,7 @@ def _fit_logs(
     model, held, first = _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
     _say_gravity_scale(robot, model, logs, opt.drive, held)
     if opt.consistent:
-        result = _consistent_of(robot, model, held, first, logs, separate, opt, prior)
+        result = _consistent_of(robot, model, held, first, opt, prior)
         return IdentifyResult(model, result, (), held)
     model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
     return IdentifyResult(model, None, (), held, delay)
@@ -550,27 +554,22 @@ def _consistent_of(
     model: IdentifiedModel,
     held: HeldOutTorques | None,
     first: CorrectedSearch | None,
-    logs: Sequence[TorqueLog],
-    separate: TorqueLog | None,
     opt: IdentifyOptions,
     prior: Robot | None,
 ) -> ConsistentResult:
-    """The one-step consistent fit of the search's model
+    """The one-step consistent fit of the search's ``model``
     (:func:`~dynid.feasibility.convex.fit.consistent_from_identified`, as
-    :func:`~dynid.feasibility.convex.fit.identify_consistent` makes it): of ``model``, or
-    where the torque constants were judged first (``first``), of the corrected search's
-    model, fitted to the efforts its factors correct (its drive, the drive's torque
-    constants times them, is the result's; a note names the factors); least squares'
-    own held-out residual said where the consistent fit's judgement rejects it
+    :func:`~dynid.feasibility.convex.fit.identify_consistent` makes it); where the torque
+    constants were judged first (``first``), of the corrected search's model, fitted to
+    the efforts its factors correct (its drive, the drive's torque constants times them,
+    is the result's; a note names the factors); least squares' own held-out residual
+    (``held``) said where the consistent fit's judgement rejects it
     (:func:`_with_outside_model_note`)."""
-    fitted = model if first is None else first.searched
     result = consistent_from_identified(
-        robot, fitted, kind="log", prior=prior, total_mass=opt.total_mass, options=opt.sdp()
+        robot, model, kind="log", prior=prior, total_mass=opt.total_mass, options=opt.sdp()
     )
     if first is not None:
         result = dataclasses.replace(result, notes=(first.consistent_note(), *result.notes))
-        if result.heldout is not None and not result.heldout.accepted:
-            held = _predicted_heldout(fitted, logs, separate)
     return _with_outside_model_note(result, held, robot.joint_names)
 
 
@@ -647,8 +646,8 @@ def _searched(
     (:func:`~dynid.workflows.gains_first.reason_to_judge_first`), chosen again on the
     efforts corrected by the factors the richest structure names
     (:func:`~dynid.workflows.gains_first.gains_first`: its factors are the held-out
-    verdict's), fitted to the efforts as logged, its selection and a note saying so; the
-    first model's warnings said only when it is kept."""
+    verdict's), fitted to those efforts (its drive's torque constants times the factors),
+    with a note saying so; the first model's warnings said only when it is kept."""
     current = drive is not None and drive.effort == "current"
     if structure != "auto" or not current:
         model = fitted(structure, drive)
@@ -663,13 +662,10 @@ def _searched(
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return model, held, None
-    with warnings.catch_warnings(record=True) as refitted:
-        warnings.simplefilter("always")
-        model = fitted(first.structure, drive)
-    _say_once((*first.said, *refitted))
+    _say_once(first.said)
+    model = first.searched  # fitted to the corrected efforts: no term takes up the constants
     info = dataclasses.replace(
         model.info,
-        selection=first.searched.info.selection,
         notes=(*model.info.notes, first.note()),
         extra={**model.info.extra, "gains_first": first.note()},
     )
