@@ -39,10 +39,12 @@ by hand (e.g. --terms armature,viscous,coulomb,offset). Through a --drive that l
 currents, when the chosen structure's held-out error or the error its gains leave is over
 2 x the noise, its gains name a factor, or a rotor inertia is negative, the torque
 constants are judged with the richest structure (armature, viscous, coulomb, offset): the
-factors the held-out data confirm correct the currents for a second search, the structure
-chosen is fitted to the currents as logged, and the verdict names the factors (a note in
-the summary says why). A rotor inertia fitted below zero is a warning naming the joint and
-its likely cause.
+factors the held-out data confirm correct the currents for a second search, whose model,
+fitted to the corrected currents, is the one kept (identification.json's drive holds the
+corrected constants), and the verdict names the factors (a note in the summary says why);
+with --consistent the consistent fit is of that model, fitted to the corrected currents too
+(feasible.json's drive holds the corrected constants; a note names the factors). A rotor
+inertia fitted below zero is a warning naming the joint and its likely cause.
 
 Checks that the data belong to --robot: a static data file that records another robot
 (name, joint count or kinematics) is an error; configurations outside the joint limits,

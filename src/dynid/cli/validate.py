@@ -51,7 +51,11 @@ the other recordings read right), and in validation.json's "opposite_sign"; so i
 same rule, a recording with columns recorded reversed (a motor mounted the other way:
 --units q6=-1,tau6=-1, in "reversed_columns"), and one whose motor the links barely load
 reads with the opposite sign to the other recordings' or to the model's own friction
-(--units b.csv:tau5=-1). With
+(--units b.csv:tau5=-1). Through a
+drive that logs currents, torque constants off by a factor per motor are named where a gain
+per motor fitted with the model's columns explains the residual and predicts the log's
+held-out time blocks better, as identify's held-out verdict names them, even beside such a
+sign finding (the factors in validation.json's "drive_gains"). With
 several recordings, a recording worse than the whole is named. When most of the error
 above the noise sits at low speed (standstill, reversals, the edges of a move: where the
 velocities' noise and low-pass blur a friction step) the verdict says so, with the error

@@ -18,9 +18,12 @@ identified, viscous and Coulomb friction, offsets: the friction the truth has is
 present), as the held-out verdict judges them
 (:func:`~dynid.friction.heldout_torques.heldout_torques`, a factor named only where it
 improves the prediction of held-out data); the named ones correct the drive's torque
-constants for a second search, and the structure it chooses is fitted to the efforts as
-logged, whose held-out verdict names the factors. Constants that are right leave a
-verdict near the noise floor and gains that name nothing: the search runs once, as it did.
+constants for a second search, whose model, fitted to the corrected efforts (its drive's
+torque constants times the factors), is the one kept, and the held-out verdict names the
+factors. Fitted to the efforts as logged, the structure chosen there took up in its terms
+what the wrong constants leave (on the 5 s log above, joint 4's rotor inertia 1.95 kg m^2
+for a true 0.2, viscous friction below zero on joints 2 and 4). Constants that are right leave
+a verdict near the noise floor and gains that name nothing: the search runs once, as it did.
 """
 
 from __future__ import annotations
@@ -81,8 +84,7 @@ class CorrectedSearch:
     why : str
         Why the constants were judged first (:func:`reason_to_judge_first`).
     said : tuple of warnings.WarningMessage
-        The search's warnings but those of its model's own coefficients (a model not kept:
-        :data:`_OF_A_MODEL`), for the caller to say once beside the kept model's own.
+        The search's warnings (of the model kept), for the caller to say.
     """
 
     gains: DriveGains
@@ -96,18 +98,33 @@ class CorrectedSearch:
         """The structure the search chose."""
         return Structure.parse(",".join(self.searched.info.extra.get("terms", ())))
 
+    def factors(self) -> str:
+        """The factors named, in words: ``joint 2's by 0.713, joint 4's by 1.42``."""
+        g = self.gains
+        return ", ".join(f"{g.per} {k + 1}'s by {g.factor[k]:.3g}" for k in g.named)
+
     def note(self) -> str:
         """One sentence for the model's notes and the summary: why the torque constants
         were judged first and the factors the search's efforts were corrected by."""
-        g = self.gains
-        unit = g.per
-        said = ", ".join(f"{unit} {k + 1}'s by {g.factor[k]:.3g}" for k in g.named)
+        said = self.factors()
         why = f" ({self.why})" if self.why else ""
         return (
             f"the torque constants were judged first{why} with the richest structure "
             f"({','.join(richest_structure(self.drive).terms)}) and the structure was chosen "
-            f"on efforts corrected by their factors: {said}; the model is fitted to the "
-            "efforts as logged"
+            f"on efforts corrected by their factors: {said}; the model is fitted to them (its "
+            "drive's torque_constant times the factors)"
+        )
+
+    def consistent_note(self) -> str:
+        """One sentence for the consistent fit's notes: the efforts it is fitted to (those
+        the factors correct) and the torque constants that read them, its drive's."""
+        kt = self.drive.torque_constant
+        said = "" if kt is None else " ".join(f"{x:.4g}" for x in kt)
+        why = f" ({self.why})" if self.why else ""
+        return (
+            f"the torque constants were judged first{why}: the consistent fit is fitted to "
+            f"the efforts corrected by their factors, {self.factors()}, read through "
+            f"torque_constant = [{said}] (its drive's), with the structure chosen on them"
         )
 
 
@@ -191,15 +208,4 @@ def gains_first(
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         searched = fit("auto", corrected)
-    kept = tuple(w for w in said if not any(m in str(w.message) for m in _OF_A_MODEL))
-    return CorrectedSearch(gains, corrected, searched, why, kept)
-
-
-#: Words of the warnings about a fitted model's own coefficients (its rotor inertias, its
-#: conditioning and standard deviations): the corrected search's model is not the one kept
-#: (a coefficient's 1,980 % std there, 61 % in the model fitted to the efforts as logged).
-_OF_A_MODEL = (
-    "the identified rotor inertia",
-    "kept coefficient(s) have a standard deviation above",
-    "is ill-conditioned (scaled condition number",
-)
+    return CorrectedSearch(gains, corrected, searched, why, tuple(said))

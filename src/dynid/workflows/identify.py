@@ -16,6 +16,12 @@ command applies, so that the Python API behaves as the command does.
   last time block, every recording predicted by the fit of the others, or the
   ``validate_on`` log, every sample) is made
   from the logs read for the fit, each file read once, and returned with the model.
+* Torque logs once read go through :func:`identify_logs`, the entry point of a caller that
+  holds :class:`~dynid.identification.log.TorqueLog` objects: the structure search, a
+  current log's torque constants judged first (:mod:`~dynid.workflows.gains_first`), and
+  the consistent fit of the model the search kept; where the constants were judged first,
+  that is the corrected search's model, fitted to the efforts its factors correct (its
+  drive's torque constants times them), whose held-out verdict names the factors.
 
 Every refusal of an option is an :class:`~dynid.exceptions.OptionError` carrying the
 option's field; the command line names it by its flag.
@@ -35,6 +41,7 @@ from ..feasibility.convex import (
     DEFAULT_SDP_MARGIN,
     ConsistentResult,
     SDPOptions,
+    consistent_from_identified,
     identify_consistent,
 )
 from ..friction.delay_check import logs_delay
@@ -62,7 +69,7 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
-from .gains_first import gains_first, reason_to_judge_first
+from .gains_first import CorrectedSearch, gains_first, reason_to_judge_first
 from .options import (
     Cutoff,
     check_band,
@@ -94,6 +101,7 @@ __all__ = [
     "IdentifyResult",
     "data_files",
     "identify_files",
+    "identify_logs",
     "parsed_terms",
 ]
 
@@ -337,10 +345,15 @@ class IdentifyResult:
     Attributes
     ----------
     model : IdentifiedModel
-        The unconstrained fit (with the column map its data were read with).
+        The unconstrained fit (with the column map its data were read with); of a current
+        log whose torque constants were judged first, the corrected search's model,
+        fitted to the efforts the factors correct (its drive holds the corrected
+        constants; its held-out verdict names the factors).
     consistent : ConsistentResult or None
         With ``consistent``: the physically consistent link parameters (``feasible``
-        says whether they satisfy every constraint).
+        says whether they satisfy every constraint); where the torque constants were
+        judged first, of the corrected search's model, fitted to the efforts the factors
+        correct (``drive``: the corrected constants; a note names the factors).
     files : tuple of Path
         The data files read, in order.
     heldout : HeldOutTorques or None
@@ -395,15 +408,169 @@ def identify_files(
     """
     opt = options or IdentifyOptions()
     paths = data_files(data)
+    prior = _prior(robot, opt)
+    path = paths[0]
+    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
+    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
+    kind = data_kind(path, cmap)
+    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
+    if kind != "torque_log":
+        _one_static_file(paths, opt)
+        static = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
+        if not opt.consistent:
+            return IdentifyResult(_static(robot, path, static, opt), None, tuple(paths))
+        consistent, unconstrained = _consistent_static(robot, path, static, opt, prior)
+        return IdentifyResult(unconstrained, consistent, tuple(paths))
+    separate = heldout.get("validate_on")
+    logs = _read_logs(robot, paths, cmap, opt, separate)
+    read = dataclasses.replace(  # the logs read with the file options; the prior loaded
+        opt, columns=None, drop_invalid=False, q_start=None, validate_on=None, prior=prior
+    )
+
+    def fit() -> IdentifyResult:
+        return identify_logs(robot, logs, read, names=[p.name for p in paths], validate_on=separate)
+
+    got = in_file(path, fit) if len(paths) == 1 else fit()
+    result = got.consistent
+    if result is not None and result.identified is not None:
+        result = dataclasses.replace(result, identified=_record(result.identified, opt.columns))
+    model = _record(got.model, opt.columns)
+    return IdentifyResult(model, result, tuple(paths), got.heldout, got.torque_delay)
+
+
+def identify_logs(
+    robot: Robot,
+    logs: TorqueLog | Sequence[TorqueLog],
+    options: IdentifyOptions | None = None,
+    *,
+    names: Sequence[str] | None = None,
+    validate_on: TorqueLog | None = None,
+) -> IdentifyResult:
+    """What ``dynid identify`` does with torque logs once it has read them: the model's
+    structure chosen on held-out data (or ``options.terms``), a current log's torque
+    constants judged first when the structure chosen points to them
+    (:mod:`~dynid.workflows.gains_first`), the held-out prediction and its verdict, the
+    torques' delay, and with ``options.consistent`` the physically consistent fit of the
+    same structure; :func:`identify_files` reads its files and calls this.
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot the logs belong to.
+    logs : TorqueLog or sequence of TorqueLog
+        One or more recordings (SI units, read through ``options.drive`` when given).
+    options : IdentifyOptions, optional
+        As :func:`identify_files`; the options of files (``columns``, ``drop_invalid``,
+        ``q_start``, ``validate_on``) are refused: read the files with them, or give the
+        separate log as ``validate_on``.
+    names : sequence of str, optional
+        One name per recording, for messages and the record.
+    validate_on : TorqueLog, optional
+        A separate recording the held-out judgement is made on.
+
+    Returns
+    -------
+    IdentifyResult
+        ``files`` empty.
+
+    Raises
+    ------
+    OptionError
+        An option of files, or ``folds`` with several recordings.
+    DataError, RankDeficientError
+        As :func:`~dynid.identification.selection.identify_recordings`.
+    """
+    opt = options or IdentifyOptions()
+    for name in ("columns", "drop_invalid", "q_start", "validate_on"):
+        if getattr(opt, name) not in (None, False):
+            raise OptionError(
+                "applies to files (identify_files); with logs already read, read them with "
+                "it (or give the separate log as validate_on)",
+                field=name,
+            )
+    logs = [logs] if isinstance(logs, TorqueLog) else list(logs)
+    if opt.folds is not None and len(logs) > 1:
+        raise OptionError(
+            f"sets time blocks of one recording; with {len(logs)} recordings each one is "
+            "left out in turn (the folds are the recordings)",
+            field="folds",
+        )
+    kw: dict[str, Any] = {} if opt.folds is None else {"folds": opt.folds}
+    if validate_on is not None:
+        kw["validate_on"] = validate_on
+    return _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
+
+
+def _prior(robot: Robot, opt: IdentifyOptions) -> Robot | None:
+    """The consistent fit's prior (``opt.prior`` read: :func:`~.prior.load_prior`)."""
+    prior = opt.prior
+    if opt.consistent and not isinstance(prior, Robot) and prior is not None:
+        return load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
+    return prior if isinstance(prior, Robot) else None
+
+
+def _fit_logs(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    names: Sequence[str] | None,
+    opt: IdentifyOptions,
+    heldout: dict[str, Any],
+    prior: Robot | None,
+) -> IdentifyResult:
+    """The torque-log route of :func:`identify_logs` (``heldout``: the held-out
+    judgement's ``folds``/``validate_on``): the search (:func:`_searched`), the gravity
+    scale's warning, and either the consistent fit of the model the search kept
+    (:func:`_consistent_of`) or the torques' delay."""
+
+    def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
+        return identify_recordings(
+            robot,
+            logs,
+            names,
+            structure=structure,
+            max_std_percent=opt.max_std_percent,
+            rtol=opt.rtol,
+            max_gap_s=opt.max_gap_s,
+            torque_delay_s=opt.torque_delay_s or 0.0,
+            drive=drive,
+            estimator=opt.estimator,
+            std=opt.std or "hac",  # the consistent fit's data term is the residual itself
+            cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
+            **heldout,
+        )
+
+    separate = heldout.get("validate_on")
+    model, held, first = _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
+    _say_gravity_scale(robot, model, logs, opt.drive, held)
     if opt.consistent:
-        prior = opt.prior
-        if not isinstance(prior, Robot) and prior is not None:
-            prior = load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
-        result, held = _identify_consistent(robot, paths, opt, prior)
-        assert result.identified is not None  # _identify_consistent sets it
-        return IdentifyResult(result.identified, result, tuple(paths), held)
-    model, held, delay = _identify(robot, paths, opt)
-    return IdentifyResult(model, None, tuple(paths), held, delay)
+        result = _consistent_of(robot, model, held, first, opt, prior)
+        return IdentifyResult(model, result, (), held)
+    model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
+    return IdentifyResult(model, None, (), held, delay)
+
+
+def _consistent_of(
+    robot: Robot,
+    model: IdentifiedModel,
+    held: HeldOutTorques | None,
+    first: CorrectedSearch | None,
+    opt: IdentifyOptions,
+    prior: Robot | None,
+) -> ConsistentResult:
+    """The one-step consistent fit of the search's ``model``
+    (:func:`~dynid.feasibility.convex.fit.consistent_from_identified`, as
+    :func:`~dynid.feasibility.convex.fit.identify_consistent` makes it); where the torque
+    constants were judged first (``first``), of the corrected search's model, fitted to
+    the efforts its factors correct (its drive, the drive's torque constants times them,
+    is the result's; a note names the factors); least squares' own held-out residual
+    (``held``) said where the consistent fit's judgement rejects it
+    (:func:`_with_outside_model_note`)."""
+    result = consistent_from_identified(
+        robot, model, kind="log", prior=prior, total_mass=opt.total_mass, options=opt.sdp()
+    )
+    if first is not None:
+        result = dataclasses.replace(result, notes=(first.consistent_note(), *result.notes))
+    return _with_outside_model_note(result, held, robot.joint_names)
 
 
 def _predicted_heldout(
@@ -442,64 +609,28 @@ def _say_gravity_scale(
         warnings.warn(found, DynidWarning, stacklevel=4)
 
 
-def _identify(
-    robot: Robot, paths: list[Path], opt: IdentifyOptions
-) -> tuple[IdentifiedModel, HeldOutTorques | None, TorqueDelay | None]:
-    """The unconstrained fit of :func:`identify_files` and, from torque logs, its
-    held-out prediction and the torques' delay its residual points to."""
-    path = paths[0]
-    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
-    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
-    kind = data_kind(path, cmap)
-    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
-    if kind == "torque_log":
-        logs = _read_logs(robot, paths, cmap, opt, heldout.get("validate_on"))
-
-        def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
-            return identify_recordings(
-                robot,
-                logs,
-                [p.name for p in paths],
-                structure=structure,
-                max_std_percent=opt.max_std_percent,
-                rtol=opt.rtol,
-                max_gap_s=opt.max_gap_s,
-                torque_delay_s=opt.torque_delay_s or 0.0,
-                drive=drive,
-                estimator=opt.estimator,
-                std=opt.std or "hac",
-                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
-                **heldout,
-            )
-
-        separate = heldout.get("validate_on")
-        fit = lambda: _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)  # noqa: E731
-        model, held = in_file(path, fit) if len(paths) == 1 else fit()
-        _say_gravity_scale(robot, model, logs, opt.drive, held)
-        model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
-    else:
-        held = delay = None
-        _one_static_file(paths, opt)
-        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
-        outside = limit_violations(robot, data.q)
-        if outside is not None:
-            warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=3)
-        model = in_file(
-            path,
-            lambda: identify_static(
-                robot,
-                data,
-                max_std_percent=opt.max_std_percent,
-                rtol=opt.rtol,
-                std=opt.std or "robust",
-                drive=opt.drive,
-                estimator=opt.estimator,
-            ),
-        )
-        misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
-        if misfit is not None:
-            warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
-    return _record(model, opt.columns), held, delay
+def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> IdentifiedModel:
+    """The unconstrained fit of static data ``data`` read from ``path``; configurations
+    outside the joint limits and a relative error far above the recorded noise warned."""
+    outside = limit_violations(robot, data.q)
+    if outside is not None:
+        warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=3)
+    model = in_file(
+        path,
+        lambda: identify_static(
+            robot,
+            data,
+            max_std_percent=opt.max_std_percent,
+            rtol=opt.rtol,
+            std=opt.std or "robust",
+            drive=opt.drive,
+            estimator=opt.estimator,
+        ),
+    )
+    misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
+    if misfit is not None:
+        warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
+    return _record(model, opt.columns)
 
 
 def _searched(
@@ -508,18 +639,19 @@ def _searched(
     drive: Drive | None,
     logs: Sequence[TorqueLog],
     separate: TorqueLog | None,
-) -> tuple[IdentifiedModel, HeldOutTorques | None]:
-    """The model of ``structure`` and its held-out prediction; chosen (``"auto"``) through
+) -> tuple[IdentifiedModel, HeldOutTorques | None, CorrectedSearch | None]:
+    """The model of ``structure``, its held-out prediction and the corrected search
+    (None: not run, or no factor named); chosen (``"auto"``) through
     a current log's drive and pointing to the torque constants
     (:func:`~dynid.workflows.gains_first.reason_to_judge_first`), chosen again on the
     efforts corrected by the factors the richest structure names
     (:func:`~dynid.workflows.gains_first.gains_first`: its factors are the held-out
-    verdict's), fitted to the efforts as logged, its selection and a note saying so; the
-    first model's warnings said only when it is kept."""
+    verdict's), fitted to those efforts (its drive's torque constants times the factors),
+    with a note saying so; the first model's warnings said only when it is kept."""
     current = drive is not None and drive.effort == "current"
     if structure != "auto" or not current:
         model = fitted(structure, drive)
-        return model, _predicted_heldout(model, logs, separate)
+        return model, _predicted_heldout(model, logs, separate), None
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         model = fitted(structure, drive)
@@ -529,14 +661,11 @@ def _searched(
     if first is None:
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        return model, held
-    with warnings.catch_warnings(record=True) as refitted:
-        warnings.simplefilter("always")
-        model = fitted(first.structure, drive)
-    _say_once((*first.said, *refitted))
+        return model, held, None
+    _say_once(first.said)
+    model = first.searched  # fitted to the corrected efforts: no term takes up the constants
     info = dataclasses.replace(
         model.info,
-        selection=first.searched.info.selection,
         notes=(*model.info.notes, first.note()),
         extra={**model.info.extra, "gains_first": first.note()},
     )
@@ -544,7 +673,7 @@ def _searched(
     held = _predicted_heldout(model, logs, separate)
     if held is not None:  # one judgement of the efforts' scale
         held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
-    return model, held
+    return model, held, first
 
 
 def _say_once(said: Sequence[warnings.WarningMessage]) -> None:
@@ -659,69 +788,27 @@ def _with_outside_model_note(
     return result if said is None else dataclasses.replace(result, notes=(said, *result.notes))
 
 
-def _identify_consistent(
-    robot: Robot, paths: list[Path], opt: IdentifyOptions, prior: Robot | None
-) -> tuple[ConsistentResult, HeldOutTorques | None]:
-    """The one-step consistent fit of :func:`identify_files`
-    (:func:`~dynid.feasibility.convex.fit.identify_consistent`), the data read and checked
-    as for the unconstrained fit, and (torque logs) the unconstrained fit's held-out
-    prediction.
-
-    Torque logs (one or more, ``max_gap_s`` honoured): the model's structure is chosen on
-    held-out data as the unconstrained fit chooses it (or given by ``terms``), and the
-    convex problem keeps each of its terms physical as the term declares (the Python
-    API's call, so that both give the same parameters); ``folds``/``validate_on`` choose
-    the held-out judgement of the prior weight and of the fit. ``identified`` of the
-    result holds the unconstrained fit.
-    """
-    path = paths[0]
-    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
-    check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
-    kind = data_kind(path, cmap)
-    heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)
-    common: dict[str, Any] = dict(prior=prior, total_mass=opt.total_mass, options=opt.sdp())
-    if kind == "torque_log":
-        separate = heldout.get("validate_on")
-        logs = _read_logs(robot, paths, cmap, opt, separate)
-
-        def fit() -> ConsistentResult:
-            return identify_consistent(
-                robot,
-                logs,
-                names=[p.name for p in paths],
-                structure=parsed_terms(opt.terms),
-                rtol=opt.rtol,
-                drive=opt.drive,
-                estimator=opt.estimator,
-                std=opt.std,
-                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
-                max_gap_s=opt.max_gap_s,
-                **heldout,
-                **common,
-            )
-
-        result = in_file(path, fit) if len(paths) == 1 else fit()
-        unconstrained = result.identified
-        held = None if unconstrained is None else _predicted_heldout(unconstrained, logs, separate)
-        if unconstrained is not None:
-            _say_gravity_scale(robot, unconstrained, logs, opt.drive, held)
-        result = _with_outside_model_note(result, held, robot.joint_names)
-    else:
-        held = None
-        _one_static_file(paths, opt)
-        data = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
-        result = in_file(
-            path,
-            lambda: identify_consistent(
-                robot,
-                data,
-                rtol=opt.rtol,
-                drive=opt.drive,
-                estimator=opt.estimator,
-                std=opt.std,
-                **common,
-            ),
-        )
+def _consistent_static(
+    robot: Robot, path: Path, data: Any, opt: IdentifyOptions, prior: Robot | None
+) -> tuple[ConsistentResult, IdentifiedModel]:
+    """The one-step consistent fit of static data ``data`` read from ``path``
+    (:func:`~dynid.feasibility.convex.fit.identify_consistent`) and its unconstrained fit
+    (``identified``), with the column map the data were read with."""
+    result = in_file(
+        path,
+        lambda: identify_consistent(
+            robot,
+            data,
+            rtol=opt.rtol,
+            drive=opt.drive,
+            estimator=opt.estimator,
+            std=opt.std,
+            prior=prior,
+            total_mass=opt.total_mass,
+            options=opt.sdp(),
+        ),
+    )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    return dataclasses.replace(result, identified=_record(result.identified, opt.columns)), held
+    model = _record(result.identified, opt.columns)
+    return dataclasses.replace(result, identified=model), model

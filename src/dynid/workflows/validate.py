@@ -56,6 +56,7 @@ from ..friction.pooled import joined_validation
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
+from ..identification.drive_gains import DriveGains
 from ..identification.floor_verdict import (
     judged_prediction,
     opposite_sign,
@@ -241,6 +242,12 @@ class ValidateResult:
         columns to the recordings joined (:func:`~dynid.friction.heldout_torques.
         residual_tilt`; said in ``verdict``'s reason when
         :attr:`~dynid.identification.gravity_tilt.GravityTilt.named`); None: not judged.
+    gains : DriveGains, optional
+        The gain per motor of the logged efforts the residual points to, judged on the
+        recordings' contiguous time blocks held out in turn as identify's held-out verdict
+        judges them (:func:`~dynid.friction.heldout_torques.residual_gains`; its named
+        motors' factors the verdict's reason names, in place of a spring or a tilt); judged
+        on a current log even beside a sign finding; None: not judged (a good verdict).
     """
 
     validation: RecordingsValidation
@@ -263,6 +270,7 @@ class ValidateResult:
     torque_delay: TorqueDelay | None = None
     applied_delay: AppliedDelay | None = None
     gravity_tilt: GravityTilt | None = None
+    gains: DriveGains | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -279,7 +287,9 @@ class ValidateResult:
         ``springs`` (the stiffness per joint the residual points to, when judged:
         :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`),
         ``gravity_tilt`` (the tilt of the gravity vector the residual points to, as
-        ``heldout.json`` records it: null when not judged) and
+        ``heldout.json`` records it: null when not judged),
+        ``drive_gains`` (the gains per motor, when judged:
+        :meth:`~dynid.identification.drive_gains.DriveGains.as_dict`) and
         ``torque_delay`` (the torques' lag behind the positions, when named:
         :meth:`~dynid.identification.torque_delay.TorqueDelay.as_dict`) and
         ``torque_delay_used`` (the delay the recordings were prepared with and its source,
@@ -312,6 +322,7 @@ class ValidateResult:
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
             "gravity_tilt": None if self.gravity_tilt is None else self.gravity_tilt.as_dict(),
+            **({"drive_gains": self.gains.as_dict()} if self.gains is not None else {}),
             **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
             **({"torque_delay_used": a.as_dict()} if (a := self.applied_delay) else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
@@ -396,8 +407,7 @@ def validate_files(
 
     val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
     val = _banded(run, friction) if val is None else val  # friction as observe evaluates it
-    errors = _finite(val, rec.names, label, opt)
-    names = robot.joint_names
+    errors, names = _finite(val, rec.names, label, opt), robot.joint_names
     inputs = _input_noise(model, val.friction, val)
     verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
     verdict = _worst_recording(val, verdict, rec.names, names, inputs)
@@ -406,12 +416,12 @@ def validate_files(
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
     # a torque of the opposite sign leaves twice the torque, which no term of the model
-    # explains: what the residual follows is not diagnosed (it read as an offset)
-    dependence = not beyond and not opposite
-    verdict, springs, tilt = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model),
-        offsets=offsets_of(model), left_out=friction_left_out(model),
-    )  # fmt: skip
+    # explains: what the residual follows is not diagnosed (a current log's gains are)
+    current = not beyond and placed is not None and placed.effort == "current"
+    verdict, springs, gains, tilt = _with_hints(
+        model, verdict, val, rec.logs, noise, names, dependence=not beyond and not opposite,
+        terms=held_terms(model), offsets=offsets_of(model), left_out=friction_left_out(model),
+        gains_too=current)  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
@@ -434,8 +444,8 @@ def validate_files(
         sign_map=sign_map,
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
-        springs=springs,
-        torque_delay=delay, applied_delay=applied, gravity_tilt=tilt,
+        springs=springs, gains=gains, torque_delay=delay, applied_delay=applied,
+        gravity_tilt=tilt,
     )  # fmt: skip
 
 
@@ -486,7 +496,8 @@ def _with_hints(
     terms: frozenset[str] = frozenset(),
     offsets: Mapping[int, tuple[str, bool]] | None = None,
     left_out: Mapping[int, tuple[str, ...]] | None = None,
-) -> tuple[Verdict, ResidualSpring | None, GravityTilt | None]:
+    gains_too: bool = False,
+) -> tuple[Verdict, ResidualSpring | None, DriveGains | None, GravityTilt | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
@@ -498,20 +509,22 @@ def _with_hints(
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
     with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`; in
     their place, a gain per motor of the logged efforts that explains the residual,
-    :func:`~dynid.friction.heldout_torques.residual_gains`), the
-    hint of a
-    cut-off too high for derived states, and that of an error at low speed; and the
-    springs and the tilt fitted (None: not judged)."""
+    :func:`~dynid.friction.heldout_torques.residual_gains`, judged with ``dependence``
+    False too where ``gains_too``: a current log, whose factors a sign finding does not
+    explain), the hint of a cut-off too high for derived states, and that of an error at
+    low speed; and the springs, the gains and the tilt fitted (None: not judged)."""
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     springs = tilt = None
-    whole = joined_validation(val.parts) if dependence and verdict.level != "good" else None
+    judged = (dependence or gains_too) and verdict.level != "good"
+    whole = joined_validation(val.parts) if judged else None
     gains = None if whole is None else residual_gains(model, whole, noise.total)
     said = None if gains is None else gains.sentence()
     if said is not None:  # the efforts' scale per motor explains it: no spring, no tilt
         verdict = with_hint(verdict, said)
     elif dependence:
+        whole = whole if dependence else None
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
@@ -527,7 +540,7 @@ def _with_hints(
             verdict, reason=f"{verdict.reason}; a floor raised because {high}"
         )
     # the low-speed hint's "above the noise": the sensors' (its module docstring)
-    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs, tilt
+    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs, gains, tilt
 
 
 @dataclass(frozen=True, slots=True)
