@@ -143,7 +143,8 @@ def test_the_kept_model_reads_the_corrected_efforts(guessed):
     the true 0.2 kg m^2, every viscous and Coulomb coefficient within 10 % of the true 0.4
     and 0.3, no offset above 0.5 N m), where fitted to the currents as logged it read
     Ia4 = 1.95 and viscous friction below zero on joints 2 and 4; its held-out verdict at
-    the floor (under 2 x) still names the factors."""
+    the floor (under 2 x) still names the factors, saying the model's drive holds the
+    corrected constants (not to identify again)."""
     model = guessed.model
     assert model.drive is not None and model.drive.torque_constant is not None
     np.testing.assert_allclose(model.drive.torque_constant[[1, 3]], KT[[1, 3]], rtol=0.01)
@@ -157,7 +158,9 @@ def test_the_kept_model_reads_the_corrected_efforts(guessed):
     assert max(offsets, default=0.0) < 0.5, values
     held = guessed.heldout
     assert held is not None and held.verdict.ratio is not None and held.verdict.ratio < 2.0
-    assert held.gains is not None and held.gains.named == (1, 3)
+    assert held.gains is not None and held.gains.named == (1, 3) and held.gains.applied
+    said = held.verdict.reason  # the model already reads the corrected constants
+    assert "identify again" not in said and "drive holds the corrected torque_constant" in said
 
 
 def test_the_consistent_fit_reads_the_corrected_efforts(guessed, current_log):

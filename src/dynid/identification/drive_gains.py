@@ -123,6 +123,10 @@ class DriveGains:
         :attr:`factor`): what the in-sample :attr:`cov` misses where the residual is not
         white (model error a gain takes up differently in each part of the log); NaN
         where not fitted; None without folds.
+    applied : bool
+        The model was fitted to the efforts these factors correct (``identify`` judging a
+        current log's torque constants first): its drive holds the corrected constants, and
+        the finding says to put them in the drive file, not to identify again.
     """
 
     factor: NDArray[np.float64]
@@ -136,6 +140,7 @@ class DriveGains:
     heldout_gain: NDArray[np.float64] | None = None
     heldout_se: NDArray[np.float64] | None = None
     heldout_std: NDArray[np.float64] | None = None
+    applied: bool = False
 
     def ratio_std(self, k: int, r: int) -> float:
         """The standard deviation [-] of motor ``k``'s gain relative to motor ``r``'s,
@@ -246,7 +251,8 @@ class DriveGains:
         """JSON-ready: ``factor`` and ``std`` per motor (null where left out), ``scaled``,
         ``ratio_fixed``, ``ratio_fitted``, ``ratio_held`` (per motor), ``determined`` and
         ``named`` (the motors' indices from 0), ``heldout_gain``, ``heldout_se`` and
-        ``heldout_std`` (per motor; null without folds), ``effort`` and ``per``."""
+        ``heldout_std`` (per motor; null without folds), ``effort``, ``per`` and
+        ``applied`` (the model was fitted to the efforts the factors correct)."""
 
         def listed(x: NDArray[np.float64] | None) -> list[float | None] | None:
             if x is None:
@@ -267,6 +273,7 @@ class DriveGains:
             "heldout_std": listed(self.heldout_std),
             "effort": self.effort,
             "per": self.per,
+            "applied": self.applied,
         }
 
     def sentence(self) -> str | None:
@@ -321,6 +328,12 @@ class DriveGains:
         loose = ", ".join(str(k + 1) for k in np.flatnonzero(~self.determined))
         if loose:
             said += f"; the data do not determine the gain of {unit}(s) {loose}"
+        if what == "current" and self.applied:
+            return said + (
+                ": the model is fitted to the currents these factors correct, and "
+                "identification.json's drive holds the corrected torque_constant: put it in "
+                "the drive file to read other logs through it"
+            )
         if what == "current":
             return said + ": change torque_constant in the drive file and identify again"
         return said + (

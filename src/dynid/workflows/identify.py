@@ -672,7 +672,8 @@ def _searched(
     model = dataclasses.replace(model, info=info)
     held = _predicted_heldout(model, logs, separate)
     if held is not None:  # one judgement of the efforts' scale
-        held = dataclasses.replace(held, gains=first.gains, springs=None, tilt=None)
+        gains = None if first.gains is None else dataclasses.replace(first.gains, applied=True)
+        held = dataclasses.replace(held, gains=gains, springs=None, tilt=None)
     return model, held, first
 
 
