@@ -131,9 +131,10 @@ def test_a_noisy_log_is_not_read_as_exact():
 def test_noise_of_smooth_signals_reads_their_rounding_and_white_noise_its_std():
     """Harmonics at 200 Hz (0.5 to 2 Hz) read noise at 1e-15 of their RMS (the
     differences of order 2 and 3 read 1e-4 to 1e-6); white noise of std 0.01 on them
-    reads 0.01 within 10 %, and is not round-off."""
+    reads 0.01 within 10 %, and is not round-off, nor noise of 1e-6 on the last 3000 of
+    5000 samples."""
     rng = np.random.default_rng(21)
-    t = np.arange(2000) / 200.0
+    t = np.arange(5000) / 200.0
     f = rng.uniform(0.5, 2.0, 3)
     x = 5.0 + np.sin(2 * np.pi * f * t[:, None] + rng.uniform(0, 6, 3))
     rms = np.sqrt(np.mean(x**2, axis=0))
@@ -144,6 +145,9 @@ def test_noise_of_smooth_signals_reads_their_rounding_and_white_noise_its_std():
     np.testing.assert_allclose(smooth_noise_std(noisy), 0.01, rtol=0.1)
     assert not at_round_off(noisy, t).any()
     np.testing.assert_array_equal(quantized_noise_std(noisy, t), velocity_noise_std(noisy, t))
+    late = x.copy()
+    late[2000:] += rng.normal(0.0, 1e-6, (3000, 3))  # noise past the first samples read
+    assert not at_round_off(late, t).any()
     jittered = t + rng.uniform(-1e-4, 1e-4, t.shape)
     assert not at_round_off(x, jittered).any()  # uneven stamps: never called exact
 

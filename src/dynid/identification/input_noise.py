@@ -128,7 +128,7 @@ def exact_to_round_off(logs: Sequence[TorqueLog]) -> bool:
     for log in logs:
         if log.dq_derived or log.n_samples < 4:
             return False
-        for x in (log.q, log.dq, log.tau, *(() if log.ddq is None else (log.ddq,))):
+        for x in (log.tau, log.q, log.dq, *(() if log.ddq is None else (log.ddq,))):
             if not at_round_off(x, log.t).all():
                 return False
     return True

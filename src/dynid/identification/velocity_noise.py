@@ -24,6 +24,7 @@ __all__ = [
     "MIN_MOTION",
     "MOVING_FRACTION",
     "NOISE_BAND_STD",
+    "PROBE_SAMPLES",
     "ROUND_OFF_SHARE",
     "at_round_off",
     "moving_joints",
@@ -45,6 +46,9 @@ MOVING_FRACTION = 0.01
 #: torques' RMS from the 9th on), while white noise's difference of order 10 holds the
 #: noise times 427 (``sqrt(C(20, 10))``), still far within float64.
 MAX_DIFFERENCE_ORDER = 10
+#: Samples :func:`at_round_off` reads first: a column with noise there is not exact, and
+#: the whole column is read only when they are (a long measured log costs no more).
+PROBE_SAMPLES = 2048
 #: The white noise, as a share of a column's RMS, at or below which the column is exact to
 #: round-off (:func:`at_round_off`): float64's rounding is 1.1e-16 of a value, a noise-free
 #: simulation reads 6e-16 to 8e-16, a CSV of 9 significant digits 3e-10 and any sensor more.
@@ -146,8 +150,11 @@ def smooth_noise_std(x: ArrayLike) -> NDArray[np.float64]:
 def at_round_off(x: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.bool_]:
     """Which columns (n,) of ``x`` (N, n), sampled at the times ``t`` (N,) [s], hold no
     noise beyond round-off: :func:`smooth_noise_std` at most :data:`ROUND_OFF_SHARE` of
-    the column's RMS. None at uneven times (jitter, gaps: the differences hold the motion)
-    nor with fewer than 4 samples. Raises as :func:`velocity_noise_std`."""
+    the column's RMS, over its first :data:`PROBE_SAMPLES` samples and then over all. None
+    at uneven times (jitter, gaps: the differences hold the motion) nor with fewer than 4
+    samples. The medians read the majority of the samples (a few steps of Coulomb friction
+    at reversals do not count): a column noisy over fewer than half of them reads exact.
+    Raises as :func:`velocity_noise_std`."""
     a = _checks.as_array("x", x)
     if a.ndim != 2:
         raise ShapeError(f"x must have shape (N, n), N >= 3; got {a.shape}")
@@ -158,6 +165,14 @@ def at_round_off(x: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.bool_]:
         h = float(np.median(dt))
         if not (h > 0 and np.all(np.abs(dt - h) <= 1e-6 * h)):
             return np.zeros(a.shape[1], dtype=bool)
+    out = _round_off(a[:PROBE_SAMPLES])  # a noisy log told from its first samples
+    if a.shape[0] > PROBE_SAMPLES and out.any():
+        out[out] = _round_off(a[:, out])
+    return out
+
+
+def _round_off(a: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """:func:`at_round_off` of the evenly sampled columns of ``a`` (N, n), N >= 4."""
     rms = np.sqrt(np.mean(np.square(a), axis=0))
     out: NDArray[np.bool_] = smooth_noise_std(a) <= ROUND_OFF_SHARE * rms
     return out
