@@ -25,6 +25,8 @@ the prediction: exactly for the accelerations (the torques are linear in them), 
 equal-probability nodes of the noise for the velocities (a friction step is not
 differentiable); :func:`noise_floor` weighs a prediction's error against both, sample by
 sample, in the terms :func:`~dynid.identification.verdict.judge_prediction` takes.
+:func:`exact_to_round_off` tells logs without noise (a simulation), which identification
+fits unfiltered (:func:`exact_note` says so).
 """
 
 from __future__ import annotations
