@@ -203,11 +203,13 @@ def test_the_heldout_prediction_of_a_wrapped_motor_log_uses_its_q_start_turns(pa
 
 
 def test_a_heldout_prediction_it_cannot_make_is_a_warning_not_a_failure(panda, logs, tmp_path):
-    """The last recording 60 samples long (too short to filter for the prediction):
-    identify_files returns the model, no held-out prediction, and a warning says why."""
+    """The last recording 60 samples long (too short to filter at 8 Hz for the prediction;
+    exact logs are not filtered unless a cut-off is given): identify_files returns the
+    model, no held-out prediction, and a warning says why."""
     (_, last), (first, _) = logs
     short = tmp_path / "short.csv"
     save_torque_log(short, last.select(slice(0, 60)))
+    opt = IdentifyOptions(terms="viscous", cutoff_hz=8.0)
     with pytest.warns(DynidWarning, match=r"skipped the held-out prediction .*trimming"):
-        result = identify_files(panda, [first, short], IdentifyOptions(terms="viscous"))
+        result = identify_files(panda, [first, short], opt)
     assert result.heldout is None and result.model.holdout is not None

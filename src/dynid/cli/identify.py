@@ -56,7 +56,11 @@ Torque logs are read strictly: rows with NaN/inf or a repeated timestamp are an 
 unless --drop-invalid; gaps up to --max-gap are bridged. Accelerations: a log with a
 complete ddq1..ddqn set (or a `ddq` array in an NPZ, or `--columns ddq=...`) has them
 used as given, low-pass filtered at the cut-off with the other signals; without one they
-are the derivative of the filtered velocities (an incomplete set is an error).
+are the derivative of the filtered velocities (an incomplete set is an error). A log exact
+to round-off (a noise-free simulation: every column's noise, read from its differences up
+to order 10, at most 1e-12 of its RMS) is fitted unfiltered at every sample, nothing
+trimmed or decimated, its accelerations as logged or differentiated from its velocities
+to order 8; a note in the summary says so (--cutoff still sets a filter).
 
 Writes DIR/identification.json (coefficients, expressions, std, metrics, kinematics,
 identifiability of every standard parameter), from torque logs heldout.json and the
@@ -250,7 +254,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="HZ",
         help="torque logs: zero-phase low-pass cutoff [Hz] (default: 10 x the motion's highest "
         "significant frequency, read from the log; decimation keeps at least 10 %% of the "
-        "samples)" + CUTOFF_NONE_HELP,
+        "samples; none for a log exact to round-off)" + CUTOFF_NONE_HELP,
     )
     p.add_argument(
         "--folds",

@@ -25,6 +25,8 @@ the prediction: exactly for the accelerations (the torques are linear in them), 
 equal-probability nodes of the noise for the velocities (a friction step is not
 differentiable); :func:`noise_floor` weighs a prediction's error against both, sample by
 sample, in the terms :func:`~dynid.identification.verdict.judge_prediction` takes.
+:func:`exact_to_round_off` tells logs without noise (a simulation), which identification
+fits unfiltered (:func:`exact_note` says so).
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks, signals
 from ..exceptions import ShapeError
 from .log import TorqueLog
-from .velocity_noise import velocity_noise_std
+from .velocity_noise import ROUND_OFF_SHARE, at_round_off, signal_noise_std
 from .verdict import NOISE_FLOOR_SHARE, joint_ratios
 
 __all__ = [
@@ -47,6 +49,8 @@ __all__ = [
     "NoiseFloor",
     "StateNoise",
     "derived_noise_gains",
+    "exact_note",
+    "exact_to_round_off",
     "input_noise_var",
     "noise_floor",
     "quantization_step",
@@ -99,7 +103,7 @@ def quantization_step(x: ArrayLike) -> NDArray[np.float64]:
 
 def quantized_noise_std(x: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.float64]:
     """The white-noise std (n,) of the samples ``x`` (N, n) at times ``t`` (N,): the
-    differences' estimate (:func:`~dynid.identification.velocity_noise.velocity_noise_std`), at
+    differences' estimate (:func:`~dynid.identification.velocity_noise.signal_noise_std`), at
     least ``step / sqrt(12)`` of a quantized column (:func:`quantization_step`).
 
     A quantized signal that moves less than a step between samples changes at a few samples
@@ -108,7 +112,45 @@ def quantized_noise_std(x: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.
     that spans many steps.
     """
     a = _checks.as_array("x", x)
-    return np.maximum(velocity_noise_std(a, t), rounding_std(a))
+    return np.maximum(signal_noise_std(a, t), rounding_std(a))
+
+
+def exact_to_round_off(logs: Sequence[TorqueLog]) -> bool:
+    """Whether every log of ``logs`` is exact to round-off: its positions, measured
+    velocities, torques and accelerations (when it holds them), each column
+    (:func:`~dynid.identification.velocity_noise.at_round_off`: a noise-free simulation).
+
+    Such logs need nothing a filter gives: a zero-phase low-pass of exact signals only
+    bends the motion the rigid body's torques follow (their products of the states are
+    not the products of the filtered states), and its edges and the decimation cost
+    samples. Velocities derived from positions (``dq_derived``) are not exact here.
+    """
+    if not logs:
+        return False
+    for log in logs:
+        if log.dq_derived or log.n_samples < 4:
+            return False
+        for x in (log.tau, log.q, log.dq, *(() if log.ddq is None else (log.ddq,))):
+            if not at_round_off(x, log.t).all():
+                return False
+    return True
+
+
+def exact_note(logs: Sequence[TorqueLog]) -> str:
+    """The one line that says the logs were found exact (:func:`exact_to_round_off`) and
+    fitted as they are, and what limits the fit of those without accelerations."""
+    said = (
+        "the logs' positions, velocities{} and torques are exact to round-off (noise at most "
+        f"{ROUND_OFF_SHARE:g} of their RMS): fitted unfiltered at every sample, none trimmed "
+        "or decimated (--cutoff sets a filter)"
+    )
+    if all(log.ddq is not None for log in logs):
+        return said.format(", accelerations")
+    return said.format("") + (
+        "; their accelerations differentiated from the velocities "
+        f"(differences of order {signals.EXACT_DERIVATIVE_ORDER}), which err by "
+        f"(2 pi f dt)^{signals.EXACT_DERIVATIVE_ORDER} / 630 of them: a ddq column is exact"
+    )
 
 
 def rounding_std(x: ArrayLike) -> NDArray[np.float64]:

@@ -23,6 +23,7 @@ from .. import signals
 from .._times import said_time
 from ..exceptions import DataError, DynidWarning, ShapeError
 from .log import _SIGNALS, DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap
+from .velocity_noise import at_round_off
 
 __all__ = [
     "MEASURED",
@@ -129,8 +130,9 @@ def prepare_log(log: TorqueLog, prep: Preprocessing = _DEFAULT) -> TorqueLog:
        log has it) with the zero-phase Butterworth (order 4 applied twice); ``tau`` only if
        ``prep.filter_tau``.
     3. If the log has no ``ddq``: ``ddq`` = derivative of the (filtered) ``dq``
-       (second-order differences). A log whose ``dq`` was derived from ``q``
-       (``log.dq_derived``) gets it derived again at ``cutoff_hz`` first, so that
+       (second-order differences; of order 8 for velocities not filtered and exact to
+       round-off, :func:`~dynid.signals.exact_derivative`). A log whose ``dq`` was derived
+       from ``q`` (``log.dq_derived``) gets it derived again at ``cutoff_hz`` first, so that
        velocities, accelerations, positions and torques share one cut-off.
     4. Drop ``prep.trim_s`` seconds at each end (default ``2 / cutoff_hz`` when
        filtering, else 0).
@@ -482,7 +484,8 @@ def _plan(log: TorqueLog, prep: Preprocessing) -> _Plan:
             f"every {decimate}-th"
         )
     derived = log.dq_derived and cutoff_hz is not None
-    pad = 2  # the central differences' neighbours
+    # the central differences' neighbours (an exact log's unfiltered: signals.exact_derivative's)
+    pad = 2 if cutoff_hz is not None else signals.EXACT_DERIVATIVE_ORDER // 2
     if cutoff_hz is not None:
         pad += int(np.ceil(SETTLE_CYCLES * rate / cutoff_hz)) * (2 if derived else 1)
     return _Plan(t, bool(uniform), rate, cutoff_hz, float(trim_s), out, pad, derived)
@@ -564,6 +567,20 @@ def _usable_cutoff(cutoff_hz: float | None, rate: float, n_samples: int) -> floa
     return cutoff_hz
 
 
+def _derivative(
+    t: NDArray[np.float64], x: NDArray[np.float64], *, exact: bool
+) -> NDArray[np.float64]:
+    """The derivative of the column ``x`` (N,) at the uniform times ``t`` (N,) [s]:
+    :func:`~dynid.signals.exact_derivative` where ``exact`` (not filtered) and ``x`` is
+    exact to round-off (:func:`~dynid.identification.velocity_noise.at_round_off`: a
+    noise-free simulation's velocities, whose second-order differences err by
+    ``(2 pi f dt)^2 / 6``), else :func:`~dynid.signals.derivative`."""
+    n_exact = signals.EXACT_DERIVATIVE_ORDER + 1
+    if exact and x.shape[0] >= n_exact and at_round_off(x[:, None], t)[0]:
+        return signals.exact_derivative(t, x)
+    return signals.derivative(t, x)
+
+
 def _conditioned(
     t: NDArray[np.float64],
     data: dict[str, NDArray[np.float64]],
@@ -598,7 +615,7 @@ def _conditioned(
                 col = signals.lowpass(col, rate, cutoff_hz)
             y[:, j] = col[rows]
             if dy is not None:
-                dy[:, j] = signals.derivative(t, col)[rows]
+                dy[:, j] = _derivative(t, col, exact=not filtered)[rows]
         out[name] = frozen(y)
         if dy is not None:
             out["ddq"] = frozen(dy)

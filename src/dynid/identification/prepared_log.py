@@ -40,7 +40,7 @@ from .prepare import (
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import check_torque_log, too_few_samples
 from .serial import Serial, hac_lag
-from .velocity_noise import moving_joints, velocity_noise_std
+from .velocity_noise import moving_joints, signal_noise_std
 
 __all__ = ["MAX_FINE_BYTES", "PreparedLog", "prepare_torque_log"]
 
@@ -80,7 +80,7 @@ class PreparedLog(TorqueRoute):
         The raw log's counts (``n_samples``, ``duration``, ``cleaning``).
     torque_noise_std : ndarray, shape (n,), or None
         White-noise std [N m] per joint of the raw log's joint-side torques
-        (:func:`~dynid.identification.velocity_noise.velocity_noise_std`, which reads any signal's).
+        (:func:`~dynid.identification.velocity_noise.signal_noise_std`, which reads any signal's).
     tau_raw : ndarray, shape like ``log.tau``, or None
         The joint-side torques at the prepared samples as measured, not low-passed (None
         when the log was not filtered): the held-out judgement predicts them, as
@@ -285,7 +285,7 @@ def prepare_torque_log(
         if fine is None:
             head, tail = trimmed_margins(jlog, prep)
         stamps = jlog.t if resamples(jlog, prep) else None
-    noise = velocity_noise_std(jlog.tau, jlog.t) if jlog.n_samples >= 3 else None
+    noise = signal_noise_std(jlog.tau, jlog.t) if jlog.n_samples >= 3 else None
     del jlog
     return PreparedLog(
         log=prepared,

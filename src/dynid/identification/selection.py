@@ -84,6 +84,7 @@ from .dissipation import (
 )
 from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut
+from .input_noise import exact_note, exact_to_round_off
 from .judge import heldout_judge
 from .largest import Fitted, LeftOut, fit_largest, recording_bands
 from .least_squares import StdMethod, within_motion_caveat
@@ -927,8 +928,8 @@ def identify_recordings(
         The terms beside the links; ``"auto"`` (default) chooses them on held-out data.
     cutoff_hz : float, "auto" or None
         Zero-phase low-pass cut-off [Hz] of every recording; ``"auto"`` (default) read from
-        their motion (:func:`~dynid.identification.trim.common_cutoff`); None for
-        noise-free data (the logs' ``ddq`` used if present, else differentiated).
+        their motion (:func:`~.trim.common_cutoff`), none for logs exact to round-off;
+        None for noise-free data (the logs' ``ddq`` used if present, else differentiated).
     trim_s, max_gap_s, torque_delay_s
         As :func:`~dynid.identification.recordings.prepare_recordings` (recorded).
     decimate : int, optional
@@ -977,6 +978,7 @@ def identify_recordings(
         check_placement(structure, drive)
     elif base is not None:
         raise OptionError("base applies to a structure given, not to one chosen (auto)")
+    exact, cutoff_hz = _exact(logs, cutoff_hz)  # nothing to filter: it would bend the motion
     data, validation = _recordings(
         robot, logs, names, validate_on, drive, torque_delay_s=torque_delay_s,
         cutoff_hz=cutoff_hz, trim_s=trim_s, max_gap_s=max_gap_s, decimate=decimate,
@@ -988,6 +990,7 @@ def identify_recordings(
             robot, data, drive=drive, estimator=est, folds=folds, validation=validation, rtol=rtol
         )
         structure = _fitted_structure(robot, data, selection, friction)
+        selection = selection and replace(selection, notes=(*exact, *selection.notes))
     model_drive, terms = _terms_of(structure, drive, robot.n, data, _limits_middle(robot))
     judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
     try:
@@ -1001,11 +1004,22 @@ def identify_recordings(
     warn_unphysical(model, terms)
     heldout = _heldout_record(model, data if validation is None else validation)
     combined = _combined(robot, data, structure, drive, model.base)
-    notes = (*model.info.notes, *warned_negative_inertias(model))
+    notes = (*exact, *model.info.notes, *warned_negative_inertias(model))
     info = replace(model.info, combined=combined, heldout=heldout, notes=notes)
     extra = {**model.info.extra, "terms": list(structure.terms)}
     info = replace(info, selection=None if selection is None else selection.as_dict(), extra=extra)
     return replace(model, info=info)
+
+
+def _exact(
+    logs: Sequence[TorqueLog], cutoff_hz: float | Literal["auto"] | None
+) -> tuple[tuple[str, ...], float | Literal["auto"] | None]:
+    """The note that the logs are fitted unfiltered and no cut-off, when the cut-off is
+    read from them (``"auto"``) and they are exact to round-off
+    (:func:`~.input_noise.exact_to_round_off`); else no note and ``cutoff_hz``."""
+    if cutoff_hz == "auto" and exact_to_round_off(logs):
+        return (exact_note(logs),), None
+    return (), cutoff_hz
 
 
 def _combined(
