@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 from test_rank_invariance import _drive, _industrial
 
+from dynid.cli.summaries import format_identification
 from dynid.exceptions import DynidWarning
 from dynid.friction.heldout_torques import heldout_torques
 from dynid.friction.model import ClassicalFriction
@@ -94,7 +95,8 @@ def test_the_search_on_exact_friction_free_data_keeps_no_friction(ratio):
     """Regression: on an exact friction-free log without accelerations the search chose
     viscous friction at the motors at ratio 1, its noise floor read 1e-5 %; now the
     truth's structure, links and rotors, at both ends of the sweep, none kept for being
-    determined, the floor at round-off and the note said in the selection."""
+    determined, the floor at round-off and the note said in the selection; the summary's
+    held-out line says its samples were not filtered."""
     (train,), drive = _exact_logs(ratio, (3,), friction=False, ddq=False, duration=3.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
@@ -106,6 +108,8 @@ def test_the_search_on_exact_friction_free_data_keeps_no_friction(ratio):
     assert "exact to round-off" in sel["notes"][0]
     floor = model.info.heldout["noise_floor_percent"]
     assert floor < 1e-10, floor  # the noise read is the rounding
+    text = format_identification(model, verdict_below=True)  # the summary says it as done
+    assert "every sample unfiltered" in text and "filtered and decimated" not in text, text
 
 
 def test_a_noisy_log_is_not_read_as_exact():

@@ -93,7 +93,8 @@ def format_identification(
     ho = info.heldout
     if ho:
         effort = "torque" if model.drive is None else model.drive.effort
-        head.append(heldout_line(dict(ho), effort, verdict_below=verdict_below))
+        filtered = info.log is not None and info.log.cutoff_hz is not None
+        head.append(heldout_line(dict(ho), effort, verdict_below=verdict_below, filtered=filtered))
     if model.base.gap is not None:
         hi, lo = model.base.gap
         head.append(
@@ -462,7 +463,13 @@ def columns_text(model: IdentifiedModel) -> str:
     return f"columns: {cols}, rank {model.fit.rank} of {r + k}"
 
 
-def heldout_line(ho: dict[str, Any], effort: str = "torque", *, verdict_below: bool = False) -> str:
+def heldout_line(
+    ho: dict[str, Any],
+    effort: str = "torque",
+    *,
+    verdict_below: bool = False,
+    filtered: bool = True,
+) -> str:
     """The training and held-out errors of least squares (``info.heldout``: every fold
     predicted by the fit of the others, pooled; the structure's choice reads them).
 
@@ -495,8 +502,8 @@ def heldout_line(ho: dict[str, Any], effort: str = "torque", *, verdict_below: b
         if floor > 0
         else ""
     )
-    if verdict_below:
-        how += ", filtered and decimated samples"
+    if verdict_below:  # (logs exact to round-off are fitted as they are: ``filtered`` False)
+        how += ", filtered and decimated samples" if filtered else ", every sample unfiltered"
     return (
         f"least squares: training error {ho['training_error_percent']:.4g} %, held-out "
         f"error {ho['heldout_error_percent']:.4g} % ({how}{said})"
