@@ -398,9 +398,12 @@ def validate_files(
     # a torque of the opposite sign leaves twice the torque, which no term of the model
     # explains: what the residual follows is not diagnosed (it read as an offset)
     dependence = not beyond and not opposite
+    rotors = placed is not None and placed.rotor_inertia is not None
+    terms = held_terms(model) | ({"armature"} if rotors else set())
     verdict, springs = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=held_terms(model),
+        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=terms,
         offsets=offsets_of(model), left_out=friction_left_out(model),
+        inertia=_urdf_inertia(model, label, terms),
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
@@ -456,6 +459,24 @@ def _with_delay(
     return verdict, delay, applied
 
 
+#: The remedy of a residual that follows a joint's acceleration, of a robot read from a
+#: URDF without a drive's rotor inertias: the file cannot hold them.
+URDF_INERTIA = (
+    "a URDF holds no armature: dynid's URDF export leaves it out, and warns so; validate "
+    "the MJCF export (robot.xml), which holds it as armature, or give --drive a drive file "
+    "with rotor_inertia"
+)
+
+
+def _urdf_inertia(
+    model: IdentifiedModel | Robot, label: str | None, terms: frozenset[str]
+) -> str | None:
+    """:data:`URDF_INERTIA` for a robot read from a URDF (``label`` naming it) whose model
+    holds no armature, else None (the remedy by the model's terms)."""
+    urdf = isinstance(model, Robot) and (label or "").lower().endswith(".urdf")
+    return URDF_INERTIA if urdf and "armature" not in terms else None
+
+
 def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
     """Each joint's largest speed [rad/s] over the identification's samples, or None (a
     robot, a model of static data)."""
@@ -476,6 +497,7 @@ def _with_hints(
     terms: frozenset[str] = frozenset(),
     offsets: Mapping[int, tuple[str, bool]] | None = None,
     left_out: Mapping[int, tuple[str, ...]] | None = None,
+    inertia: str | None = None,
 ) -> tuple[Verdict, ResidualSpring | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
@@ -483,7 +505,8 @@ def _with_hints(
     any residual follows the motion; ``terms`` the model's, which its remedies leave out;
     ``offsets`` its offset per joint, with which a constant residual is told;
     ``left_out`` its friction coefficients left out per joint, named where the residual
-    follows the velocity;
+    follows the velocity; ``inertia`` the remedy of a residual that follows a joint's
+    acceleration (a URDF's: :func:`_urdf_inertia`);
     first the tilt of the gravity vector the residual points to, when it explains it:
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
     with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`; in
@@ -505,9 +528,10 @@ def _with_hints(
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
+        ddq = [v.log.ddq for v in val.parts]
         verdict = with_dependence_hint(
             verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau,
-            offsets, left_out,
+            offsets, left_out, None if any(a is None for a in ddq) else ddq, inertia,
         )  # fmt: skip
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
