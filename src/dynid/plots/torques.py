@@ -103,7 +103,7 @@ def _mark_recordings(
     from matplotlib.ticker import MaxNLocator
 
     step = MaxNLocator(nbins=max(2, int(8 / len(names))), steps=[1, 2, 2.5, 5, 10])
-    local = step.tick_values(0.0, float(length.max()))
+    local = np.asarray(step.tick_values(0.0, float(length.max())), dtype=np.float64)
     dt = float(local[1] - local[0]) if local.size > 1 else float(length.max()) or 1.0
     ticks, labels = [], []
     for a, d in zip(at, length, strict=True):

@@ -318,11 +318,12 @@ def _events_parts(name: str, run: RunFiles) -> list[str]:
         if not (is_number(a) and is_number(b)):
             return [json_section(name, doc)]
         into = t0 is not None and t0 != 0.0
+        t0 = t0 if into and t0 is not None else 0.0
         rows.append(
             [
                 str(k), esc(log), esc(e.get("level", "")),
                 esc(", ".join(map(str, e.get("joint_names") or e.get("joints") or ()))),
-                stamp_text(a - t0 if into else a), stamp_text(b - t0 if into else b),
+                stamp_text(a - t0), stamp_text(b - t0),
                 f"{1e3 * (b - a):.0f}", stamp_text(a) if into else "",
                 cell(e.get("peak")),
             ]

@@ -39,7 +39,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -398,12 +398,9 @@ def validate_files(
     # a torque of the opposite sign leaves twice the torque, which no term of the model
     # explains: what the residual follows is not diagnosed (it read as an offset)
     dependence = not beyond and not opposite
-    rotors = placed is not None and placed.rotor_inertia is not None
-    terms = held_terms(model) | ({"armature"} if rotors else set())
     verdict, springs = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=dependence, terms=terms,
-        offsets=offsets_of(model), left_out=friction_left_out(model),
-        inertia=_urdf_inertia(model, label, terms),
+        model, verdict, val, rec.logs, noise, names, dependence=dependence,
+        held=_terms_held(model, placed, label),
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
@@ -468,13 +465,18 @@ URDF_INERTIA = (
 )
 
 
-def _urdf_inertia(
-    model: IdentifiedModel | Robot, label: str | None, terms: frozenset[str]
-) -> str | None:
-    """:data:`URDF_INERTIA` for a robot read from a URDF (``label`` naming it) whose model
-    holds no armature, else None (the remedy by the model's terms)."""
+def _terms_held(
+    model: IdentifiedModel | Robot, drive: Drive | None, label: str | None
+) -> tuple[frozenset[str], str | None]:
+    """The terms ``model`` holds beside the rigid bodies
+    (:func:`~dynid.identification.residual_dependence.held_terms`; ``armature`` too where
+    the ``drive`` placed has rotor inertias), and the remedy of a residual that follows
+    a joint's acceleration: :data:`URDF_INERTIA` for a robot read from a URDF (``label``
+    naming it) without an armature, else None (the remedy by the terms)."""
+    rotors = drive is not None and drive.rotor_inertia is not None
+    terms = held_terms(model) | ({"armature"} if rotors else frozenset())
     urdf = isinstance(model, Robot) and (label or "").lower().endswith(".urdf")
-    return URDF_INERTIA if urdf and "armature" not in terms else None
+    return terms, URDF_INERTIA if urdf and "armature" not in terms else None
 
 
 def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
@@ -494,19 +496,16 @@ def _with_hints(
     names: Sequence[str],
     *,
     dependence: bool = True,
-    terms: frozenset[str] = frozenset(),
-    offsets: Mapping[int, tuple[str, bool]] | None = None,
-    left_out: Mapping[int, tuple[str, ...]] | None = None,
-    inertia: str | None = None,
+    held: tuple[frozenset[str], str | None] = (frozenset(), None),
 ) -> tuple[Verdict, ResidualSpring | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
-    any residual follows the motion; ``terms`` the model's, which its remedies leave out;
-    ``offsets`` its offset per joint, with which a constant residual is told;
-    ``left_out`` its friction coefficients left out per joint, named where the residual
-    follows the velocity; ``inertia`` the remedy of a residual that follows a joint's
-    acceleration (a URDF's: :func:`_urdf_inertia`);
+    any residual follows the motion; ``held`` the model's terms, which its remedies leave
+    out, and the remedy of a residual that follows a joint's acceleration
+    (:func:`_terms_held`); the model's offset per joint, with which a constant residual is
+    told, and its friction coefficients left out per joint, named where the residual
+    follows the velocity;
     first the tilt of the gravity vector the residual points to, when it explains it:
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
     with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`; in
@@ -515,6 +514,8 @@ def _with_hints(
     hint of a
     cut-off too high for derived states, and that of an error at low speed; and the
     springs fitted (None: not judged)."""
+    terms, inertia = held
+    offsets, left_out = offsets_of(model), friction_left_out(model)
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
@@ -528,10 +529,11 @@ def _with_hints(
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
-        ddq = [v.log.ddq for v in val.parts]
+        got = [v.log.ddq for v in val.parts]
+        ddq = [a for a in got if a is not None]
         verdict = with_dependence_hint(
             verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau,
-            offsets, left_out, None if any(a is None for a in ddq) else ddq, inertia,
+            offsets, left_out, ddq if len(ddq) == len(got) else None, inertia,
         )  # fmt: skip
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
