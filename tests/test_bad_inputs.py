@@ -1020,7 +1020,7 @@ CASES = [
     C("trajectory-json-unknown-key", trajectory_json_edited, f"simulate --trajectory {{d}}/extra.json --out {OUT}/x.csv", 2, "extra.json: key 'note': unknown key; allowed: capsule_radii_m,"),
     C("trajectory-json-harmonics-string", trajectory_json_edited, f"simulate --trajectory {{d}}/five.json --out {OUT}/x.csv", 2, "five.json: key 'trajectory.harmonics': expected a number; got 'five'"),
     C("trajectory-json-duration-edited", trajectory_json_edited, f"simulate --trajectory {{d}}/longer.json --out {OUT}/x.csv", 2, "longer.json: key 'trajectory.total_duration_s': expected 21 (from the coefficients; the file was edited: regenerate it with dynid excite); got 3"),
-    C("toml-inertia-triangle", toml_inertia_triangle, "fk --robot {d}/tri.toml --q 0.1,0.2", 0, "the inertial is physically inconsistent: principal moments [0.01, 0.01, 0.05] violate the triangle inequality"),
+    C("toml-inertia-triangle", toml_inertia_triangle, "fk --robot {d}/tri.toml --q 0.1,0.2", 0, "the inertial is physically inconsistent: principal moments 0.01, 0.01, 0.05 kg m^2 violate the triangle inequality (0.01 + 0.01 < 0.05)"),
     # feasible.json read back by export: strict keys and types, sane masses and CoMs
     C("feasible-unknown-key", feasible_edited, "export --params {d}/extra.json --out {d}/out.urdf", 2, "extra.json: key 'note': unknown key; allowed: combined, conventions, drive, dynid_version"),
     C("feasible-kinematics-unknown-key", feasible_edited, "export --params {d}/kin.json --out {d}/out.urdf", 2, "kin.json: key 'kinematics.note': unknown key; allowed: T_parent_joint, axes"),

@@ -176,6 +176,25 @@ def test_simulate_writes_the_log_of_the_api(tmp_path):
     assert res.log.n_samples < 200  # samples were dropped
 
 
+def test_simulate_says_where_the_simulated_friction_acts_in_the_drive_line():
+    """A geared drive's line in simulate says where the simulated friction acts: none with
+    friction "none"; the Panda's own at the joints when the drive file leaves friction_at
+    out (a description's friction stays at the joints); at the motors when it says so."""
+    from dynid.model.drive import Drive
+
+    def drive_line(friction, **kw):
+        drive = Drive.from_gears(50.0, n=7, side="motor", **kw)
+        options = SimulateOptions(duration_s=0.2, rate_hz=100.0, drive=drive, friction=friction)
+        notes = simulate_log(dynid.panda(), options).notes
+        return next(n for n in notes if n.startswith("drive:"))
+
+    none = drive_line("none", friction_at="motor")
+    assert "no friction simulated" in none and "friction at the motors" not in none
+    default = drive_line("robot")
+    assert "own friction at the joints" in default and "at the motors" not in default
+    assert "friction at the motors" in drive_line("robot", friction_at="motor")
+
+
 # ---------------------------------------------------------------------- export
 def test_export_chooses_the_chain_of_a_urdf_with_several_leaves(tmp_path, capsys):
     """A URDF with a hand and two fingers has several leaves: export --params refuses it

@@ -128,3 +128,24 @@ def test_a_friction_urdf_cannot_hold_is_said_in_one_sentence(tmp_path):
         assert line.endswith(
             "exactly, and a TOML export (--out s.toml, not written) would hold it exactly"
         )
+
+
+def test_armature_shares_of_an_unlimited_joint_are_read_at_zero_without_a_warning():
+    """A continuous joint (no limits) takes its inertia at q = 0 and raises no floating
+    point warning: the shares equal armature over the mass matrix's diagonal at the
+    middle of the limited joints' ranges and 0 for the unlimited one."""
+    import warnings
+
+    from dynid.dynamics.terms import mass_matrix
+    from dynid.io.robot.urdf import armature_shares
+
+    panda = dynid.panda()
+    q_min, q_max = panda.q_min.copy(), panda.q_max.copy()
+    q_min[6], q_max[6] = -np.inf, np.inf
+    robot = panda.replace(q_min=q_min, q_max=q_max)
+    armature = np.full(7, 0.1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        shares = armature_shares(robot, armature)
+    mid = np.r_[0.5 * (q_min[:6] + q_max[:6]), 0.0]
+    np.testing.assert_allclose(shares, armature / np.diagonal(mass_matrix(panda, mid)), rtol=1e-12)

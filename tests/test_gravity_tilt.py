@@ -144,7 +144,8 @@ def test_a_tilted_base_is_named_with_its_angle_not_called_a_spring(panda, tmp_pa
 def test_validate_names_the_tilt_of_a_recording_against_a_robots_own_parameters(tmp_path):
     """validate of a recording of a Panda tilted 0.3 deg about y against the level Panda's
     own parameters (its published friction in both): the verdict names the tilt, its angle
-    within 10 %, and no spring; the level recording names none."""
+    within 10 %, and no spring, and validation.json records the angle; the level recording
+    names none."""
     from dynid.workflows.validate import ValidateOptions, validate_files
 
     panda = dynid.panda()
@@ -158,6 +159,9 @@ def test_validate_names_the_tilt_of_a_recording_against_a_robots_own_parameters(
             warnings.simplefilter("ignore", DynidWarning)
             res = validate_files(panda, tmp_path / f"{name}.csv", ValidateOptions())
         said[name] = res.verdict.reason
+        recorded = res.metadata()["gravity_tilt"]  # validation.json's record of it
+        if name == "tilted":
+            assert abs(recorded["angle_deg"][1] - 0.3) < 0.03 and recorded["named"], recorded
     m = re.search(r"0?\.?[0-9.e-]+ deg about x and ([-0-9.e]+) deg about y", said["tilted"])
     assert m is not None and abs(float(m[1]) - 0.3) < 0.03, said["tilted"]
     assert "spring" not in said["tilted"] and "tilted" not in said["level"], said

@@ -87,6 +87,26 @@ def test_identify_files_returns_the_prediction_of_a_separate_log(panda, logs):
     assert np.linalg.norm(v.tau_hat - tau) < 1e-4 * np.linalg.norm(tau)
 
 
+def test_validate_of_the_separate_log_judges_the_samples_identify_held_out(panda, logs):
+    """validate of the --validate-on recording with the identified model judges the same
+    samples as identify's held-out prediction of it (the same ends trimmed at the same
+    cut-off): the same time stamps, prediction and error."""
+    from dynid.workflows.validate import ValidateOptions, validate_files
+
+    (_, separate), (path, other) = logs
+    ident = _identified(panda, path, validate_on=other)
+    held = ident.heldout
+    assert held is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        val = validate_files(ident.model, other, ValidateOptions())
+    (part,) = val.validation.parts
+    np.testing.assert_array_equal(part.log.t, held.validation.log.t)
+    np.testing.assert_allclose(part.tau_hat, held.validation.tau_hat, rtol=0, atol=1e-9)
+    rel = val.validation.errors.relative_error_percent
+    assert abs(rel - held.validation.errors.relative_error_percent) < 1e-9 * rel
+
+
 def test_identify_files_returns_the_prediction_of_every_recording(panda, logs):
     """Two recordings: each, predicted by the fit of the other, pooled one after the
     other (the verdict was the last recording's alone, while the leave-one-recording-out

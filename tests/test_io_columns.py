@@ -414,6 +414,52 @@ def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
     assert "with --units tau=Nm; the model's data were read with --units q=deg" in caplog.text
 
 
+def test_a_training_files_own_flips_do_not_make_a_held_out_files_units_differ(caplog):
+    """A model read with ``t=ns`` and a training file's own flips: a held-out file read
+    with ``--units t=ns`` reads alike (no warning), one read without ``t=ns`` or with
+    a flip of its own does not (the warning names both)."""
+    from dynid.workflows.data_files import recorded_columns
+
+    rec = {"columns": None, "units": "t=ns,rec2.csv:tau1=-1,rec2.csv:tau2=-1"}
+    with caplog.at_level("WARNING"):
+        assert recorded_columns(rec, None, "t=ns", ["held.csv"]) == (None, "t=ns")
+    assert caplog.text == ""
+    for units in ("t=us", "t=ns,held.csv:tau1=-1", "t=ns,tau1=-1"):
+        caplog.clear()
+        with caplog.at_level("WARNING"):
+            recorded_columns(rec, None, units, ["held.csv"])
+        assert f"with --units {units}; the model's data were read with" in caplog.text
+    caplog.clear()
+    with caplog.at_level("WARNING"):  # the training file itself read without its flips
+        recorded_columns(rec, None, "t=ns", ["rec2.csv"])
+    assert "the model's data were read with" in caplog.text
+
+
+def test_a_files_own_sign_negates_every_joint_of_that_file_alone(tmp_path):
+    """``--units b.csv:tau=-1`` negates every joint's torques of ``b.csv`` (a driver that
+    logs the torque the motor feels) and of no other file, said as the entry given; with
+    ``tau=mNm`` every file's torques are scaled too; a unit other than a sign stays
+    refused as a file's own entry."""
+    from dynid.io.torque_log import save_torque_log
+
+    logs = {"a.csv": _log(7), "b.csv": _log(8)}
+    for name, log in logs.items():
+        save_torque_log(tmp_path / name, log)
+    cmap = parse_column_map(None, "b.csv:tau=-1")
+    a = load_mapped_torque_log(tmp_path / "a.csv", cmap)
+    b = load_mapped_torque_log(tmp_path / "b.csv", cmap)
+    np.testing.assert_array_equal(a.log.tau, logs["a.csv"].tau)
+    np.testing.assert_array_equal(b.log.tau, -logs["b.csv"].tau)
+    assert a.conversions == () and b.conversions == ("tau sign flipped (--units b.csv:tau=-1)",)
+    assert cmap.unknown_files(["a.csv"]) == ("b.csv",)
+    scaled = parse_column_map(None, "b.csv:tau=-1,tau=mNm")
+    b = load_mapped_torque_log(tmp_path / "b.csv", scaled)
+    np.testing.assert_allclose(b.log.tau, -1e-3 * logs["b.csv"].tau, rtol=1e-15)
+    assert "(--units b.csv:tau=-1,tau=mNm)" in b.conversions[0], b.conversions
+    with pytest.raises(DataError, match=r"b.csv:tau=mNm: a file's own entry flips the sign"):
+        parse_column_map(None, "b.csv:tau=mNm")
+
+
 def test_a_files_own_flip_reads_that_file_alone_and_is_said_with_its_name(tmp_path):
     """``--units b.csv:tau2=-1`` negates joint 2's torques of ``b.csv`` (as written) and
     of no other file, said as the entry given; with ``tau3=-1`` for every file too."""

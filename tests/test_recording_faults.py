@@ -378,7 +378,9 @@ def test_one_recording_of_another_convention_is_flipped_alone(panda, log, tmp_pa
     """Two recordings, the second logged with joint 4's torque of the opposite sign: the
     fit refuses it naming that file and the entry that flips it alone, which reads it
     alone flipped: the fit is the one of both recordings logged alike (bit for bit); an
-    entry naming a file not given is refused in one line."""
+    entry naming a file not given is refused in one line. A recording of every joint's
+    torque of the opposite sign is named with the file's one entry, c.csv:tau=-1, which
+    reads it alike (bit for bit)."""
     from dynid.workflows.identify import IdentifyOptions, identify_files
 
     half = len(log.t) // 2
@@ -398,8 +400,15 @@ def test_one_recording_of_another_convention_is_flipped_alone(panda, log, tmp_pa
     np.testing.assert_array_equal(own.model.fit.beta, alike.model.fit.beta)
     with pytest.raises(DataError, match="c.csv is none of the files given"):
         identify_files(panda, both, IdentifyOptions(columns=(None, "c.csv:tau4=-1")))
-    with pytest.raises(DataError, match="a file's own entry flips single joints"):
+    with pytest.raises(DataError, match="a file's own entry flips the sign of single joints"):
         identify_files(panda, both, IdentifyOptions(columns=(None, "b.csv:tau=mNm")))
+    save_torque_log(tmp_path / "c.csv", TorqueLog(b.t, b.q, b.dq, -b.tau))  # every joint
+    every = [tmp_path / "a.csv", tmp_path / "c.csv"]
+    with pytest.raises(DataError, match="c.csv") as exc:
+        identify_files(panda, every)
+    assert "--units c.csv:tau=-1" in str(exc.value), str(exc.value)
+    own = identify_files(panda, every, IdentifyOptions(columns=(None, "c.csv:tau=-1")))
+    np.testing.assert_array_equal(own.model.fit.beta, alike.model.fit.beta)
 
 
 def test_a_log_whose_comment_lines_say_currents_is_not_read_as_torques(panda, log, tmp_path):

@@ -42,6 +42,7 @@ from ..identification.prepare import (
     resamples,
 )
 from ..identification.recordings import common_cutoff
+from ..identification.trim import edge_seconds
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import report
@@ -218,7 +219,12 @@ def validate_torques(
     cutoff_hz, trim_s, filter_tau, max_gap_s
         Preparation of the log (:func:`~dynid.friction.fit.friction_residual`);
         ``cutoff_hz="recorded"`` (default): the cut-off an identified model was identified
-        with, else the one read from the log's motion (:func:`recorded_cutoff`).
+        with, else the one read from the log's motion (:func:`recorded_cutoff`);
+        ``trim_s`` None (default): the seconds identification trims at each end of a
+        piece filtered at that cut-off, read from this log's motion
+        (:func:`~dynid.identification.trim.edge_seconds`), as ``validate`` trims a
+        recording, so that identify's held-out error and validate's of the same recording
+        are over the same samples.
     drive : Drive, optional
         The drive the log was recorded through (motor side, currents); default: an
         identified model's own (:func:`model_drive`). Its known rotor inertias are added to
@@ -244,6 +250,8 @@ def validate_torques(
     d = model_drive(model, drive)
     jlog = joint_side_log(log, d)
     cut = recorded_cutoff(model, jlog) if isinstance(cutoff_hz, str) else cutoff_hz
+    if trim_s is None and cut is not None:  # identification's rule on this log's motion
+        trim_s = edge_seconds([jlog], [0], cut)
     del log  # a long log's raw signals are freed here when the caller holds no other reference
     if torque_delay_s is None:
         own = model.info.log if isinstance(model, IdentifiedModel) else None

@@ -159,6 +159,12 @@ def flip_entries(joints: Iterable[int], file: str | None = None) -> str:
     return ",".join(f"{at}tau{k + 1}=-1" for k in joints)
 
 
+def every_joint_entry(file: str | None = None) -> str:
+    """The ``--units`` entry that flips the torques of every joint: ``tau=-1``, or a
+    file's own, ``rec2.csv:tau=-1``."""
+    return "tau=-1" if file is None else f"{file}:tau=-1"
+
+
 def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> str | None:
     """The finding that a joint-side log's torques have the opposite sign to ``robot``'s
     (anti-correlated with its gravity torques and with its whole rigid-body torques along
@@ -212,7 +218,7 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
     )
     unjudged = np.flatnonzero(~(loaded | strong))
     if unjudged.size == 0:
-        every_joint = "tau=-1" if file is None else flip_entries(range(robot.n), file)
+        every_joint = every_joint_entry(file)
         return (
             f"{said}: the torque sign is probably opposite to the model's; hint: --units "
             f"{every_joint} reads them flipped"
@@ -224,7 +230,7 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
         f"{', '.join(names[k] for k in unjudged)}, whose torques the model's do not explain "
         "(gravity barely loads them, and friction or a drive's rotor inertia outweighs their "
         "links'), is not told by this check; hint: --units "
-        f"{'tau=-1' if file is None else flip_entries(range(robot.n), file)} if every joint's is "
+        f"{every_joint_entry(file)} if every joint's is "
         f"opposite, --units {flip_entries(seen, file)} if these only"
     )
 
@@ -528,7 +534,7 @@ def _opposite(
         )
         + (
             f"; hint: --units "
-            f"{'tau=-1' if file is None else flip_entries(range(len(names)), file)} if every "
+            f"{every_joint_entry(file)} if every "
             f"joint's is opposite, --units {flip_entries(bad, file)} if these only"
             if rest.size == 0 and bad.size > 1
             else f"; hint: --units {flip_entries(bad, file)} reads "

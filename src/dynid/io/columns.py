@@ -35,6 +35,7 @@ import re
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from itertools import chain
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -143,6 +144,10 @@ class ColumnMap:
     file_flips : mapping of str to mapping of str to tuple of int
         A file's name -> its own flips, added to ``flips`` when that file is read
         (``--units rec2.csv:tau4=-1``: ``{"rec2.csv": {"tau": (3,)}}``, :meth:`for_file`).
+    file_signs : mapping of str to tuple of str
+        A file's name -> the quantities read with the opposite sign on every joint of
+        that file alone, its factor negated when that file is read (``--units
+        rec2.csv:tau=-1``: ``{"rec2.csv": ("tau",)}``, :meth:`for_file`).
     """
 
     columns: Mapping[str, str] = field(default_factory=dict)
@@ -151,12 +156,14 @@ class ColumnMap:
     names: Mapping[str, str] = field(default_factory=dict)
     flips: Mapping[str, tuple[int, ...]] = field(default_factory=dict)
     file_flips: Mapping[str, Mapping[str, tuple[int, ...]]] = field(default_factory=dict)
+    file_signs: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for key in list(self.columns) + list(self.factors):
             if key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
-        for key in [*self.flips, *(k for f in self.file_flips.values() for k in f)]:
+        own = [*(k for f in self.file_flips.values() for k in f), *chain(*self.file_signs.values())]
+        for key in [*self.flips, *own]:
             if key not in _FLIPPABLE:
                 raise DataError(f"a joint's sign flips one of {list(_FLIPPABLE)}; got {key!r}")
         object.__setattr__(
@@ -165,6 +172,8 @@ class ColumnMap:
             MappingProxyType({k: MappingProxyType(dict(v)) for k, v in self.file_flips.items()}),
         )
         object.__setattr__(self, "flips", MappingProxyType(dict(self.flips)))
+        signs = {k: tuple(v) for k, v in self.file_signs.items()}
+        object.__setattr__(self, "file_signs", MappingProxyType(signs))
         object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
         object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
         object.__setattr__(self, "names", MappingProxyType(dict(self.names)))
@@ -177,13 +186,19 @@ class ColumnMap:
         joints' sign flips (``{"tau2": -1}``)."""
         flips: dict[str, set[int]] = {}
         files: dict[str, dict[str, set[int]]] = {}
+        whole: dict[str, set[str]] = {}  # a file's quantities negated on every joint
         for key, u in units.items():
             if ":" in key:
                 name, _, own = key.rpartition(":")
+                if own.strip() in _FLIPPABLE and name.strip() and _is_sign(u):
+                    if _sign_flip(key, u):  # (FILE:tau=1: read as it is)
+                        whole.setdefault(name.strip(), set()).add(own.strip())
+                    continue
                 if (joint := _joint_key(own)) is None or not name.strip():
                     raise DataError(
-                        f"{key}={u}: a file's own entry flips single joints "
-                        f"(FILE:tau4=-1); units other than a sign are every file's"
+                        f"{key}={u}: a file's own entry flips the sign of single joints "
+                        f"(FILE:tau4=-1) or of all (FILE:tau=-1); units other than a sign "
+                        "are every file's"
                     )
                 if _sign_flip(own, u):
                     files.setdefault(name.strip(), {}).setdefault(joint[0], set()).add(joint[1])
@@ -202,30 +217,47 @@ class ColumnMap:
         names = {k: str(u) for k, u in given.items()}
         signs = {k: tuple(sorted(v)) for k, v in flips.items()}
         per_file = {f: {k: tuple(sorted(v)) for k, v in d.items()} for f, d in files.items()}
-        return cls(dict(columns), factors, names=names, flips=signs, file_flips=per_file, **kw)
+        return cls(
+            dict(columns),
+            factors,
+            names=names,
+            flips=signs,
+            file_flips=per_file,
+            file_signs={f: tuple(sorted(q)) for f, q in whole.items()},
+            **kw,
+        )
 
     def for_file(self, name: str) -> ColumnMap:
         """The map the file ``name`` is read with: the flips of every file and its own
         (:attr:`file_flips`, kept as its only entry for the notes), without the other
         files' own."""
-        if not self.file_flips:
+        if not self.file_flips and not self.file_signs:
             return self
         own = self.file_flips.get(name, {})
         flips = {
             k: tuple(sorted({*self.flips.get(k, ()), *own.get(k, ())})) for k in {*self.flips, *own}
         }
+        negated = self.file_signs.get(name, ())
+        factors = {**self.factors, **{k: -self.factor(k) for k in negated}}
         return ColumnMap(
             self.columns,
-            self.factors,
+            factors,
             self.velocity_cutoff_hz,
             names=self.names,
             flips=flips,
             file_flips={name: own} if own else {},
+            file_signs={name: negated} if negated else {},
         )
 
     def unknown_files(self, names: Sequence[str]) -> tuple[str, ...]:
         """The files named by a file's own entry that are not among ``names``."""
-        return tuple(f for f in self.file_flips if f not in set(names))
+        return tuple(f for f in self.own_files if f not in set(names))
+
+    @property
+    def own_files(self) -> tuple[str, ...]:
+        """The files named by a file's own entry (``rec2.csv:tau4=-1``,
+        ``rec2.csv:tau=-1``), in the order given."""
+        return tuple(dict.fromkeys([*self.file_flips, *self.file_signs]))
 
     @property
     def tau_is_current(self) -> bool:
@@ -271,6 +303,14 @@ def _joint_key(key: str) -> tuple[str, int] | None:
     None."""
     m = re.fullmatch(r"(ddq|dq|q|tau)([1-9][0-9]*)", key.strip())
     return None if m is None else (m.group(1), int(m.group(2)) - 1)
+
+
+def _is_sign(value: Any) -> bool:
+    """Whether ``value`` is a sign, ``1`` or ``-1``."""
+    try:
+        return _checks.decimal(str(value).strip()) in (1.0, -1.0)
+    except ValueError:
+        return False
 
 
 def _sign_flip(key: str, value: Any) -> bool:
@@ -697,9 +737,15 @@ def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str
     out = []
     for k in quantities:
         f = columns.factor(k)
+        whole = [n for n, q in columns.file_signs.items() if k in q]  # a file's own entry
+        if whole:
+            unit = columns.names.get(k)  # every file's unit, as given
+            flag = f"{whole[0]}:{k}=-1" + ("" if unit is None else f",{k}={unit}")
+        else:
+            flag = f"{k}={f:.17g}"
         if f < 0:
             scaled = "" if f == -1.0 else f" and scaled by {-f:.17g} to SI"
-            out.append(f"{k} sign flipped{scaled} (--units {k}={f:.17g})")
+            out.append(f"{k} sign flipped{scaled} (--units {flag})")
         if joints := columns.flips.get(k, ()):
             own = {f: set(d.get(k, ())) for f, d in columns.file_flips.items()}
             which = ", ".join(f"{k}{j + 1}" for j in joints)

@@ -24,6 +24,7 @@ from ..exceptions import ShapeError
 
 __all__ = [
     "PARAMS_PER_LINK",
+    "READ_AS_GIVEN",
     "INERTIA_ORDER",
     "param_labels",
     "matrix_from_inertia6",
@@ -171,6 +172,13 @@ def inertial_from_params(
     return a[:, 0].copy(), a[:, 1:4].copy(), matrix_from_inertia6(a[:, 4:])
 
 
+#: What a robot description's physically inconsistent inertial becomes when read.
+READ_AS_GIVEN = (
+    "read as given (identification fits the links anew; a consistent fit repairs it where it "
+    "takes the description as its prior)"
+)
+
+
 def inertial_problems(mass: float, inertia: ArrayLike) -> list[str]:
     """What makes one link's mass and inertia about its CoM physically inconsistent.
 
@@ -193,10 +201,12 @@ def inertial_problems(mass: float, inertia: ArrayLike) -> list[str]:
         problems.append(f"negative mass {mass}")
     lam = np.linalg.eigvalsh(np.asarray(inertia, dtype=np.float64))
     tol = 1e-9 * max(float(np.sum(np.abs(lam))), 1e-300)
+    moments = ", ".join(f"{x:.4g}" for x in lam)
     if lam[0] < -tol:
-        problems.append(f"inertia not positive semi-definite (eigenvalues {lam.tolist()})")
+        problems.append(f"inertia not positive semi-definite (eigenvalues {moments} kg m^2)")
     elif lam[0] + lam[1] < lam[2] - tol:
         problems.append(
-            f"principal moments {lam.tolist()} violate the triangle inequality (a + b >= c)"
+            f"principal moments {moments} kg m^2 violate the triangle inequality "
+            f"({lam[0]:.4g} + {lam[1]:.4g} < {lam[2]:.4g})"
         )
     return problems

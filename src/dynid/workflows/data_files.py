@@ -133,6 +133,7 @@ def column_map(
                 names={**cmap.names, **extra.names},
                 flips={**cmap.flips, **extra.flips},
                 file_flips={**cmap.file_flips, **extra.file_flips},
+                file_signs={**cmap.file_signs, **extra.file_signs},
                 **kw,
             )
     else:
@@ -453,13 +454,36 @@ def recorded_columns(
             _read_with(*used),
             _another_file(str(rec[1] or "")),
         )
-    elif used != rec:
+    elif used != rec and not _reads_alike(used, rec, files):
         _log.warning(
             "reading the data with %s; the model's data were read with %s",
             _read_with(*used),
             _read_with(*rec),
         )
     return used[0], used[1]
+
+
+def _reads_alike(
+    used: tuple[Any, ...], rec: tuple[Any, ...], files: Sequence[str | Path] | None
+) -> bool:
+    """Whether ``used`` and the recorded ``(columns, units)`` read every one of ``files``
+    alike (None: not known, so they may not): the recorded entries of files not read here
+    (``rec2.csv:tau1=-1`` of a training file) change nothing of them."""
+    if files is None:
+        return False
+    try:
+        a, b = parse_column_map(*used), parse_column_map(*rec)
+    except DataError:
+        return False
+    for name in (Path(f).name for f in files):
+        x, y = a.for_file(name), b.for_file(name)
+        if (dict(x.columns), dict(x.factors), dict(x.flips)) != (
+            dict(y.columns),
+            dict(y.factors),
+            dict(y.flips),
+        ):
+            return False
+    return True
 
 
 def _applies(rec: tuple[Any, Any], files: Sequence[str | Path] | None) -> bool:
@@ -471,7 +495,7 @@ def _applies(rec: tuple[Any, Any], files: Sequence[str | Path] | None) -> bool:
     if cmap.factors or cmap.flips:  # entries for every file
         return True
     names = [Path(f).name for f in files]
-    return len(cmap.unknown_files(names)) < len(cmap.file_flips)
+    return len(cmap.unknown_files(names)) < len(cmap.own_files)
 
 
 def _another_file(units: str) -> str:
@@ -480,9 +504,9 @@ def _another_file(units: str) -> str:
     of that name only."""
     cmap = parse_column_map(None, units or None)
     said = ["e.g. --units tau=Nm for SI torques"] if cmap.tau_is_torque else []
-    if cmap.file_flips:
+    if cmap.own_files:
         said.append(
-            f"a file's own entries ({', '.join(f'{f}:...' for f in cmap.file_flips)}) hold "
+            f"a file's own entries ({', '.join(f'{f}:...' for f in cmap.own_files)}) hold "
             "for a file of that name"
         )
     return "; ".join(said) or "given, they replace the recorded ones"

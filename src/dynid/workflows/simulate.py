@@ -218,7 +218,7 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
             )
     if opt.drive is not None:
         notes.append(
-            f"drive: {opt.drive.describe()}; the log is written on the {opt.drive.side} side"
+            f"drive: {_drive_line(opt, robot)}; the log is written on the {opt.drive.side} side"
         )
         if opt.friction == "robot" and (said := own_at_motors_note(robot, opt.drive)):
             notes.append(said)
@@ -258,6 +258,22 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
         for c in opt.contacts
     ]
     return SimulatedLog(log, tuple(notes), float(first), float(last))
+
+
+def _drive_line(opt: SimulateOptions, robot: Robot) -> str:
+    """The drive's line (:meth:`~dynid.model.drive.Drive.describe`) with where the
+    simulated friction acts in place of the drive's default place for a law: none
+    simulated, or a description's own at the joints where the drive file does not put it
+    at the motors (:func:`~dynid.friction.model.own_at_motors_note`)."""
+    assert opt.drive is not None
+    line = opt.drive.describe()
+    place = f"friction at the {opt.drive.friction_place}s"
+    own = opt.friction == "robot"
+    if opt.friction == "none" or (own and robot.friction is None):
+        return line.replace(place, "no friction simulated")
+    if own and opt.drive.friction_at is None:
+        return line.replace(place, f"the robot's own friction at the joints ({robot.name})")
+    return line
 
 
 def _friction(friction: str | Path | FrictionModel) -> FrictionModel | str | None:

@@ -62,6 +62,7 @@ from ..identification.floor_verdict import (
     prediction_input_noise,
     sensor_variance,
 )
+from ..identification.gravity_tilt import GravityTilt
 from ..identification.log import TorqueLog
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
@@ -235,6 +236,11 @@ class ValidateResult:
     applied_delay : AppliedDelay, optional
         The delay the recordings were prepared with and where it came from (given, or the
         model's record); None: none applied.
+    gravity_tilt : GravityTilt, optional
+        The tilt of the gravity vector the residual points to, fitted with the model's
+        columns to the recordings joined (:func:`~dynid.friction.heldout_torques.
+        residual_tilt`; said in ``verdict``'s reason when
+        :attr:`~dynid.identification.gravity_tilt.GravityTilt.named`); None: not judged.
     """
 
     validation: RecordingsValidation
@@ -256,6 +262,7 @@ class ValidateResult:
     reversed_columns: tuple[tuple[str, str], ...] = ()
     torque_delay: TorqueDelay | None = None
     applied_delay: AppliedDelay | None = None
+    gravity_tilt: GravityTilt | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -270,7 +277,9 @@ class ValidateResult:
         reversed, with the ``--units`` that reads them; when there is one),
         ``verdict`` (``level``, ``label``, ``reason``), ``joint_names`` (when known) and
         ``springs`` (the stiffness per joint the residual points to, when judged:
-        :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`) and
+        :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`),
+        ``gravity_tilt`` (the tilt of the gravity vector the residual points to, as
+        ``heldout.json`` records it: null when not judged) and
         ``torque_delay`` (the torques' lag behind the positions, when named:
         :meth:`~dynid.identification.torque_delay.TorqueDelay.as_dict`) and
         ``torque_delay_used`` (the delay the recordings were prepared with and its source,
@@ -302,6 +311,7 @@ class ValidateResult:
             **({"reversed_columns": dict(self.reversed_columns)} if self.reversed_columns else {}),
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
+            "gravity_tilt": None if self.gravity_tilt is None else self.gravity_tilt.as_dict(),
             **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
             **({"torque_delay_used": a.as_dict()} if (a := self.applied_delay) else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
@@ -398,7 +408,7 @@ def validate_files(
     # a torque of the opposite sign leaves twice the torque, which no term of the model
     # explains: what the residual follows is not diagnosed (it read as an offset)
     dependence = not beyond and not opposite
-    verdict, springs = _with_hints(
+    verdict, springs, tilt = _with_hints(
         model, verdict, val, rec.logs, noise, names, dependence=dependence,
         held=_terms_held(model, placed, label),
     )  # fmt: skip
@@ -425,7 +435,7 @@ def validate_files(
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=springs,
-        torque_delay=delay, applied_delay=applied,
+        torque_delay=delay, applied_delay=applied, gravity_tilt=tilt,
     )  # fmt: skip
 
 
@@ -497,7 +507,7 @@ def _with_hints(
     *,
     dependence: bool = True,
     held: tuple[frozenset[str], str | None] = (frozenset(), None),
-) -> tuple[Verdict, ResidualSpring | None]:
+) -> tuple[Verdict, ResidualSpring | None, GravityTilt | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
@@ -513,13 +523,13 @@ def _with_hints(
     :func:`~dynid.friction.heldout_torques.residual_gains`), the
     hint of a
     cut-off too high for derived states, and that of an error at low speed; and the
-    springs fitted (None: not judged)."""
+    springs and the tilt fitted (None: not judged)."""
     terms, inertia = held
     offsets, left_out = offsets_of(model), friction_left_out(model)
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
-    springs = None
+    springs = tilt = None
     whole = joined_validation(val.parts) if dependence and verdict.level != "good" else None
     gains = None if whole is None else residual_gains(model, whole, noise.total)
     said = None if gains is None else gains.sentence()
@@ -543,7 +553,7 @@ def _with_hints(
             verdict, reason=f"{verdict.reason}; a floor raised because {high}"
         )
     # the low-speed hint's "above the noise": the sensors' (its module docstring)
-    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs
+    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs, tilt
 
 
 @dataclass(frozen=True, slots=True)

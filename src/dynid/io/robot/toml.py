@@ -48,6 +48,7 @@ from ...friction.model import (
 )
 from ...model.drive import Drive
 from ...model.inertia import (
+    READ_AS_GIVEN,
     inertia6_from_matrix,
     inertial_problems,
     matrix_from_inertia6,
@@ -241,7 +242,7 @@ def _inertial(
     if problems:  # as the URDF reader: kept, as a real description may round its numbers
         warnings.warn(
             f"{source}: key '{at}.inertial': the inertial is physically inconsistent: "
-            f"{'; '.join(problems)}; kept as given",
+            f"{'; '.join(problems)}; {READ_AS_GIVEN}",
             DynidWarning,
             stacklevel=2,
         )

@@ -312,7 +312,8 @@ def armature_shares(robot: Robot, armature: NDArray[np.float64]) -> NDArray[np.f
     share of the joint's inertia a URDF without it leaves out (``inf`` where ``M_jj`` is 0,
     a robot without link inertias)."""
     lo, hi = np.asarray(robot.q_min), np.asarray(robot.q_max)
-    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), 0.0)
+    limited = np.isfinite(lo) & np.isfinite(hi)  # an unlimited joint's middle: 0
+    mid = 0.5 * (np.where(limited, lo, 0.0) + np.where(limited, hi, 0.0))
     diag = np.diagonal(mass_matrix(robot, mid)) if np.any(robot.phi) else np.zeros(robot.n)
     a = np.asarray(armature, dtype=np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):

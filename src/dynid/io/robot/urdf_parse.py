@@ -65,7 +65,7 @@ from numpy.typing import NDArray
 
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...friction.model import ClassicalFriction, Friction
-from ...model.inertia import inertial_problems, phi_from_inertial
+from ...model.inertia import READ_AS_GIVEN, inertial_problems, phi_from_inertial
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ...progress import NOTE
 from ..input_files import file_bytes
@@ -135,7 +135,7 @@ def _warn_if_inconsistent(link: str, mass: float, I: NDArray[np.float64]) -> Non
     if problems:
         warnings.warn(
             f"link {link!r} has a physically inconsistent inertial: {'; '.join(problems)}; "
-            "kept as given",
+            + READ_AS_GIVEN,
             DynidWarning,
             stacklevel=7,
         )
