@@ -64,13 +64,16 @@ def save_validation_figures(
     noise_std: float | None = None,
     title: str | None = None,
     t0: float | None = None,
+    recordings: list[tuple[str, float, float]] | tuple[tuple[str, float, float], ...] = (),
 ) -> list[Path]:
     """Write ``<prefix>_torques.png`` (Fig. 3) and ``<prefix>_rms.png`` under ``out``
-    (those skipped are left out); time drawn from ``t0`` [s] (default: the first sample)."""
+    (those skipped are left out); time drawn from ``t0`` [s] (default: the first sample),
+    or, of several ``recordings`` (name, first and last stamp [s]) pooled in
+    ``validation``, each from its own start."""
     paths = [
         save_figure(
             lambda: torque_plots.plot_torque_validation(
-                validation, joint_names=names, title=title, t0=t0
+                validation, joint_names=names, title=title, t0=t0, recordings=recordings
             ),
             out / f"{prefix}_torques.png",
             dpi=100,
@@ -85,12 +88,21 @@ def save_validation_figures(
     return [p for p in paths if p is not None]
 
 
-def save_heldout_figures(out: Path, held: HeldOutTorques) -> list[Path]:
+def save_heldout_figures(
+    out: Path, held: HeldOutTorques, recordings: list[str] | tuple[str, ...] = ()
+) -> list[Path]:
     """The held-out prediction of a torque log's identification (made by the library,
     :attr:`~dynid.workflows.identify.IdentifyResult.heldout`) drawn under ``out``:
-    ``heldout_torques.png`` (measured and predicted torques) and ``heldout_residuals.png``
-    (residual histograms against the sensor noise); those skipped are left out."""
+    ``heldout_torques.png`` (measured and predicted torques; each of several held-out
+    recordings from its own start, named by ``recordings``, the file names in the fit's
+    order) and ``heldout_residuals.png`` (residual histograms against the sensor noise);
+    those skipped are left out."""
     names = list(held.joint_names)
+    spans = (
+        [(r, float(x.t[0]), float(x.t[-1])) for r, x in zip(recordings, held.logs, strict=True)]
+        if len(held.logs) > 1 and len(recordings) == len(held.logs)
+        else []
+    )
     paths = [
         save_figure(
             lambda: torque_plots.plot_torque_validation(
@@ -98,6 +110,7 @@ def save_heldout_figures(out: Path, held: HeldOutTorques) -> list[Path]:
                 joint_names=names,
                 title=f"Held-out: {held.block}",
                 t0=float(held.logs[0].t[0]) if held.logs else None,
+                recordings=spans,
             ),
             Path(out) / "heldout_torques.png",
             dpi=100,

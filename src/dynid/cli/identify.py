@@ -291,7 +291,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if held is not None:  # every sample of the figures' data, not the decimated rows
         doc = held.as_dict()
         files.append(save_json(args.out / "heldout.json", doc, schema="dynid-heldout-torques/1"))
-        files += [] if args.no_figures else save_heldout_figures(args.out, held)
+        fitted = [Path(str(r.get("file", ""))).name for r in result.model.info.recordings]
+        files += [] if args.no_figures else save_heldout_figures(args.out, held, fitted)
         v = held.verdict
         text += _delay_first(result.torque_delay, v)
         text.append(f"held-out verdict on {held.block}, every sample: {v.label}: {v.reason}")

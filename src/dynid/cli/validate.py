@@ -29,8 +29,9 @@ the times, and the verdict says how many.
 --data takes several recordings (or a folder of them): each recording, and each piece of
 one cut at a gap longer than --max-gap, is filtered on its own and never joined to
 another. The errors are pooled over every sample of every recording (RMS per joint,
-relative error over all), and given per recording; the torque figure shows the longest
-piece of the first recording, the RMS figure the pooled errors.
+relative error over all), and given per recording; the torque figure shows every
+recording, each from its own start, one after another and named (one recording: its longest
+piece), the RMS figure the pooled errors.
 
 --torque-delay MS reads each piece's states MS earlier (torques that lag the positions);
 a model identified with a delay is validated with it. The summary, validation.json
@@ -82,6 +83,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..friction.pooled import joined_validation
 from ..identification.model import IdentifiedModel
 from ..io.validation_json import save_validation_json
 from ..workflows.validate import ValidateOptions, ValidateResult, validate_files
@@ -180,15 +182,25 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
 
 def _save_figures(out: Path, result: ValidateResult, names: list[str], label: str) -> None:
-    """The validation figures of the shown recording, titled with the model and the file."""
-    what = result.files[0] + (" (its torques; errors over all)" if len(result.files) > 1 else "")
+    """The validation figures, titled with the model and the files: of one recording its
+    longest piece; of several, every recording's pieces, each recording from its own
+    start, one after another, named (the errors over all)."""
+    val = result.validation
+    if len(result.files) == 1:
+        save_validation_figures(
+            out, val.shown, names=names, title=shown(f"{label} on {result.files[0]}"),
+            t0=val.shown_start,
+        )  # fmt: skip
+        return
+    spans = []
+    for k, name in enumerate(result.files):
+        mine = [v.log.t for v, r in zip(val.parts, val.pieces.recording, strict=True) if r == k]
+        if mine:
+            spans.append((name, float(min(t[0] for t in mine)), float(max(t[-1] for t in mine))))
     save_validation_figures(
-        out,
-        result.validation.shown,
-        names=names,
-        title=shown(f"{label} on {what}"),
-        t0=result.validation.shown_start,
-    )
+        out, joined_validation(val.parts), names=names, recordings=spans,
+        title=shown(f"{label} on {len(result.files)} recordings (errors over all)"),
+    )  # fmt: skip
 
 
 def print_validation(

@@ -46,6 +46,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BINS",
+    "acceleration_led",
     "Dependence",
     "dependence_hint",
     "friction_left_out",
@@ -96,6 +97,9 @@ class Dependence:
     ratio : float
         The joint's error over its noise as the verdict judges it (each sample weighed by
         its own noise), or ``rms / noise``: what orders the joints.
+    acceleration : float
+        The RMS [N m] of the residual's binned means over the joint's acceleration, as
+        ``position`` (0 where the accelerations were not given).
     """
 
     joint: int
@@ -105,6 +109,7 @@ class Dependence:
     velocity: float
     mean: float
     ratio: float = float("nan")
+    acceleration: float = 0.0
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.ratio):
@@ -133,6 +138,15 @@ def _parts(
     return _binned(Q[:, j], E[:, j], var), _binned(V[:, j], E[:, j], var)
 
 
+def acceleration_led(d: Dependence) -> bool:
+    """Whether joint ``d``'s residual follows its acceleration more than its position and
+    its velocity, by at least :data:`FOLLOWS` of its part above the noise: an inertia the
+    model lacks at the joint (a rotor's, the armature ``I_a ddq``), which a motion of a
+    few harmonics also shows against the position (``ddq`` near ``-w^2 q``), less."""
+    top = max(d.position, d.velocity)
+    return d.acceleration > top and d.acceleration >= FOLLOWS * d.systematic
+
+
 def position_led(d: Dependence) -> bool:
     """Whether joint ``d``'s residual follows its position at least as much as its
     velocity: the one test of a spring's (or another position-dependent effect's) against
@@ -146,9 +160,11 @@ def residual_dependence(
     error: Sequence[NDArray[np.float64]],
     noise_rms: NDArray[np.float64],
     ratios: NDArray[np.float64] | None = None,
+    ddq: Sequence[NDArray[np.float64]] | None = None,
 ) -> tuple[Dependence, ...]:
     """Each joint above :data:`~dynid.identification.verdict.SYSTEMATIC_RATIO` x its noise,
-    its residual's dependence on its own position and velocity (module docstring).
+    its residual's dependence on its own position and velocity, and acceleration when
+    given (module docstring).
 
     Parameters
     ----------
@@ -163,6 +179,9 @@ def residual_dependence(
         their own noise: :attr:`~dynid.identification.input_noise.NoiseFloor.joint_ratios`),
         which then says which joints are above their noise, so that the joints named are
         the verdict's; default ``rms / noise_rms``.
+    ddq : sequence of ndarray, each (N_k, n), optional
+        The accelerations [rad/s^2] at the same samples: the part that follows them
+        (:attr:`Dependence.acceleration`).
 
     Returns
     -------
@@ -173,6 +192,7 @@ def residual_dependence(
     Q = np.concatenate([np.asarray(x, dtype=np.float64) for x in q])
     V = np.concatenate([np.asarray(x, dtype=np.float64) for x in dq])
     E = np.concatenate([np.asarray(x, dtype=np.float64) for x in error])
+    A = None if ddq is None else np.concatenate([np.asarray(x, dtype=np.float64) for x in ddq])
     s = np.asarray(noise_rms, dtype=np.float64)
     if E.shape[0] < BINS * MIN_PER_BIN or not np.all(np.isfinite(s)):
         return ()
@@ -190,6 +210,7 @@ def residual_dependence(
                 velocity=velocity,
                 mean=float(np.mean(E[:, j])),
                 ratio=float(judged[j]),
+                acceleration=0.0 if A is None else _binned(A[:, j], E[:, j], float(s[j]) ** 2),
             )
         )
     return tuple(out)
@@ -254,6 +275,17 @@ def _remedy(terms: Collection[str]) -> str:
     return "beyond the model's linear spring: a spring that is not linear, a cable"
 
 
+def _inertia_remedy(terms: Collection[str]) -> str:
+    """What to add to the model for a residual that follows a joint's acceleration, given
+    the model's ``terms``."""
+    if "armature" in terms:
+        return "beyond the model's armature: an inertia the rigid bodies and rotors miss"
+    return (
+        "add armature to --terms of dynid identify, or give a drive file with rotor_inertia "
+        "(--drive)"
+    )
+
+
 def _constant(d: Dependence, head: str, offset: tuple[str, bool] | None) -> str:
     """Joint ``d``'s residual that is a constant over the samples judged, in words, told
     with the model's own offset (``offset``: its label and whether the model holds it,
@@ -284,8 +316,11 @@ def _sentence(
     springs: ResidualSpring | None = None,
     offsets: Mapping[int, tuple[str, bool]] | None = None,
     left_out: Mapping[int, tuple[str, ...]] | None = None,
+    inertia: str | None = None,
 ) -> str:
-    """One joint's diagnosis in words; ``terms`` the model's term names (:func:`held_terms`),
+    """One joint's diagnosis in words (a residual that follows the acceleration first:
+    an inertia the model lacks, with ``inertia`` the remedy where the caller knows it,
+    else :func:`_inertia_remedy`); ``terms`` the model's term names (:func:`held_terms`),
     so that the remedy names what the model lacks, not what it holds; ``springs`` the
     stiffness per joint fitted with the model (its named joints' said with their
     stiffness, a position dependence no spring explains said so); ``offsets`` the model's
@@ -295,6 +330,12 @@ def _sentence(
     (a model fitted to two FR3 recordings of opposite signs on joint 7 had dropped fv7 and
     fc7, and its validation had suggested comparing the laws)."""
     head = f"{name}: "
+    if acceleration_led(d):
+        return (
+            f"{head}{d.acceleration:.2g} of {d.rms:.2g} N m RMS residual follows its "
+            "acceleration: an inertia the model lacks at the joint, most likely a rotor's "
+            f"(armature) ({inertia or _inertia_remedy(terms)})"
+        )
     named = springs is not None and d.joint in springs.named  # judged_springs judged it
     follows = f"{head}{d.position:.2g} of {d.rms:.2g} N m RMS residual follows its position"
     if named:
@@ -410,6 +451,8 @@ def dependence_hint(
     springs: ResidualSpring | None = None,
     offsets: Mapping[int, tuple[str, bool]] | None = None,
     left_out: Mapping[int, tuple[str, ...]] | None = None,
+    ddq: Sequence[NDArray[np.float64]] | None = None,
+    inertia: str | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -426,22 +469,34 @@ def dependence_hint(
     spring's joint with its stiffness and says where a position dependence is no
     spring's. ``offsets``: the model's offset per joint (:func:`offsets_of`), with which a
     constant residual is told; ``left_out``: the friction coefficients the model left out
-    per joint (:func:`friction_left_out`), named where the residual follows the velocity."""
+    per joint (:func:`friction_left_out`), named where the residual follows the velocity;
+    ``ddq``: the accelerations [rad/s^2] at the samples (pieces as ``q``), with which a
+    residual that follows them is said to be an inertia the model lacks (a rotor's),
+    ``inertia`` the remedy said where the caller knows it (a URDF holds no armature)."""
     if tilt is not None and tilt.named:
         rows = tilt.rows
-        q = [np.concatenate([np.asarray(x, dtype=np.float64) for x in q])[rows]]
-        dq = [np.concatenate([np.asarray(x, dtype=np.float64) for x in dq])[rows]]
+
+        def kept(x: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
+            return [np.concatenate([np.asarray(p, dtype=np.float64) for p in x])[rows]]
+
         rest = dependence_hint(
-            q, dq, [tilt.rest], noise_rms, joint_names, terms, offsets=offsets, left_out=left_out
-        )
+            kept(q), kept(dq), [tilt.rest], noise_rms, joint_names, terms, offsets=offsets,
+            left_out=left_out, ddq=None if ddq is None else kept(ddq), inertia=inertia,
+        )  # fmt: skip
         return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
-    found = residual_dependence(q, dq, error, noise_rms, ratios)
+    found = residual_dependence(q, dq, error, noise_rms, ratios, ddq)
     if not found:
         return None
     worst = sorted(found, key=lambda d: d.ratio, reverse=True)
-    said = "; ".join(
-        _sentence(d, joint_names[d.joint], terms, springs, offsets, left_out) for d in worst[:NAMED]
-    )
+    clauses, first = [], None  # the inertia's remedy said once, at its first joint
+    for d in worst[:NAMED]:
+        remedy = inertia if first is None else f"as for {first}"
+        clauses.append(
+            _sentence(d, joint_names[d.joint], terms, springs, offsets, left_out, remedy)
+        )
+        if first is None and acceleration_led(d):
+            first = joint_names[d.joint]
+    said = "; ".join(clauses)
     more = len(worst) - NAMED
     return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
 
@@ -487,6 +542,8 @@ def with_dependence_hint(
     torques: Sequence[NDArray[np.float64]] | None = None,
     offsets: Mapping[int, tuple[str, bool]] | None = None,
     left_out: Mapping[int, tuple[str, ...]] | None = None,
+    ddq: Sequence[NDArray[np.float64]] | None = None,
+    inertia: str | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself; with the
@@ -497,14 +554,17 @@ def with_dependence_hint(
     say which joints are above their noise; ``springs``: the stiffness per joint fitted
     with the model, said for a spring's joint; ``offsets``: the model's offset per joint
     (:func:`offsets_of`), with which a constant residual is told; ``left_out``: its
-    friction coefficients left out per joint (:func:`friction_left_out`)."""
+    friction coefficients left out per joint (:func:`friction_left_out`); ``ddq`` and
+    ``inertia``: the accelerations and the remedy of a residual that follows them
+    (:func:`dependence_hint`)."""
     if verdict.level == "good":
         return verdict
     if (exact := round_off(error, torques)) is not None:
         return with_hint(verdict, round_off_note(exact))
     said = dependence_hint(
-        q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets, left_out
-    )
+        q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets, left_out,
+        ddq, inertia,
+    )  # fmt: skip
     return with_hint(verdict, said)
 
 

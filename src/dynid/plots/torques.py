@@ -21,7 +21,12 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["plot_rms_comparison", "plot_torque_validation", "plot_validation_rms"]
+__all__ = [
+    "plot_rms_comparison",
+    "plot_torque_validation",
+    "plot_validation_rms",
+    "recording_of",
+]
 
 _MEASURED = dict(color=COLOURS["measured"], lw=0.6, label="measured")
 _NO_FRICTION = dict(color=COLOURS["no_friction"], lw=1.1, label="model, no friction")
@@ -37,6 +42,86 @@ def _gaps(t: NDArray[np.float64]) -> NDArray[np.intp]:
     return np.flatnonzero(dt > 10.0 * float(np.median(dt))) + 1
 
 
+#: The space left between two recordings laid one after another, as a share of their time.
+_SPACER = 0.04
+
+
+def recording_of(t: NDArray[np.float64], spans: Sequence[tuple[float, float]]) -> NDArray[np.intp]:
+    """The recording of each sample: ``t`` [s] (N,) holds the samples of the recordings of
+    ``spans`` (each recording's first and last stamp [s]) one recording after another, in
+    their order (pieces of a recording in time order); a recording ends where the times
+    go back or leave its span (recordings stamped each from 0 too).
+
+    Returns
+    -------
+    ndarray of int, shape (N,)
+        The index into ``spans`` of each sample (-1 for samples after the last span's).
+    """
+    n = t.shape[0]
+    out = np.full(n, -1, dtype=np.intp)
+    back = np.concatenate([[False], np.diff(t) < 0.0])  # a new recording stamped earlier
+    i = 0
+    for k, (a, b) in enumerate(spans):
+        if i >= n:
+            break
+        tol = 1e-9 * max(abs(a), abs(b), 1.0)
+        leave = (t[i:] < a - tol) | (t[i:] > b + tol)
+        leave[1:] |= back[i + 1 :]
+        ends = np.flatnonzero(leave)
+        j = n if ends.size == 0 else i + int(ends[0])
+        out[i:j] = k
+        i = j
+    return out
+
+
+def _one_after_another(
+    t: NDArray[np.float64], spans: Sequence[tuple[float, float]]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]] | None:
+    """The times [s] (N,) drawn with each recording from its own start, the recordings one
+    after another with a space between; where each recording starts on that axis; and the
+    indices where a recording begins (the lines broken there). None where a sample lies
+    in no recording's span or a recording has no sample: recordings each stamped from 0,
+    which the pooling already laid one after another on its own axis."""
+    which = recording_of(t, spans)
+    if np.any(which < 0) or np.unique(which).size != len(spans):
+        return None
+    length = np.array([b - a for a, b in spans], dtype=np.float64)
+    spacer = _SPACER * float(length.sum())
+    at = np.concatenate([[0.0], np.cumsum(length + spacer)[:-1]])
+    first = np.array([a for a, _ in spans], dtype=np.float64)
+    k = np.maximum(which, 0)
+    drawn = np.where(which >= 0, t - first[k] + at[k], np.nan)
+    begins = np.flatnonzero(np.diff(which) != 0) + 1
+    return drawn, at, begins
+
+
+def _mark_recordings(
+    axes: Sequence[Axes], names: Sequence[str], at: NDArray[np.float64], length: NDArray[np.float64]
+) -> None:
+    """Each recording's name over the top panels, a boundary line between two recordings
+    on every panel, and ticks that read each recording's own time from its start [s]."""
+    from matplotlib.ticker import MaxNLocator
+
+    step = MaxNLocator(nbins=max(2, int(8 / len(names))), steps=[1, 2, 2.5, 5, 10])
+    local = np.asarray(step.tick_values(0.0, float(length.max())), dtype=np.float64)
+    dt = float(local[1] - local[0]) if local.size > 1 else float(length.max()) or 1.0
+    ticks, labels = [], []
+    for a, d in zip(at, length, strict=True):
+        own = np.arange(0.0, d + 1e-9 * max(d, 1.0), dt)
+        ticks += list(a + own)
+        labels += [f"{x:g}" for x in own]
+    spacer = _SPACER * float(length.sum())
+    for ax in axes:
+        for a in at[1:]:
+            ax.axvline(a - spacer / 2, color="0.3", lw=1.0, ls="-")
+        ax.set_xticks(ticks, labels)
+        ax.set_xlim(at[0] - spacer / 4, at[-1] + length[-1] + spacer / 4)
+    for ax in axes[:2]:
+        for a, d, name in zip(at, length, names, strict=True):
+            ax.text(a + d / 2, 1.02, name, transform=ax.get_xaxis_transform(), ha="center",
+                    va="bottom", fontsize=7, clip_on=False)  # fmt: skip
+
+
 def plot_torque_validation(
     validation: Validation,
     *,
@@ -45,6 +130,7 @@ def plot_torque_validation(
     title: str | None = None,
     fig: Figure | None = None,
     t0: float | None = None,
+    recordings: Sequence[tuple[str, float, float]] = (),
 ) -> Figure:
     """Per joint: measured and predicted torques (left) and prediction errors (right).
 
@@ -65,6 +151,12 @@ def plot_torque_validation(
     t0 : float, optional
         The log's first time stamp [s], from which times are drawn (default: the first
         sample's; a held-out block's log's, so that the block sits at its place in it).
+    recordings : sequence of (str, float, float)
+        Of a validation of several recordings pooled one after another in the log
+        (:func:`recording_of`): each one's name and its first and last stamp [s]. With two
+        or more, each recording is drawn from its own start, the recordings one after
+        another, each named over the top panels, a line between two (``t0`` unused): on one
+        clock, recordings minutes apart left each a sliver of the axis.
 
     Returns
     -------
@@ -86,7 +178,14 @@ def plot_torque_validation(
     axes = fig.subplots(n, 2, sharex=True, squeeze=False, gridspec_kw={"width_ratios": [3, 2]})
     start = float(log.t[0]) if t0 is None else float(t0)
     time = np.asarray(log.t, dtype=np.float64) - start  # from the log's start
-    cut = _gaps(time)
+    spans = [(float(a), float(b)) for _, a, b in recordings]
+    laid = _one_after_another(log.t, spans) if len(spans) > 1 else None
+    several = laid is not None
+    if laid is not None:  # each recording from its own start, one after another
+        time, begins_at, begins = laid
+        cut = np.union1d(_gaps(time), begins).astype(np.intp)
+    else:
+        cut = _gaps(time)
     e0 = log.tau - validation.tau_model
     e1 = None if validation.tau_friction is None else e0 - validation.tau_friction
 
@@ -114,14 +213,20 @@ def plot_torque_validation(
         axe.grid(alpha=0.3)
         axe.yaxis.set_label_position("right")  # beside the data, not over it
         axe.set_ylabel(rms, fontsize=7, rotation=0, ha="left", va="center")
-    axes[0, 0].set_title("joint torques [N m]", fontsize=10)
-    axes[0, 1].set_title("error: measured - model [N m]", fontsize=10)
+    pad = 16.0 if several else 6.0  # room for the recordings' names
+    axes[0, 0].set_title("joint torques [N m]", fontsize=10, pad=pad)
+    axes[0, 1].set_title("error: measured - model [N m]", fontsize=10, pad=pad)
     handles, labels = axes[0, 0].get_legend_handles_labels()
     top = 1.0 - (0.6 if title else 0.3) / fig.get_figheight()  # room for the legend above
     fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=8,
                frameon=False, bbox_to_anchor=(0.5, top))  # fmt: skip
-    axes[-1, 0].set_xlabel("time from the log's start [s]")
-    axes[-1, 1].set_xlabel("time from the log's start [s]")
+    xlabel = "time from the log's start [s]"
+    if several:
+        length = np.array([b - a for _, a, b in recordings], dtype=np.float64)
+        _mark_recordings(list(axes.ravel()), [n for n, _, _ in recordings], begins_at, length)
+        xlabel = "time from each recording's start [s], the recordings one after another"
+    axes[-1, 0].set_xlabel(xlabel)
+    axes[-1, 1].set_xlabel(xlabel)
     if title:
         fig.suptitle(title, fontsize=11)
     tight_layout(fig, rect=(0, 0, 1, top - 0.1 / fig.get_figheight()))

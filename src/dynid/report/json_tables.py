@@ -9,9 +9,11 @@ first.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from .._times import stamp_text
 from .html import (
     MAX_VECTOR,
     cell,
@@ -67,6 +69,21 @@ def _with_unit(key: str, units: Mapping[str, str]) -> str:
     return key
 
 
+#: Keys of a time stamp [s] (a start, an end: not a duration), printed to the millisecond
+#: (:func:`~dynid._times.stamp_text`): four significant digits leave ``1.765e+09`` of a
+#: stamp on the epoch's clock, which names no sample.
+STAMP_KEYS = frozenset({"start", "end", "start_s", "end_s"})
+
+
+def _stamp_cell(key: str, v: Any, units: Mapping[str, str]) -> str:
+    """``v`` as a cell; a number at a time stamp's key (:data:`STAMP_KEYS`, in seconds: its
+    unit ``s`` or its name) to the millisecond, as the log holds it."""
+    in_s = units.get(key) == "s" or key.endswith("_s")
+    if key in STAMP_KEYS and in_s and is_number(v) and math.isfinite(v):
+        return f'<span class="n">{stamp_text(v)}</span>'
+    return cell(v)
+
+
 def names_for(n: int, labels: Sequence[list[str]]) -> list[str]:
     """The first of ``labels`` (joint names, link names) with ``n`` entries, else 1..n."""
     return next((names for names in labels if len(names) == n), [str(i + 1) for i in range(n)])
@@ -87,7 +104,7 @@ def _records_table(
     for r in records:
         columns += [k for k in r if k not in columns]
     shown = records[:MAX_ROWS]
-    rows = [[cell(r.get(c)) for c in columns] for r in shown]
+    rows = [[_stamp_cell(c, r.get(c), units) for c in columns] for r in shown]
     headers = [_with_unit(c, units) for c in columns]
     if not {"name", "link", "joint", "method"} & set(columns):
         names = names_for(len(records), labels)
@@ -170,7 +187,7 @@ def _object_html(
             parts.append(_vectors_table(group, vector_labels, units))
         else:
             other += list(group.items())
-    rows = [[esc(k), cell(v), esc(units.get(k, ""))] for k, v in scalars + other]
+    rows = [[esc(k), _stamp_cell(k, v, units), esc(units.get(k, ""))] for k, v in scalars + other]
     if rows:
         with_units = any(r[2] for r in rows)
         headers = ["key", "value", "unit"] if with_units else ["key", "value"]

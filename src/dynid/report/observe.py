@@ -16,10 +16,23 @@ clean result to usable, the thresholds and the residual holding that friction.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
+from .._times import stamp_text
 from ..identification.verdict import LEVELS
-from .html import capitalised, esc, figure, href, is_number, number, section, table, verdict
+from .html import (
+    capitalised,
+    cell,
+    esc,
+    figure,
+    href,
+    is_number,
+    number,
+    section,
+    table,
+    verdict,
+)
 from .json_tables import json_section
 from .run import Answer, RunFiles
 
@@ -256,6 +269,80 @@ def _dropped(doc: Any) -> tuple[int, str | None]:
     return int(count), esc(said + ".")
 
 
+def _first_stamp(path: Path) -> float | None:
+    """The first time stamp [s] of a residual table (``residuals.csv``: comment lines, a
+    header, then ``t, r1, ...``): the log's first observed sample, from which its figure
+    draws time; None when the file has no row."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            rows = (line for line in fh if line.strip() and not line.startswith("#"))
+            next(rows, None)  # the header
+            first = next(rows, None)
+        return None if first is None else float(first.split(",")[0])
+    except (OSError, ValueError):
+        return None
+
+
+def _log_starts(doc: dict, run: RunFiles) -> dict[str, float]:
+    """Each log's first observed stamp [s] by its name in ``events.json`` (``data``), read
+    from its residual table (``residuals.csv``, ``residuals_<name>.csv`` for several:
+    :func:`~dynid.io.observer_files.residual_names`); a log without one is left out."""
+    from ..io.observer_files import residual_names  # here: any run's page loads this
+
+    logs = [str(x) for x in doc.get("data") or () if isinstance(x, str)]
+    out = {}
+    for log, stem in zip(logs, residual_names(logs) if logs else [], strict=True):
+        path = run.files.get(f"{stem}.csv")
+        t0 = None if path is None else _first_stamp(path)
+        if t0 is not None:
+            out[log] = t0
+    return out
+
+
+def _events_parts(name: str, run: RunFiles) -> list[str]:
+    """The events of ``events.json`` as a table whose times read to the millisecond
+    (HTML), then the rest of the file as tables. Start and end are seconds from the
+    first sample of the event's log, the axis of its residual figure, with the log's
+    clock said once above the table and each start as the log holds it beside them (to
+    find the row in the log, or in another record on the same clock); a log whose first
+    stamp no residual table gives keeps its stamps, to the millisecond."""
+    doc = run.docs[name]
+    events = _events(doc)
+    if not isinstance(doc, dict) or not events or not all(isinstance(e, dict) for e in events):
+        return [json_section(name, doc)]
+    starts = _log_starts(doc, run)
+    rows = []
+    for k, e in enumerate(events, 1):
+        log = str(e.get("log", ""))
+        a, b, t0 = e.get("start"), e.get("end"), starts.get(log)
+        if not (is_number(a) and is_number(b)):
+            return [json_section(name, doc)]
+        into = t0 is not None and t0 != 0.0
+        t0 = t0 if into and t0 is not None else 0.0
+        rows.append(
+            [
+                str(k), esc(log), esc(e.get("level", "")),
+                esc(", ".join(map(str, e.get("joint_names") or e.get("joints") or ()))),
+                stamp_text(a - t0), stamp_text(b - t0),
+                f"{1e3 * (b - a):.0f}", stamp_text(a) if into else "",
+                cell(e.get("peak")),
+            ]
+        )  # fmt: skip
+    said = "; ".join(f"{esc(log)}: t = {stamp_text(t0)} s" for log, t0 in starts.items() if t0)
+    head = (
+        f"<p>start and end: seconds from the log's first sample, as on the residual "
+        f"figure's axis; the log's clock at that sample: {said}.</p>"
+        if said
+        else ""
+    )
+    headers = [
+        "#", "log", "level", "joints", "start [s]", "end [s]", "duration [ms]",
+        "start on the log's clock [s]", "peak [N m]",
+    ]  # fmt: skip
+    rest = {k: v for k, v in doc.items() if k != "events"}
+    return [head + table(headers, rows, cls="events"), json_section(name, rest)]
+
+
 #: Words of the note of a model without friction whose residual shows the arm's.
 FRICTION_FOUND = "friction is in the logs"
 #: Words of a note on a figure left out (the page's banner says it).
@@ -336,10 +423,9 @@ def answer(run: RunFiles) -> Answer | None:
         rel = found["residuals.csv"]
         facts.append(f'Residuals over time: <a href="{href(rel)}">{esc(rel)}</a>')
     sections = []
-    for key, title in (("events.json", "Events"),):
-        name = found[key]
-        if name is not None and name in run.docs:
-            sections.append(section("events", title, json_section(name, run.docs[name])))
+    name = found["events.json"]
+    if name is not None and name in run.docs:
+        sections.append(section("events", "Events", *_events_parts(name, run)))
     if found["residuals.png"] is not None:
         rel = found["residuals.png"]
         title = "Residuals and thresholds" + (" over the calibration" if events is None else "")

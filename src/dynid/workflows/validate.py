@@ -39,7 +39,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -420,8 +420,8 @@ def validate_files(
     current = not beyond and placed is not None and placed.effort == "current"
     verdict, springs, gains, tilt = _with_hints(
         model, verdict, val, rec.logs, noise, names, dependence=not beyond and not opposite,
-        terms=held_terms(model), offsets=offsets_of(model), left_out=friction_left_out(model),
-        gains_too=current)  # fmt: skip
+        held=_terms_held(model, placed, label), gains_too=current,
+    )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
@@ -476,6 +476,29 @@ def _with_delay(
     return verdict, delay, applied
 
 
+#: The remedy of a residual that follows a joint's acceleration, of a robot read from a
+#: URDF without a drive's rotor inertias: the file cannot hold them.
+URDF_INERTIA = (
+    "a URDF holds no armature: dynid's URDF export leaves it out, and warns so; validate "
+    "the MJCF export (robot.xml), which holds it as armature, or give --drive a drive file "
+    "with rotor_inertia"
+)
+
+
+def _terms_held(
+    model: IdentifiedModel | Robot, drive: Drive | None, label: str | None
+) -> tuple[frozenset[str], str | None]:
+    """The terms ``model`` holds beside the rigid bodies
+    (:func:`~dynid.identification.residual_dependence.held_terms`; ``armature`` too where
+    the ``drive`` placed has rotor inertias), and the remedy of a residual that follows
+    a joint's acceleration: :data:`URDF_INERTIA` for a robot read from a URDF (``label``
+    naming it) without an armature, else None (the remedy by the terms)."""
+    rotors = drive is not None and drive.rotor_inertia is not None
+    terms = held_terms(model) | ({"armature"} if rotors else frozenset())
+    urdf = isinstance(model, Robot) and (label or "").lower().endswith(".urdf")
+    return terms, URDF_INERTIA if urdf and "armature" not in terms else None
+
+
 def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
     """Each joint's largest speed [rad/s] over the identification's samples, or None (a
     robot, a model of static data)."""
@@ -493,17 +516,16 @@ def _with_hints(
     names: Sequence[str],
     *,
     dependence: bool = True,
-    terms: frozenset[str] = frozenset(),
-    offsets: Mapping[int, tuple[str, bool]] | None = None,
-    left_out: Mapping[int, tuple[str, ...]] | None = None,
+    held: tuple[frozenset[str], str | None] = (frozenset(), None),
     gains_too: bool = False,
 ) -> tuple[Verdict, ResidualSpring | None, DriveGains | None, GravityTilt | None]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
-    any residual follows the motion; ``terms`` the model's, which its remedies leave out;
-    ``offsets`` its offset per joint, with which a constant residual is told;
-    ``left_out`` its friction coefficients left out per joint, named where the residual
+    any residual follows the motion; ``held`` the model's terms, which its remedies leave
+    out, and the remedy of a residual that follows a joint's acceleration
+    (:func:`_terms_held`); the model's offset per joint, with which a constant residual is
+    told, and its friction coefficients left out per joint, named where the residual
     follows the velocity;
     first the tilt of the gravity vector the residual points to, when it explains it:
     :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
@@ -513,6 +535,8 @@ def _with_hints(
     False too where ``gains_too``: a current log, whose factors a sign finding does not
     explain), the hint of a cut-off too high for derived states, and that of an error at
     low speed; and the springs, the gains and the tilt fitted (None: not judged)."""
+    terms, inertia = held
+    offsets, left_out = offsets_of(model), friction_left_out(model)
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
@@ -528,9 +552,11 @@ def _with_hints(
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
+        got = [v.log.ddq for v in val.parts]
+        ddq = [a for a in got if a is not None]
         verdict = with_dependence_hint(
             verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau,
-            offsets, left_out,
+            offsets, left_out, ddq if len(ddq) == len(got) else None, inertia,
         )  # fmt: skip
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
