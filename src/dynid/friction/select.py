@@ -354,17 +354,17 @@ def select_friction(
         if not last:  # new data to the model: its prediction is held out as it is
             scores.append(own_score)
     for name in names:
-        width, held = None, None
+        width: float | None = None
+        reused: NDArray[np.float64] | None = None
         if name in WIDTH_LAWS:  # the width's held-out torques, reused by the law judged
             width, best = _best_width(res, drive, labels, judge)
-            held = best if name == WIDTH_LAWS[0] else None
+            reused = best if name == WIDTH_LAWS[0] else None
         with warnings.catch_warnings():
             if name != names[-1]:  # one warning about still joints is enough
                 warnings.simplefilter("ignore", DynidWarning)
             fits[name] = fit_friction_through(res, drive, name, width=width)
         train = fits[name].friction.torques(res.dq)
-        if held is None:
-            held = _heldout_torques(res, drive, name, labels, width)
+        held = _heldout_torques(res, drive, name, labels, width) if reused is None else reused
         bad = (
             ()
             if dq_max is None
