@@ -375,15 +375,17 @@ def _own_terms(
     dq: NDArray[np.float64],
     ddq: NDArray[np.float64],
     drive: Drive | None = None,
+    columns: Sequence[_GroupColumns] | None = None,
 ) -> list[_OwnTerms]:
     """Each joint's (motor's) own viscous, Coulomb, offset and armature coefficients fitted
     to the residuals ``r`` (N, n), group by group (:func:`_motor_groups`: a coupled wrist's
     joints together), as :func:`_left_over` describes; in a coupled group, beside the
     motors', the viscous and Coulomb friction of the joints no motor turns alone
-    (:func:`_shared_joints`), at the joint."""
+    (:func:`_shared_joints`), at the joint. ``columns``: :func:`_group_columns` at ``dq``,
+    ``ddq`` when the caller has them already (or the groups of them it wants)."""
     Kf = np.eye(r.shape[1]) if drive is None else drive.friction_transmission
     out = []
-    for fit in _group_fits(r, dq, ddq, drive):
+    for fit in _group_fits(r, dq, ddq, drive, columns):
         X, motors, v = fit.columns.X, fit.columns.motors, fit.columns.v
         coef, left = fit.coef, fit.left
         dof = max(X.shape[0] - X.shape[1], 1)
@@ -684,14 +686,19 @@ DISSIPATION_SHARE = 0.3
 
 
 def _pooled_fits(
-    sides: Sequence[_Modelled], signs: Sequence[NDArray[np.float64]]
+    sides: Sequence[_Modelled],
+    signs: Sequence[NDArray[np.float64]],
+    motor: int | None = None,
+    columns: Sequence[_GroupColumns] | None = None,
 ) -> dict[int, tuple[float, float, float, float]]:
     """Per motor (joint): the sum of squares [N^2 m^2] its group's own terms
     (:func:`_own_terms`: one friction, rotor and offset for every recording) leave of what
     the robot's rigid-body torques leave of the recordings pooled, each column times its
     recording's ``signs`` (n,), the power [W] that friction dissipates with its standard
     deviation (:func:`_power`), and the scale of that power [W]: the RMS of what the
-    rigid-body torques leave times the mean speed, at the joints the motor turns."""
+    rigid-body torques leave times the mean speed, at the joints the motor turns. Of the
+    group of ``motor`` alone when given; ``columns``: :func:`_pooled_columns` of
+    ``sides`` when the caller has them already."""
     r = np.concatenate(
         [s.rec.signed_torques(sign) - s.model for s, sign in zip(sides, signs, strict=True)]
     )
@@ -700,11 +707,22 @@ def _pooled_fits(
     drive = sides[0].rec.drive
     turns = np.eye(r.shape[1]) if drive is None else drive.friction_transmission
     each = np.sqrt(np.mean(r**2, axis=0)) * np.mean(np.abs(dq), axis=0)  # (n,) [W]
+    groups = _group_columns(dq, ddq, drive) if columns is None else columns
+    if motor is not None:
+        groups = [c for c in groups if motor in c.motors]
     out = {}
-    for g in _own_terms(r, dq, ddq, drive):
+    for g in _own_terms(r, dq, ddq, drive, groups):
         for i, k in enumerate(g.motors):
             out[k] = (g.left, *_power(g, i), float(np.max(each[turns[k] != 0], initial=0.0)))
     return out
+
+
+def _pooled_columns(sides: Sequence[_Modelled]) -> list[_GroupColumns]:
+    """The own terms' columns (:func:`_group_columns`) of the recordings ``sides`` pooled,
+    as :func:`_pooled_fits` fits them (the same for every sign of the torques)."""
+    dq = np.concatenate([s.dq for s in sides])
+    ddq = np.concatenate([s.ddq for s in sides])
+    return _group_columns(dq, ddq, sides[0].rec.drive)
 
 
 def _told(
@@ -754,13 +772,14 @@ def _pooled_confirmed(
         return found
     kept: list[_Modelled] = [x for x in sides if x is not None]
     n = kept[0].rec.tau.shape[1]
-    read = _pooled_fits(kept, [np.ones(n)] * len(kept))
+    columns = _pooled_columns(kept)
+    read = _pooled_fits(kept, [np.ones(n)] * len(kept), columns=columns)
     out: dict[int, list[int]] = {}
     for r, motors in found.items():
         for k in motors:
             signs = [np.ones(n) for _ in kept]
             signs[r][k] = -1.0
-            if _pooled_fits(kept, signs)[k][0] <= DISAGREE_SHARE * read[k][0]:
+            if _pooled_fits(kept, signs, k, columns)[k][0] <= DISAGREE_SHARE * read[k][0]:
                 out.setdefault(r, []).append(k)
     return out
 
@@ -789,14 +808,15 @@ def opposite_among_pooled(
     kept: list[_Modelled] = [s for s in sides if s is not None]
     n = kept[0].rec.tau.shape[1]
     one = [np.ones(n) for _ in kept]
-    read = _pooled_fits(kept, one)
+    columns = _pooled_columns(kept)
+    read = _pooled_fits(kept, one, columns=columns)
     told: dict[int | None, list[tuple[int, list[int], tuple]]] = {}
     for k in range(n):
         fits = []
         for r in range(len(kept)):
             signs = [x.copy() for x in one]
             signs[r][k] = -1.0
-            fits.append(_pooled_fits(kept, signs)[k])
+            fits.append(_pooled_fits(kept, signs, k, columns)[k])
         order = sorted(range(len(kept)), key=lambda r: fits[r][0])
         if not fits[order[0]][0] <= DISAGREE_SHARE * read[k][0]:
             continue
