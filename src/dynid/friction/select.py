@@ -354,13 +354,17 @@ def select_friction(
         if not last:  # new data to the model: its prediction is held out as it is
             scores.append(own_score)
     for name in names:
-        width = _best_width(res, drive, labels, judge) if name in WIDTH_LAWS else None
+        width: float | None = None
+        reused: NDArray[np.float64] | None = None
+        if name in WIDTH_LAWS:  # the width's held-out torques, reused by the law judged
+            width, best = _best_width(res, drive, labels, judge)
+            reused = best if name == WIDTH_LAWS[0] else None
         with warnings.catch_warnings():
             if name != names[-1]:  # one warning about still joints is enough
                 warnings.simplefilter("ignore", DynidWarning)
             fits[name] = fit_friction_through(res, drive, name, width=width)
         train = fits[name].friction.torques(res.dq)
-        held = _heldout_torques(res, drive, name, labels, width)
+        held = _heldout_torques(res, drive, name, labels, width) if reused is None else reused
         bad = (
             ()
             if dq_max is None
@@ -407,22 +411,23 @@ def choose_smooth_width(
         ``folds < 2`` or fewer than 10 samples per block.
     """
     labels, _, _ = _folds(res, folds)
-    return _best_width(res, drive, labels, _Judge(res, labels))
+    return _best_width(res, drive, labels, _Judge(res, labels))[0]
 
 
 def _best_width(
     res: FrictionResidual, drive: Drive | None, labels: NDArray[np.intp], judge: _Judge
-) -> float:
-    """:func:`choose_smooth_width` on the blocks ``labels``."""
+) -> tuple[float, NDArray[np.float64]]:
+    """:func:`choose_smooth_width` on the blocks ``labels``, and the held-out torques (N, n)
+    [N m] of that factor (:func:`_heldout_torques`: the law's score reuses them)."""
     n = res.dq.shape[1]
-    best: tuple[float, float] | None = None
+    best: tuple[float, float, NDArray[np.float64]] | None = None
     for factor, _ in smooth_width_grid([0.0] * n):
         held = _heldout_torques(res, drive, WIDTH_LAWS[0], labels, factor)
         score = judge.score(WIDTH_LAWS[0], (), 0, held, held).scaled_error_percent
         if best is None or score < best[1]:
-            best = (factor, score)
+            best = (factor, score, held)
     assert best is not None  # (the grid is not empty)
-    return best[0]
+    return best[0], best[2]
 
 
 def _dissipative(scores: Sequence[CandidateScore]) -> list[CandidateScore]:

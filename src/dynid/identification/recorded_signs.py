@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -81,6 +81,13 @@ class _Recorded:
     ddq: NDArray[np.float64]
     tau: NDArray[np.float64]
     drive: Drive | None
+    #: Per columns' signs ``motion`` (its bytes), the joint velocities, accelerations, the
+    #: model's torques and the own terms' columns (:func:`_group_columns`) :meth:`left`
+    #: computed with them (the search tries several efforts' signs beside one motion's).
+    seen: dict[
+        bytes,
+        tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], list[_GroupColumns]],
+    ] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def joint_torques(self) -> NDArray[np.float64]:
@@ -112,14 +119,20 @@ class _Recorded:
     def left(self, robot: Robot, motion: NDArray[np.float64], torque: NDArray[np.float64]) -> float:
         """What the model and each motor's friction and rotor leave [N^2 m^2] (sum of
         squares over the joints) with the columns' signs ``motion`` and ``torque`` (n,)."""
-        q, dq, ddq, tau = self.q * motion, self.dq * motion, self.ddq * motion, self.tau * torque
+        key = np.asarray(motion, dtype=np.float64).tobytes()
+        if key not in self.seen:  # (the robot is the one of every call: reversed_joint's)
+            q, dq, ddq = self.q * motion, self.dq * motion, self.ddq * motion
+            if self.drive is not None:
+                q, dq, ddq = self.drive.joint_states(q, dq, ddq)
+            model = rnea(robot, q, dq, ddq)
+            if robot.spring is not None:
+                model = model + robot.spring.torques(q)
+            self.seen[key] = (dq, ddq, model, _group_columns(dq, ddq, self.drive))
+        dq, ddq, model, columns = self.seen[key]
+        tau = self.tau * torque
         if self.drive is not None:
-            q, dq, ddq = self.drive.joint_states(q, dq, ddq)
             tau = self.drive.joint_torques(tau)
-        model = rnea(robot, q, dq, ddq)
-        if robot.spring is not None:
-            model = model + robot.spring.torques(q)
-        return _left_over(tau - model, dq, ddq, self.drive)
+        return _left_over(tau - model, dq, ddq, self.drive, columns)
 
 
 def _recorded(log: TorqueLog, drive: Drive | None) -> _Recorded | None:
@@ -291,13 +304,15 @@ def _left_over(
     dq: NDArray[np.float64],
     ddq: NDArray[np.float64],
     drive: Drive | None = None,
+    columns: Sequence[_GroupColumns] | None = None,
 ) -> float:
     """The sum of squares [N^2 m^2] of the residuals ``r`` (N, n) left by each joint's own
     viscous, Coulomb, offset and armature columns (``dq``, ``sign(dq)``, 1, ``ddq``); with
     a ``drive``, each motor's where its friction acts (``K_f^T`` of those of ``K_f dq``)
     and its rotor's (``K^T`` of ``K ddq``), the joints a motor couples fitted together
-    with the friction of those no motor turns alone (:func:`_own_terms`)."""
-    return sum(g.left for g in _own_terms(r, dq, ddq, drive))
+    with the friction of those no motor turns alone (:func:`_own_terms`). ``columns``:
+    :func:`_group_columns` at ``dq``, ``ddq`` when the caller has them already."""
+    return sum(g.left for g in _group_fits(r, dq, ddq, drive, columns))
 
 
 @dataclass(frozen=True)
@@ -360,13 +375,66 @@ def _own_terms(
     dq: NDArray[np.float64],
     ddq: NDArray[np.float64],
     drive: Drive | None = None,
+    columns: Sequence[_GroupColumns] | None = None,
 ) -> list[_OwnTerms]:
     """Each joint's (motor's) own viscous, Coulomb, offset and armature coefficients fitted
     to the residuals ``r`` (N, n), group by group (:func:`_motor_groups`: a coupled wrist's
     joints together), as :func:`_left_over` describes; in a coupled group, beside the
     motors', the viscous and Coulomb friction of the joints no motor turns alone
-    (:func:`_shared_joints`), at the joint."""
-    n = r.shape[1]
+    (:func:`_shared_joints`), at the joint. ``columns``: :func:`_group_columns` at ``dq``,
+    ``ddq`` when the caller has them already (or the groups of them it wants)."""
+    Kf = np.eye(r.shape[1]) if drive is None else drive.friction_transmission
+    out = []
+    for fit in _group_fits(r, dq, ddq, drive, columns):
+        X, motors, v = fit.columns.X, fit.columns.motors, fit.columns.v
+        coef, left = fit.coef, fit.left
+        dof = max(X.shape[0] - X.shape[1], 1)
+        cov = (left / dof) * np.linalg.pinv(X.T @ X)
+        m = len(motors)
+        blocks = np.array([cov[4 * i : 4 * i + 4, 4 * i : 4 * i + 4] for i in range(m)])
+        speed = np.array([[np.mean(np.abs(v[:, k])), np.mean(v[:, k] ** 2)] for k in motors])
+        grads = np.zeros((m, X.shape[1]))  # d power / d coef, per motor
+        for i, k in enumerate(motors):
+            grads[i, 4 * i : 4 * i + 2] = speed[i, 1], speed[i, 0]
+            for c, (j, unit) in enumerate(fit.columns.at_joint):
+                grads[i, 4 * m + c] = unit if Kf[k, j] != 0 else 0.0
+        power = np.array(
+            [[g @ coef, math.sqrt(max(float(g @ cov @ g), 0.0))] for g in grads], dtype=np.float64
+        ).reshape(m, 2)
+        coefs = np.asarray(coef[: 4 * m], dtype=np.float64).reshape(m, 4)
+        out.append(_OwnTerms(motors, coefs, blocks, left, speed, power))
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class _GroupColumns:
+    """One group's columns in :func:`_group_columns`: its joints and motors, the columns
+    ``X`` (N m, c), per column at a joint (after the motors' 4 each) that joint and its
+    power per unit, and every motor's velocities ``v`` (N, motors)."""
+
+    joints: list[int]
+    motors: list[int]
+    X: NDArray[np.float64]
+    at_joint: list[tuple[int, float]]
+    v: NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class _GroupFit:
+    """One group's least squares in :func:`_group_fits`: its columns (:class:`_GroupColumns`),
+    the coefficients (c,) and the residual sum of squares ``left`` [N^2 m^2]."""
+
+    columns: _GroupColumns
+    coef: NDArray[np.float64]
+    left: float
+
+
+def _group_columns(
+    dq: NDArray[np.float64], ddq: NDArray[np.float64], drive: Drive | None
+) -> list[_GroupColumns]:
+    """The columns of :func:`_own_terms`, group by group, at the joint velocities ``dq``
+    and accelerations ``ddq`` (N, n): the same for every residual fitted at those states."""
+    n = dq.shape[1]
     Kf = np.eye(n) if drive is None else drive.friction_transmission
     K = np.eye(n) if drive is None else drive.transmission
     v, a = dq @ Kf.T, ddq @ K.T
@@ -375,7 +443,7 @@ def _own_terms(
     for joints, motors in _motor_groups((K != 0) | (Kf != 0)):
         cols = []
         for k in motors:  # motor k's columns at the group's joints: (N, m) each
-            for f in (v[:, k], np.sign(v[:, k]), np.ones(len(r))):
+            for f in (v[:, k], np.sign(v[:, k]), np.ones(len(dq))):
                 cols.append(f[:, None] * Kf[k, joints])
             cols.append(a[:, k, None] * K[k, joints])
         extra = [j for j in joints if shared[j]] if len(joints) > 1 else []
@@ -388,26 +456,26 @@ def _own_terms(
                 at_joint.append((j, float(np.mean(dq[:, j] ** 2))))
             cols.append(np.sign(dq[:, j, None]) * at)
             at_joint.append((j, float(np.mean(np.abs(dq[:, j])))))
-        X = np.stack(cols, axis=-1).reshape(len(r) * len(joints), len(cols))
-        y = r[:, joints].reshape(-1)
-        coef = np.linalg.lstsq(X, y, rcond=None)[0]
-        left = float(np.sum((y - X @ coef) ** 2))
-        dof = max(X.shape[0] - X.shape[1], 1)
-        cov = (left / dof) * np.linalg.pinv(X.T @ X)
-        m = len(motors)
-        blocks = np.array([cov[4 * i : 4 * i + 4, 4 * i : 4 * i + 4] for i in range(m)])
-        speed = np.array([[np.mean(np.abs(v[:, k])), np.mean(v[:, k] ** 2)] for k in motors])
-        grads = np.zeros((m, len(cols)))  # d power / d coef, per motor
-        for i, k in enumerate(motors):
-            grads[i, 4 * i : 4 * i + 2] = speed[i, 1], speed[i, 0]
-            for c, (j, unit) in enumerate(at_joint):
-                grads[i, 4 * m + c] = unit if Kf[k, j] != 0 else 0.0
-        power = np.array(
-            [[g @ coef, math.sqrt(max(float(g @ cov @ g), 0.0))] for g in grads], dtype=np.float64
-        ).reshape(m, 2)
-        coefs = np.asarray(coef[: 4 * m], dtype=np.float64).reshape(m, 4)
-        out.append(_OwnTerms(motors, coefs, blocks, left, speed, power))
+        X = np.stack(cols, axis=-1).reshape(len(dq) * len(joints), len(cols))
+        out.append(_GroupColumns(joints, motors, X, at_joint, v))
     return out
+
+
+def _group_fits(
+    r: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64],
+    drive: Drive | None,
+    columns: Sequence[_GroupColumns] | None = None,
+) -> Iterator[_GroupFit]:
+    """The least squares of :func:`_own_terms`, group by group: what :func:`_left_over`
+    reads, without the coefficients' covariance and powers. ``columns``:
+    :func:`_group_columns` at ``dq``, ``ddq`` when the caller has them already."""
+    for c in _group_columns(dq, ddq, drive) if columns is None else columns:
+        y = r[:, c.joints].reshape(-1)
+        coef = np.asarray(np.linalg.lstsq(c.X, y, rcond=None)[0], dtype=np.float64)
+        left = float(np.sum((y - c.X @ coef) ** 2))
+        yield _GroupFit(c, coef, left)
 
 
 #: A motor's (joint's) friction and rotor read of the opposite sign in one recording to
@@ -618,14 +686,19 @@ DISSIPATION_SHARE = 0.3
 
 
 def _pooled_fits(
-    sides: Sequence[_Modelled], signs: Sequence[NDArray[np.float64]]
+    sides: Sequence[_Modelled],
+    signs: Sequence[NDArray[np.float64]],
+    motor: int | None = None,
+    columns: Sequence[_GroupColumns] | None = None,
 ) -> dict[int, tuple[float, float, float, float]]:
     """Per motor (joint): the sum of squares [N^2 m^2] its group's own terms
     (:func:`_own_terms`: one friction, rotor and offset for every recording) leave of what
     the robot's rigid-body torques leave of the recordings pooled, each column times its
     recording's ``signs`` (n,), the power [W] that friction dissipates with its standard
     deviation (:func:`_power`), and the scale of that power [W]: the RMS of what the
-    rigid-body torques leave times the mean speed, at the joints the motor turns."""
+    rigid-body torques leave times the mean speed, at the joints the motor turns. Of the
+    group of ``motor`` alone when given; ``columns``: :func:`_pooled_columns` of
+    ``sides`` when the caller has them already."""
     r = np.concatenate(
         [s.rec.signed_torques(sign) - s.model for s, sign in zip(sides, signs, strict=True)]
     )
@@ -634,11 +707,22 @@ def _pooled_fits(
     drive = sides[0].rec.drive
     turns = np.eye(r.shape[1]) if drive is None else drive.friction_transmission
     each = np.sqrt(np.mean(r**2, axis=0)) * np.mean(np.abs(dq), axis=0)  # (n,) [W]
+    groups = _group_columns(dq, ddq, drive) if columns is None else columns
+    if motor is not None:
+        groups = [c for c in groups if motor in c.motors]
     out = {}
-    for g in _own_terms(r, dq, ddq, drive):
+    for g in _own_terms(r, dq, ddq, drive, groups):
         for i, k in enumerate(g.motors):
             out[k] = (g.left, *_power(g, i), float(np.max(each[turns[k] != 0], initial=0.0)))
     return out
+
+
+def _pooled_columns(sides: Sequence[_Modelled]) -> list[_GroupColumns]:
+    """The own terms' columns (:func:`_group_columns`) of the recordings ``sides`` pooled,
+    as :func:`_pooled_fits` fits them (the same for every sign of the torques)."""
+    dq = np.concatenate([s.dq for s in sides])
+    ddq = np.concatenate([s.ddq for s in sides])
+    return _group_columns(dq, ddq, sides[0].rec.drive)
 
 
 def _told(
@@ -688,13 +772,14 @@ def _pooled_confirmed(
         return found
     kept: list[_Modelled] = [x for x in sides if x is not None]
     n = kept[0].rec.tau.shape[1]
-    read = _pooled_fits(kept, [np.ones(n)] * len(kept))
+    columns = _pooled_columns(kept)
+    read = _pooled_fits(kept, [np.ones(n)] * len(kept), columns=columns)
     out: dict[int, list[int]] = {}
     for r, motors in found.items():
         for k in motors:
             signs = [np.ones(n) for _ in kept]
             signs[r][k] = -1.0
-            if _pooled_fits(kept, signs)[k][0] <= DISAGREE_SHARE * read[k][0]:
+            if _pooled_fits(kept, signs, k, columns)[k][0] <= DISAGREE_SHARE * read[k][0]:
                 out.setdefault(r, []).append(k)
     return out
 
@@ -723,14 +808,15 @@ def opposite_among_pooled(
     kept: list[_Modelled] = [s for s in sides if s is not None]
     n = kept[0].rec.tau.shape[1]
     one = [np.ones(n) for _ in kept]
-    read = _pooled_fits(kept, one)
+    columns = _pooled_columns(kept)
+    read = _pooled_fits(kept, one, columns=columns)
     told: dict[int | None, list[tuple[int, list[int], tuple]]] = {}
     for k in range(n):
         fits = []
         for r in range(len(kept)):
             signs = [x.copy() for x in one]
             signs[r][k] = -1.0
-            fits.append(_pooled_fits(kept, signs)[k])
+            fits.append(_pooled_fits(kept, signs, k, columns)[k])
         order = sorted(range(len(kept)), key=lambda r: fits[r][0])
         if not fits[order[0]][0] <= DISAGREE_SHARE * read[k][0]:
             continue
