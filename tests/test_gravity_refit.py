@@ -9,6 +9,7 @@ never saw; the same arm level, whose identification must not change.
 from __future__ import annotations
 
 import dataclasses
+import json
 import warnings
 
 import numpy as np
@@ -57,9 +58,7 @@ def _tilted(robot, axis, deg):
 def _logs(truth, seeds, duration=3.0):
     """Noisy recordings of ``truth`` with the friction, offsets and rotor inertias above."""
     fr = ClassicalFriction(*FRICTION.T)
-    return recordings(
-        truth, seeds, friction=fr, armature=ARMATURE, duration=duration, noise=NOISE
-    )
+    return recordings(truth, seeds, friction=fr, armature=ARMATURE, duration=duration, noise=NOISE)
 
 
 def _identify(robot, logs):
@@ -205,3 +204,29 @@ def test_a_level_arm_is_fitted_once_and_unchanged(level_logs, monkeypatch):
     ea, eb = res.heldout.validation.errors, plain.heldout.validation.errors
     np.testing.assert_array_equal(ea.rms, eb.rms)
     assert a.info.notes == b.info.notes
+
+
+def test_identify_takes_the_gravity_the_note_gives(tilted_x, tmp_path):
+    """dynid identify --gravity=GX,GY,GZ of the tilted arm, the vector its note printed:
+    identified once with it (no note, no refit), identification.json's robot holds it and
+    the held-out verdict is at the floor; two numbers are refused naming --gravity."""
+    from dynid.cli.__main__ import main
+
+    logs, res = tilted_x
+    paths = []
+    for i, log in enumerate(logs):
+        paths.append(str(tmp_path / f"tilted{i}.csv"))
+        save_torque_log(paths[-1], log)
+    note = res.model.info.extra["gravity_fitted"]["note"]
+    given = note.split("--gravity=")[1].split()[0]
+    out = tmp_path / "out"
+    args = ["identify", "--robot", "panda", "--data", *paths, "--terms", TERMS]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*args, f"--gravity={given}", "--out", str(out), "--no-figures", "-q"]) == 0
+    model = load_model_json(out / "identification.json")
+    np.testing.assert_allclose(model.robot.gravity, res.gravity.gravity, rtol=1e-5)
+    assert "gravity_fitted" not in model.info.extra
+    held = json.loads((out / "heldout.json").read_text())
+    assert held["verdict"]["level"] == "good", held["verdict"]
+    assert main([*args, "--gravity", "0,-9.8", "--out", str(tmp_path / "x"), "-q"]) == 2

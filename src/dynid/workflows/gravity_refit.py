@@ -94,14 +94,15 @@ class FittedGravity:
         """The finding in one sentence, with the angles [deg], both held-out errors and
         where a user gives the gravity vector."""
         ax, ay = np.degrees(self.angle)
-        g = ", ".join(f"{x:.4g}" for x in self.gravity)
+        g = ",".join(f"{x:.6g}" for x in self.gravity)
+        shown = g.replace(",", ", ")
         return (
             f"gravity vector fitted: the base reads tilted {ax:.2f} deg about x and {ay:.2f} "
-            f"deg about y, gravity = [{g}] m/s^2 in the base frame (the robot's in "
+            f"deg about y, gravity = [{shown}] m/s^2 in the base frame (the robot's in "
             "identification.json); the description's level gravity left a held-out error of "
             f"{self.level_percent:.3g} %, the fitted one {self.fitted_percent:.3g} % (noise "
-            f"floor {self.floor_percent:.3g} %); give it as --gravity {g.replace(' ', '')} "
-            "(or the robot file's gravity) to identify with it from the start"
+            f"floor {self.floor_percent:.3g} %); give it as --gravity={g} "
+            "(or a robot TOML's gravity) to identify with it from the start"
         )
 
     def as_dict(self) -> dict[str, Any]:

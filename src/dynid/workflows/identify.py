@@ -16,6 +16,10 @@ command applies, so that the Python API behaves as the command does.
   last time block, every recording predicted by the fit of the others, or the
   ``validate_on`` log, every sample) is made
   from the logs read for the fit, each file read once, and returned with the model.
+* From torque logs, where the held-out verdict names a tilted base, the identification is
+  made again with the gravity vector the data read as and the model held out better kept,
+  its robot carrying that gravity (:mod:`~dynid.workflows.gravity_refit`; a level arm is
+  identified once).
 * Torque logs once read go through :func:`identify_logs`, the entry point of a caller that
   holds :class:`~dynid.identification.log.TorqueLog` objects: the structure search, a
   current log's torque constants judged first (:mod:`~dynid.workflows.gains_first`), and
@@ -530,8 +534,9 @@ def _fit_logs(
     judgement's ``folds``/``validate_on``): the search (:func:`_searched`), made again
     with the gravity vector the data read as where its held-out verdict names a tilted
     base (:func:`~dynid.workflows.gravity_refit.refit_gravity`: the model held out better
-    kept, its robot carrying that gravity, a note saying so), the gravity scale's warning, and either the consistent fit of the model the search kept
-    (:func:`_consistent_of`) or the torques' delay."""
+    kept, its robot carrying that gravity, a note saying so), the gravity scale's warning,
+    and either the consistent fit of the model the search kept (:func:`_consistent_of`) or
+    the torques' delay."""
 
     def search(robot: Robot) -> tuple[IdentifiedModel, HeldOutTorques | None, Any]:
         def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
