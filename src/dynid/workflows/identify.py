@@ -560,8 +560,7 @@ def _fit_logs(
 
     separate = heldout.get("validate_on")
     kept = refit_gravity(robot, search)
-    for w in kept.said:
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    _say_once(kept.said)  # the kept search's, each once as the default filter says them
     robot, (model, held, first), gravity = kept.robot, kept.searched, kept.gravity
     if gravity is not None:
         note = gravity.note()
