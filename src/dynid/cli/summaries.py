@@ -115,6 +115,8 @@ def format_identification(
     head += recordings_lines(info.recordings)
     first = info.extra.get("gains_first")  # why the torque constants were judged first:
     head += [f"note: {first}"] if isinstance(first, str) else []  # before the table it explains
+    gravity = info.extra.get("gravity_fitted")  # the gravity vector a tilted base reads
+    head += [f"note: {gravity['note']}"] if isinstance(gravity, dict) and "note" in gravity else []
     head += selection_lines(info.selection)
     lw = text_width("name", model.base.labels[: model.base.rank], 7)
     head.append(f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}  kept  expression")

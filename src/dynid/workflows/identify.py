@@ -16,6 +16,10 @@ command applies, so that the Python API behaves as the command does.
   last time block, every recording predicted by the fit of the others, or the
   ``validate_on`` log, every sample) is made
   from the logs read for the fit, each file read once, and returned with the model.
+* From torque logs, where the held-out verdict names a tilted base, the identification is
+  made again with the gravity vector the data read as and the model held out better kept,
+  its robot carrying that gravity (:mod:`~dynid.workflows.gravity_refit`; a level arm is
+  identified once).
 * Torque logs once read go through :func:`identify_logs`, the entry point of a caller that
   holds :class:`~dynid.identification.log.TorqueLog` objects: the structure search, a
   current log's torque constants judged first (:mod:`~dynid.workflows.gains_first`), and
@@ -70,6 +74,7 @@ from .data_files import (
     read_torque_log,
 )
 from .gains_first import CorrectedSearch, gains_first, reason_to_judge_first
+from .gravity_refit import FittedGravity, refit_gravity
 from .options import (
     Cutoff,
     check_band,
@@ -367,6 +372,13 @@ class IdentifyResult:
         the ``torque_delay_s`` given); None for static data or the consistent fit. When
         :attr:`~dynid.identification.torque_delay.TorqueDelay.named`, the model's notes
         say it and ``identification.json``'s metadata hold it (``torque_delay``).
+    gravity : FittedGravity or None
+        Torque logs: the gravity vector fitted where the held-out verdict of the
+        description's named a tilted base and the model identified with the vector the
+        data read as predicts the held-out data better
+        (:func:`~dynid.workflows.gravity_refit.refit_gravity`): ``model.robot`` carries it,
+        a note says it and ``identification.json``'s metadata hold it
+        (``gravity_fitted``); None otherwise (a level arm: fitted once, as before).
     """
 
     model: IdentifiedModel
@@ -374,6 +386,7 @@ class IdentifyResult:
     files: tuple[Path, ...]
     heldout: HeldOutTorques | None = None
     torque_delay: TorqueDelay | None = None
+    gravity: FittedGravity | None = None
 
 
 def identify_files(
@@ -435,7 +448,7 @@ def identify_files(
     if result is not None and result.identified is not None:
         result = dataclasses.replace(result, identified=_record(result.identified, opt.columns))
     model = _record(got.model, opt.columns)
-    return IdentifyResult(model, result, tuple(paths), got.heldout, got.torque_delay)
+    return IdentifyResult(model, result, tuple(paths), got.heldout, got.torque_delay, got.gravity)
 
 
 def identify_logs(
@@ -518,35 +531,51 @@ def _fit_logs(
     prior: Robot | None,
 ) -> IdentifyResult:
     """The torque-log route of :func:`identify_logs` (``heldout``: the held-out
-    judgement's ``folds``/``validate_on``): the search (:func:`_searched`), the gravity
-    scale's warning, and either the consistent fit of the model the search kept
-    (:func:`_consistent_of`) or the torques' delay."""
+    judgement's ``folds``/``validate_on``): the search (:func:`_searched`), made again
+    with the gravity vector the data read as where its held-out verdict names a tilted
+    base (:func:`~dynid.workflows.gravity_refit.refit_gravity`: the model held out better
+    kept, its robot carrying that gravity, a note saying so), the gravity scale's warning,
+    and either the consistent fit of the model the search kept (:func:`_consistent_of`) or
+    the torques' delay."""
 
-    def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
-        return identify_recordings(
-            robot,
-            logs,
-            names,
-            structure=structure,
-            max_std_percent=opt.max_std_percent,
-            rtol=opt.rtol,
-            max_gap_s=opt.max_gap_s,
-            torque_delay_s=opt.torque_delay_s or 0.0,
-            drive=drive,
-            estimator=opt.estimator,
-            std=opt.std or "hac",  # the consistent fit's data term is the residual itself
-            cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
-            **heldout,
-        )
+    def search(robot: Robot) -> tuple[IdentifiedModel, HeldOutTorques | None, Any]:
+        def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
+            return identify_recordings(
+                robot,
+                logs,
+                names,
+                structure=structure,
+                max_std_percent=opt.max_std_percent,
+                rtol=opt.rtol,
+                max_gap_s=opt.max_gap_s,
+                torque_delay_s=opt.torque_delay_s or 0.0,
+                drive=drive,
+                estimator=opt.estimator,
+                std=opt.std or "hac",  # the consistent fit's data term is the residual itself
+                cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
+                **heldout,
+            )
+
+        return _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
 
     separate = heldout.get("validate_on")
-    model, held, first = _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
+    kept = refit_gravity(robot, search)
+    _say_once(kept.said)  # the kept search's, each once as the default filter says them
+    robot, (model, held, first), gravity = kept.robot, kept.searched, kept.gravity
+    if gravity is not None:
+        note = gravity.note()
+        info = dataclasses.replace(
+            model.info,
+            notes=(*model.info.notes, note),
+            extra={**model.info.extra, "gravity_fitted": gravity.as_dict()},
+        )
+        model = dataclasses.replace(model, info=info)
     _say_gravity_scale(robot, model, logs, opt.drive, held)
     if opt.consistent:
         result = _consistent_of(robot, model, held, first, opt, prior)
-        return IdentifyResult(model, result, (), held)
+        return IdentifyResult(model, result, (), held, None, gravity)
     model, delay = _with_torque_delay(model, logs, () if held is None else held.prepared)
-    return IdentifyResult(model, None, (), held, delay)
+    return IdentifyResult(model, None, (), held, delay, gravity)
 
 
 def _consistent_of(
