@@ -26,6 +26,7 @@ from dynid.identification.verdict import judge_prediction
 from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
+from dynid.workflows import identify as identify_module
 from dynid.workflows.data_files import data_files
 from dynid.workflows.identify import IdentifyOptions, identify_files
 from dynid.workflows.observe import ObserveOptions, observe_files
@@ -63,6 +64,7 @@ def test_the_consistent_route_warns_each_finding_of_the_data_once(panda, tmp_pat
         raise _Stop
 
     monkeypatch.setattr(convex_fit, "consistent_from_identified", stop)
+    monkeypatch.setattr(identify_module, "consistent_from_identified", stop)  # where called
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         with pytest.raises(_Stop):
