@@ -3,9 +3,8 @@ that has imported the command line already (:mod:`docs_pages` runs the pages).
 
 A page's commands spent most of a second each importing numpy, scipy, matplotlib and the
 library before they did anything. ``python docs_commands.py serve SOCKET`` imports every
-subcommand's modules and the parts of scipy the library imports where it uses them (not
-numba: a one-sample call without numba loaded takes the numpy path, as a fresh process
-does) and listens on the Unix socket ``SOCKET``; ``python
+subcommand's modules (not numba: a one-sample call without numba loaded takes the numpy
+path, as a fresh process does) and listens on the Unix socket ``SOCKET``; ``python
 docs_commands.py run SOCKET ARGS...`` (the ``dynid`` of a page's ``PATH``) hands it the
 arguments, its working folder, environment and standard streams, and exits as the forked
 command did. Each command is thus a process of its own, as written on the page: its own
@@ -71,8 +70,6 @@ def serve(path: str) -> None:
     import importlib
 
     import matplotlib.pyplot  # noqa: F401 (the figures of every command's report)
-    import scipy.optimize  # noqa: F401 (imported where used: the friction laws' fits)
-    import scipy.signal  # noqa: F401 (imported where used: every log's low-pass, 1 s each)
 
     import dynid
     from dynid.cli import __main__ as cli
