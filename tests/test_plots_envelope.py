@@ -1,7 +1,8 @@
 """A long time series drawn as its envelope keeps every extreme: per bin of consecutive
 samples the smallest and largest sample, against a brute-force minimum and maximum over
 each bin; the torque figure's lines reach the data's extremes and keep a one-sample spike
-an even stride dropped.
+an even stride dropped, and the observer's residual figure keeps a contact of three
+samples.
 
 Reference: ``min`` and ``max`` of each bin computed one bin at a time.
 """
@@ -81,3 +82,30 @@ def test_the_torque_figure_draws_the_datas_extremes_and_a_one_sample_spike():
     assert 20.0 < np.nanmax(spike.get_ydata()) == tau[12345, 1]
     assert np.nanmax(tau[::8, 1]) < 20.0  # the old stride's line missed it
     fig.clf()
+
+
+def test_the_observer_figure_draws_a_contact_of_three_samples():
+    """A 100000-sample residual with a contact of three samples (12 N m, an even stride of
+    10 stepped over it): the residual's drawn line reaches it and the data's extremes, the
+    true external torque's too, and each line holds at most 20000 points."""
+    pytest.importorskip("matplotlib")
+    from dynid.plots.observer import plot_residuals
+
+    rng = np.random.default_rng(4)
+    N, n = 100_000, 2
+    t = 1.7e9 + 0.001 * np.arange(N)  # a log of absolute stamps
+    r = rng.normal(0.0, 0.3, (N, n))
+    ext = np.zeros((N, n))
+    ext[54321:54324, 1] = 12.0
+    r += ext
+    assert r[::10, 1].max() < 5.0  # the stride of the old drawing missed it
+    fig = plot_residuals(t, r, np.full_like(r, 2.0), np.full_like(r, 4.0), tau_ext=ext)
+    for j in range(n):
+        residual, external = fig.axes[j].lines[:2]
+        d = np.asarray(residual.get_ydata(), dtype=float)
+        assert d.max() == r[:, j].max() and d.min() == r[:, j].min()
+        assert np.asarray(external.get_ydata()).max() == ext[:, j].max()
+        assert all(np.asarray(line.get_ydata()).size <= 20000 for line in fig.axes[j].lines)
+    line = fig.axes[1].lines[0]
+    at = np.asarray(line.get_xdata())[np.argmax(line.get_ydata())]
+    assert 54.321 - 1e-6 <= at <= 54.323 + 1e-6  # at its time from the log's start

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..observer.detection import ContactEvent
+from .envelope import envelope_indices
 from .layout import tight_layout
 from .style import COLOURS
 
@@ -51,7 +52,9 @@ def plot_residuals(
         The true external torques (a simulated contact), drawn thin.
     joint_names : sequence of str, optional
     max_points : int
-        Samples drawn per curve (evenly strided).
+        Samples drawn per curve at most: of a longer log, each bin's smallest and largest
+        sample (:func:`~dynid.plots.envelope.envelope_indices`), so that a contact of a
+        few samples stays on the figure.
     title : str, optional
     labelled : sequence of (float, float)
         Labelled contacts ``(start, end)`` [s] (:mod:`dynid.observer.scoring`), hatched
@@ -66,7 +69,12 @@ def plot_residuals(
     n = r.shape[1]
     names = list(joint_names) if joint_names is not None else [f"joint {j + 1}" for j in range(n)]
     fig, axes = plt.subplots(n, 1, sharex=True, figsize=(10, 1.6 * n + 0.8), squeeze=False)
-    s = slice(None, None, max(1, int(np.ceil(t.size / max_points))))
+    bins = max(1, max_points // 2)
+
+    def drawn(y: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        k = envelope_indices(y, bins)  # every spike and extreme kept
+        return t[k], y[k]
+
     t0 = float(t[0]) if t.size else 0.0
     t = t - t0  # from the log's start (a log of absolute stamps too)
     labelled = [(a - t0, b - t0) for a, b in labelled]
@@ -83,16 +91,17 @@ def plot_residuals(
                 color=COLOURS["collision" if e.level == "collision" else "contact"],
                 alpha=0.25, lw=0,
             )  # fmt: skip
-        ax.plot(t[s], r[s, j], color=COLOURS["residual"], lw=0.9, label="residual")
+        ax.plot(*drawn(r[:, j]), color=COLOURS["residual"], lw=0.9, label="residual")
         if tau_ext is not None:
             ax.plot(
-                t[s], tau_ext[s, j], color=COLOURS["external"], lw=0.8,
+                *drawn(tau_ext[:, j]), color=COLOURS["external"], lw=0.8,
                 label="true external torque",
             )  # fmt: skip
         for th, style, label in ((contact, "--", "contact"), (collision, ":", "collision")):
             line = dict(color=COLOURS["reference"], ls=style, lw=0.7)
-            ax.plot(t[s], th[s, j], **line, label=f"{label} threshold")
-            ax.plot(t[s], -th[s, j], **line)
+            tt, y = drawn(th[:, j])
+            ax.plot(tt, y, **line, label=f"{label} threshold")
+            ax.plot(tt, -y, **line)
         ax.set_ylabel(f"{names[j]}\n[N m]", fontsize=8)
         ax.tick_params(labelsize=7)
     axes[-1, 0].set_xlabel("time from the log's start [s]")
