@@ -132,6 +132,21 @@ def test_a_noisy_log_is_not_read_as_exact():
     assert not any("exact to round-off" in note for note in model.info.notes)
 
 
+@pytest.mark.parametrize(("start", "seconds"), [(2.0, 0.3), (2.0, 1.0), (4.5, 0.5)])
+def test_a_log_exact_but_for_a_stretch_of_noise_is_not_read_as_exact(start, seconds):
+    """Regression: an exact log with 0.05 N m of torque noise over 0.3 s or 1 s of its 5 s
+    (fewer than half its samples) read exact from the medians of its whole columns and was
+    fitted unfiltered, its noise floor printed as 3e-13 %; the blocks of 64 samples read
+    on their own find the stretch (at the log's end too), and the exact log stays exact."""
+    (log,), _ = _exact_logs(1.0, (5,), duration=5.0)
+    assert exact_to_round_off([log])
+    rng = np.random.default_rng(6)
+    on = (log.t >= log.t[0] + start) & (log.t < log.t[0] + start + seconds)
+    tau = log.tau + on[:, None] * rng.normal(0.0, 0.05, log.tau.shape)
+    assert not exact_to_round_off([dataclasses.replace(log, tau=tau)])
+    assert not at_round_off(tau, log.t).any()
+
+
 def test_noise_of_smooth_signals_reads_their_rounding_and_white_noise_its_std():
     """Harmonics at 200 Hz (0.5 to 2 Hz) read noise at 1e-15 of their RMS (the
     differences of order 2 and 3 read 1e-4 to 1e-6); white noise of std 0.01 on them

@@ -53,6 +53,10 @@ PROBE_SAMPLES = 2048
 #: round-off (:func:`at_round_off`): float64's rounding is 1.1e-16 of a value, a noise-free
 #: simulation reads 6e-16 to 8e-16, a CSV of 9 significant digits 3e-10 and any sensor more.
 ROUND_OFF_SHARE = 1e-12
+#: Samples per block :func:`at_round_off` reads on its own besides the whole column: a
+#: stretch of noise of half a block or more makes its block's median, and the column, not
+#: exact (a log exact but for 1 s of noise in 5 s at 200 Hz read exact from its medians).
+ROUND_OFF_BLOCK = 64
 
 
 def velocity_noise_std(dq: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.float64]:
@@ -150,10 +154,11 @@ def smooth_noise_std(x: ArrayLike) -> NDArray[np.float64]:
 def at_round_off(x: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.bool_]:
     """Which columns (n,) of ``x`` (N, n), sampled at the times ``t`` (N,) [s], hold no
     noise beyond round-off: :func:`smooth_noise_std` at most :data:`ROUND_OFF_SHARE` of
-    the column's RMS, over its first :data:`PROBE_SAMPLES` samples and then over all. None
-    at uneven times (jitter, gaps: the differences hold the motion) nor with fewer than 4
-    samples. The medians read the majority of the samples (a few steps of Coulomb friction
-    at reversals do not count): a column noisy over fewer than half of them reads exact.
+    the column's RMS, over its first :data:`PROBE_SAMPLES` samples and then over all, and
+    over each block of :data:`ROUND_OFF_BLOCK` consecutive samples. None at uneven times
+    (jitter, gaps: the differences hold the motion) nor with fewer than 4 samples. The
+    medians read the majority of each block's samples (a few steps of Coulomb friction at
+    reversals do not count): a stretch of noise shorter than half a block may read exact.
     Raises as :func:`velocity_noise_std`."""
     a = _checks.as_array("x", x)
     if a.ndim != 2:
@@ -175,6 +180,26 @@ def _round_off(a: NDArray[np.float64]) -> NDArray[np.bool_]:
     """:func:`at_round_off` of the evenly sampled columns of ``a`` (N, n), N >= 4."""
     rms = np.sqrt(np.mean(np.square(a), axis=0))
     out: NDArray[np.bool_] = smooth_noise_std(a) <= ROUND_OFF_SHARE * rms
+    if out.any() and a.shape[0] >= 2 * ROUND_OFF_BLOCK:
+        out[out] = _blocks_noise_std(a[:, out]) <= ROUND_OFF_SHARE * rms[out]
+    return out
+
+
+def _blocks_noise_std(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The largest over the blocks of :data:`ROUND_OFF_BLOCK` consecutive samples of ``a``
+    (N, n) (the last partial block left out) of :func:`smooth_noise_std` of each (n,)."""
+    from math import comb
+
+    nb = a.shape[0] // ROUND_OFF_BLOCK
+    d = a[: nb * ROUND_OFF_BLOCK].reshape(nb, ROUND_OFF_BLOCK, a.shape[1])
+    best = np.full((nb, a.shape[1]), np.inf)
+    for order in range(1, MAX_DIFFERENCE_ORDER + 1):
+        d = np.diff(d, axis=1)
+        if order < 2:
+            continue
+        mad = np.median(np.abs(d - np.median(d, axis=1, keepdims=True)), axis=1)
+        best = np.minimum(best, 1.4826 * mad / np.sqrt(comb(2 * order, order)))
+    out: NDArray[np.float64] = best.max(axis=0)
     return out
 
 
