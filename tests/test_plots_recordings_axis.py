@@ -83,6 +83,24 @@ def test_recordings_minutes_apart_are_drawn_each_from_its_own_start():
     assert names == {"rec1.csv", "rec2.csv", "rec3.csv", "rec4.csv"}
 
 
+def test_recordings_each_stamped_from_zero_are_named_one_after_another():
+    """Three recordings each stamped from 0 (which the pooling lays one after another, each
+    one sample step after the one before): the three names over the top panels, two
+    boundary lines, and each recording's samples drawn from its own start."""
+    rng = np.random.default_rng(6)
+    lengths = (3000, 2500, 3300)
+    parts = [_part(1e-3 * np.arange(m), rng) for m in lengths]
+    spans = [(f"r{k + 1}.csv", 0.0, 1e-3 * (m - 1)) for k, m in enumerate(lengths)]
+    fig = plot_torque_validation(joined_validation(parts), recordings=spans, max_points=8000)
+    ax = fig.axes[0]
+    assert {t.get_text() for t in ax.texts} == {"r1.csv", "r2.csv", "r3.csv"}
+    vertical = [ln for ln in ax.lines if np.ptp(np.asarray(ln.get_xdata(), float)) == 0]
+    assert len(vertical) == 2
+    x = np.asarray(ax.lines[0].get_xdata(), dtype=float)
+    blocks = np.split(x[np.isfinite(x)], np.flatnonzero(np.diff(x[np.isfinite(x)]) > 0.05) + 1)
+    assert [round(b[-1] - b[0], 3) for b in blocks] == [1e-3 * (m - 1) for m in lengths]
+
+
 def test_one_recording_keeps_the_log_axis():
     """Without several recordings the figure draws time from the log's start as before."""
     rng = np.random.default_rng(5)

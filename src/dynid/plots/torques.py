@@ -79,10 +79,13 @@ def _one_after_another(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]] | None:
     """The times [s] (N,) drawn with each recording from its own start, the recordings one
     after another with a space between; where each recording starts on that axis; and the
-    indices where a recording begins (the lines broken there). None where a sample lies
-    in no recording's span or a recording has no sample: recordings each stamped from 0,
-    which the pooling already laid one after another on its own axis."""
+    indices where a recording begins (the lines broken there). Recordings each stamped
+    from 0 are found where the pooling laid them (:func:`_pooled_spans`). None where a
+    sample lies in no recording's span or a recording has no sample."""
     which = recording_of(t, spans)
+    if np.any(which < 0) or np.unique(which).size != len(spans):
+        spans = _pooled_spans(t, spans)
+        which = recording_of(t, spans)
     if np.any(which < 0) or np.unique(which).size != len(spans):
         return None
     length = np.array([b - a for a, b in spans], dtype=np.float64)
@@ -93,6 +96,21 @@ def _one_after_another(
     drawn = np.where(which >= 0, t - first[k] + at[k], np.nan)
     begins = np.flatnonzero(np.diff(which) != 0) + 1
     return drawn, at, begins
+
+
+def _pooled_spans(
+    t: NDArray[np.float64], spans: Sequence[tuple[float, float]]
+) -> list[tuple[float, float]]:
+    """The recordings' ``spans`` [s] where the pooled prediction laid them on one axis
+    (:func:`~dynid.friction.pooled.joined_validation`: a recording that starts no later
+    than the one before ends moved to begin one sample step after it; the step the median
+    of ``t``'s)."""
+    step = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    out = [(float(spans[0][0]), float(spans[0][1]))] if spans else []
+    for a, b in spans[1:]:
+        end = out[-1][1]
+        out.append((a, b) if a > end else (end + step, end + step + (b - a)))
+    return out
 
 
 def _mark_recordings(
