@@ -212,6 +212,20 @@ def test_the_kept_model_predicts_another_log_at_the_noise_floor(guessed, other_l
     assert got.gains is None or got.gains.named == ()
 
 
+def test_validate_through_the_guessed_constants_warns_the_model_reads_others(guessed, other_log):
+    """The kept model (its drive the corrected constants) validated through the drive file
+    of the guessed constants: a warning names both sets of torque constants and to leave
+    out --drive (validating through the guess read the currents 1.4 and 0.7 times off)."""
+    from dynid.workflows.validate import ValidateOptions
+
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        validate_files(guessed.model, other_log, ValidateOptions(drive=_drive(GUESS)))
+    texts = [str(w.message) for w in said if issubclass(w.category, DynidWarning)]
+    told = [t for t in texts if "the drive given reads the currents through" in t]
+    assert told and "leave out --drive" in told[0], texts
+
+
 def test_validate_names_the_factors_beside_a_sign_finding(panda, current_log, other_log):
     """A model fitted to the currents as logged (its terms given: nothing judged first)
     validated on another log of the same arm: the verdict names joint 2's and joint 4's

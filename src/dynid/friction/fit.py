@@ -229,6 +229,15 @@ def same_drive(drive: Drive | None, own: Drive | None, whose: str, what: str) ->
     if mine != theirs:
         keys = sorted(k for k in {*mine, *theirs} if mine.get(k) != theirs.get(k))
         if set(keys) <= set(LOGGING_FIELDS):
+            if own.effort == "current" and own.torque_constant is not None:
+                warnings.warn(  # currents read through other constants than the fit's
+                    f"the drive given reads the currents through torque_constant = "
+                    f"{_short(mine.get('torque_constant'))}, {whose} through "
+                    f"{_short(theirs.get('torque_constant'))} (identified through them); "
+                    f"hint: leave out --drive to read them through {whose}'s",
+                    DynidWarning,
+                    stacklevel=2,
+                )
             return replace(own, effort=drive.effort, torque_constant=drive.torque_constant)
         given = ", ".join(
             f"{k} = {_short(mine.get(k))} ({whose}'s {_short(theirs.get(k))})" for k in keys
