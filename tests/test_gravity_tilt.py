@@ -199,3 +199,21 @@ def test_a_tilted_geared_arm_with_a_coupled_wrist_is_told_its_tilt(panda):
     level = found["level"]
     assert level.tilt is None or not level.tilt.named
     assert "tilted" not in level.verdict.reason, level.verdict.reason
+
+
+def test_the_simulated_tilt_is_said_with_its_axis_and_its_angles_about_x_and_y():
+    """simulate --unmodelled says its tilt with the axis and, to first order, the angles
+    about the base's x and y the verdict names (0.3 deg about (cos a, sin a, 0): 0.3 cos a
+    and 0.3 sin a), where it said "gravity tilted 0.30 deg" alone."""
+    import math
+
+    from dynid.simulation.unmodelled import UnmodelledEffects
+
+    a = math.radians(30.0)
+    e = UnmodelledEffects(
+        rotor_inertia=np.zeros(7), torque_offset=np.zeros(7), gravity_tilt=math.radians(0.3),
+        tilt_axis=(math.cos(a), math.sin(a), 0.0),
+    )  # fmt: skip
+    said = e.describe()
+    assert "gravity tilted 0.30 deg about the axis (0.87, 0.50, 0.00)" in said, said
+    assert "(0.26 deg about x and 0.15 deg about y to first order)" in said, said

@@ -420,6 +420,9 @@ def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
     text = (
         f"{log.n_samples_used} samples used (1 in {k} after the {how} and trimming "
         f"of {log.n_samples_log} recorded"
+        if cut is not None
+        else f"{log.n_samples_used} samples used (1 in {k}, unfiltered, after the trimming "
+        f"of {log.n_samples_log} recorded"
     )
     if log.resampled:
         jitter = jitter_text(log.stamp_jitter_s, 1.0 / log.sample_rate_hz)

@@ -100,7 +100,15 @@ class UnmodelledEffects:
             + " ".join(f"{x:.3f}" for x in self.rotor_inertia)
             + " kg m^2; torque offsets "
             + " ".join(f"{x:+.3f}" for x in self.torque_offset)
-            + f" N m; gravity tilted {math.degrees(self.gravity_tilt):.2f} deg"
+            + f" N m; gravity tilted {math.degrees(self.gravity_tilt):.2f} deg about the "
+            + "axis ("
+            + ", ".join(f"{x:.2f}" for x in np.asarray(self.tilt_axis))
+            + ") of the base ("
+            + " and ".join(
+                f"{math.degrees(self.gravity_tilt) * float(c):.2f} deg about {a}"
+                for c, a in zip(np.asarray(self.tilt_axis)[:2], "xy", strict=True)
+            )
+            + " to first order)"
         )
 
     @property
