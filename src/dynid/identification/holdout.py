@@ -213,12 +213,15 @@ class Normals:
 
     def restricted(self, columns: NDArray[np.intp]) -> Normals:
         """The normal equations of the columns ``columns`` only."""
-        ix = np.asarray(columns, dtype=np.intp)
-        G, b = self.G[np.ix_(ix, ix)], self.b[ix]
+        return self._restricted(_Restriction.of(columns, self.p))
+
+    def _restricted(self, on: _Restriction) -> Normals:
+        """:meth:`restricted` to the columns ``on`` names."""
+        G, b = self.G[on.grid], self.b[on.ix]
         x0 = self.origin
-        if x0 is None or np.any(np.delete(x0, ix)):  # the origin needs a column left out
+        if x0 is None or np.any(x0[on.left_out]):  # the origin needs a column left out
             return Normals(G, b, self.c, self.rows)
-        return Normals(G, b, self.c, self.rows, x0[ix], self.sse0)
+        return Normals(G, b, self.c, self.rows, x0[on.ix], self.sse0)
 
     def expanded(self, mask: NDArray[np.bool_]) -> Normals:
         """Written over ``mask.size`` columns, these at ``mask`` (zero for the others)."""
@@ -232,6 +235,25 @@ class Normals:
         x0 = np.zeros(mask.size)
         x0[ix] = self.origin
         return Normals(G, b, self.c, self.rows, x0, self.sse0)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Restriction:
+    """The columns ``ix`` (k,) kept of ``p``, their rows and columns of ``G``
+    (``np.ix_``) and the columns left out (p,) bool: made once for every set of normal
+    equations a :class:`HeldOut` restricts alike."""
+
+    ix: NDArray[np.intp]
+    grid: tuple[NDArray[np.intp], ...]
+    left_out: NDArray[np.bool_]
+
+    @classmethod
+    def of(cls, columns: NDArray[np.intp], p: int) -> _Restriction:
+        """The restriction to ``columns`` of ``p`` columns."""
+        ix = np.asarray(columns, dtype=np.intp)
+        left_out = np.ones(p, dtype=bool)
+        left_out[ix] = False
+        return cls(ix, np.ix_(ix, ix), left_out)
 
 
 def _noise(whole: Normals) -> float:
@@ -378,14 +400,15 @@ class HeldOut:
 
     def restricted(self, columns: NDArray[np.intp]) -> HeldOut:
         """The same folds over the columns ``columns`` only."""
+        on = _Restriction.of(columns, self.whole.p)
         return HeldOut(
-            tuple(t.restricted(columns) for t in self.train),
-            tuple(t.restricted(columns) for t in self.test),
-            self.whole.restricted(columns),
+            tuple(t._restricted(on) for t in self.train),
+            tuple(t._restricted(on) for t in self.test),
+            self.whole._restricted(on),
             self.scheme,
             self.noise,
-            tuple(t.restricted(columns) for t in self.whitened),
-            None if self.judged is None else self.judged.restricted(columns),
+            tuple(t._restricted(on) for t in self.whitened),
+            None if self.judged is None else self.judged._restricted(on),
         )
 
     def expanded(self, mask: NDArray[np.bool_]) -> HeldOut:
