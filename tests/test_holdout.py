@@ -15,6 +15,7 @@ from dynid.identification.holdout import (
     block_labels,
     block_normals,
     cross_validate,
+    shared_eigen,
 )
 
 
@@ -75,3 +76,22 @@ def test_a_separate_log_and_restricted_and_expanded_columns():
     sub = block_normals(W[:, [1, 3]], y, zero)[0]
     back = sub.expanded(mask).restricted(np.flatnonzero(mask))
     np.testing.assert_allclose(back.solve(), np.linalg.lstsq(W[:, [1, 3]], y, rcond=None)[0])
+
+
+def test_shared_eigen_solves_rows_of_the_same_gram_with_their_own_targets():
+    """Within shared_eigen, two sets of rows with one W^T W and other targets each solve
+    to their own least squares (numpy lstsq on the rows), the second from the first's
+    eigendecomposition; the standard deviations too (sigma^2 (W^T W)^-1)."""
+    rng = np.random.default_rng(11)
+    W = rng.normal(size=(300, 5))
+    ys = [W @ rng.normal(size=5) + 0.1 * rng.normal(size=300) for _ in range(2)]
+    with shared_eigen():
+        for y in ys:
+            n = block_normals(W, y, np.zeros(300, np.intp))[0]
+            x, sd = n.solve_with_std()
+            ref = np.linalg.lstsq(W, y, rcond=None)[0]
+            r = y - W @ ref
+            var = (r @ r) / (300 - 5) * np.diag(np.linalg.inv(W.T @ W))
+            np.testing.assert_allclose(x, ref, rtol=1e-10, atol=1e-12)
+            assert sd is not None
+            np.testing.assert_allclose(sd, np.sqrt(var), rtol=1e-8)

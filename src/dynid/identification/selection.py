@@ -83,7 +83,7 @@ from .dissipation import (
     warn_unphysical,
 )
 from .estimators import Estimator, EstimatorName, estimator_named
-from .holdout import DEFAULT_FOLDS, HeldOut
+from .holdout import DEFAULT_FOLDS, HeldOut, shared_eigen
 from .input_noise import exact_note, exact_to_round_off
 from .judge import heldout_judge
 from .largest import Fitted, LeftOut, fit_largest, recording_bands
@@ -231,6 +231,7 @@ def _lacks(c: Candidate, best: Candidate) -> dict[str, float]:
 
 @shared_steps()
 @shared_bases()
+@shared_eigen()
 def select_structure(
     robot: Robot,
     data: Recordings,
@@ -889,6 +890,7 @@ def _repaired(
 
 
 @shared_steps()
+@shared_eigen()
 def identify_recordings(
     robot: Robot,
     logs: Sequence[TorqueLog],

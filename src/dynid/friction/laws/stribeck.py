@@ -38,11 +38,23 @@ Sign = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]
 def _columns(
     dq: NDArray[np.float64], band: NDArray[np.float64], vst: NDArray[np.float64], sign: Sign
 ) -> NDArray[np.float64]:
-    s = sign(dq, band)
+    """The columns (..., n, 4) the law is linear in, ``fv, fc, fs, fo``, at ``vst``."""
+    return _at_vst(dq, sign(dq, band), np.ones_like(dq), vst)
+
+
+def _at_vst(
+    dq: NDArray[np.float64],
+    s: NDArray[np.float64],
+    ones: NDArray[np.float64],
+    vst: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """:func:`_columns` of the velocities ``dq`` given their Coulomb sign ``s`` and a
+    column of ones, both alike ``dq`` (what does not depend on ``vst``: a fit's grid of
+    Stribeck velocities computes them once)."""
     # vst = 0 is a joint left unidentified (it never moved; every coefficient 0): the
     # limit of exp(-(dq / vst)^2) as vst -> 0 (stribeck_decay gives 0 there)
     e = stribeck_decay(dq, vst)
-    return np.stack([dq, s * (1.0 - e), s * e, np.ones_like(dq)], axis=-1)
+    return np.stack([dq, s * (1.0 - e), s * e, ones], axis=-1)
 
 
 def _torques(
@@ -58,26 +70,32 @@ def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float, sign: Sig
     hi = np.asarray(_UPPER)[_LIN]
     step = max(1, dq.size // 5_000)  # the search on a subsample, the final solve on all
     dqs, rs = dq[::step], r[::step]
+    # what the columns hold whatever vst (the sign, the ones), computed once per data set
+    sub = (dqs, sign(dqs, np.asarray(band)), np.ones_like(dqs), rs)
+    full = (dq, sign(dq, np.asarray(band)), np.ones_like(dq), r)
 
     def solve(
-        ln_vst: float, v: NDArray[np.float64], rr: NDArray[np.float64]
+        ln_vst: float, data: tuple[NDArray[np.float64], ...]
     ) -> tuple[NDArray[np.float64], float]:
-        A = _columns(v, np.asarray(band), np.asarray(np.exp(ln_vst)), sign)
+        """The linear coefficients at ``vst = exp(ln_vst)`` on ``data`` (velocities, their
+        sign, ones, residual) and their squared error."""
+        v, s, ones, rr = data
+        A = _at_vst(v, s, ones, np.asarray(np.exp(ln_vst)))
         x = bounded_lstsq(A, rr, lo, hi)
         return x, float(np.sum((A @ x - rr) ** 2))
 
     top = min(_UPPER[3], max(float(np.max(np.abs(dq))), 2 * _LOWER[3]))
     grid = np.linspace(np.log(max(_LOWER[3], band)), np.log(top), 24)
-    costs = [solve(g, dqs, rs)[1] for g in grid]
+    costs = [solve(g, sub)[1] for g in grid]
     k = int(np.argmin(costs))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     import scipy.optimize  # here: a robot holding the law loads no solver
 
     res = scipy.optimize.minimize_scalar(
-        lambda g: solve(g, dqs, rs)[1], bounds=(a, b), method="bounded", options={"xatol": 1e-4}
+        lambda g: solve(g, sub)[1], bounds=(a, b), method="bounded", options={"xatol": 1e-4}
     )
     g = float(res.x) if res.fun <= costs[k] else float(grid[k])
-    x, _ = solve(g, dq, r)
+    x, _ = solve(g, full)
     p = np.array([x[0], x[1], x[2], np.exp(g), x[3]])
     return JointFit(p, bool(res.success), int(res.nfev) + grid.size)
 
