@@ -513,6 +513,8 @@ def _held_out(
     # few samples, the model's columns projected out, left none (a Panda tilted 0.3 deg,
     # one 6 s log, 2.3 x the floor: no tilt judged)
     tilt = residual_tilt(model, every, total, springs)
+    if tilt is not None and every is not v:  # what it leaves is the whole log's, not v's
+        tilt = dataclasses.replace(tilt, rest=tilt.rest[:0], rows=tilt.rows[:0])
     return dataclasses.replace(held, tilt=tilt, springs=springs, gains=gains)
 
 

@@ -463,7 +463,8 @@ def dependence_hint(
     (:func:`~dynid.identification.gravity_tilt.gravity_tilt` of the pieces concatenated);
     when it explains the residual (:attr:`~dynid.identification.gravity_tilt.GravityTilt.
     named`) it is said first and the joints are diagnosed on what it leaves (a residual
-    the tilt explains is no spring's). ``ratios``: the verdict's per joint
+    the tilt explains is no spring's); a tilt without ``rows`` (judged on a held-out
+    block's whole log) is said alone. ``ratios``: the verdict's per joint
     (:func:`residual_dependence`). ``springs``: the stiffness per joint fitted with the
     model (:func:`~dynid.identification.residual_spring.residual_spring`), which names a
     spring's joint with its stiffness and says where a position dependence is no
@@ -473,6 +474,8 @@ def dependence_hint(
     ``ddq``: the accelerations [rad/s^2] at the samples (pieces as ``q``), with which a
     residual that follows them is said to be an inertia the model lacks (a rotor's),
     ``inertia`` the remedy said where the caller knows it (a URDF holds no armature)."""
+    if tilt is not None and tilt.named and tilt.rows.size == 0:
+        return tilt.sentence()  # judged on other samples (a block's whole log): said alone
     if tilt is not None and tilt.named:
         rows = tilt.rows
 
