@@ -59,6 +59,17 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     items.sort(key=lambda item: item.path not in slow)  # (a stable sort)
 
 
+@pytest.fixture(autouse=True)
+def _figures_closed():
+    """Every figure a test drew closed after it (pyplot keeps them open: a worker that ran
+    many figure tests in a row crossed matplotlib's 20 open figures, a warning and so an
+    error)."""
+    yield
+    plt = sys.modules.get("matplotlib.pyplot")
+    if plt is not None:
+        plt.close("all")
+
+
 @pytest.fixture(scope="session")
 def panda() -> dynid.Robot:
     return dynid.panda()
