@@ -1338,11 +1338,7 @@ def test_ctrl_c_stops_a_write_without_a_partial_file(tmp_path):
         "acquire-static", "--n", "400000", "--out", str(out),
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )  # fmt: skip
-    # the signal once the write has begun (its temporary file exists), whatever the
-    # machine's load: a fixed wait sent it during the imports on a busy machine
-    deadline = time.monotonic() + 300.0
-    while not any(tmp_path.iterdir()) and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.01)
+    time.sleep(4.0)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 130, err
