@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import warnings
 
 import numpy as np
@@ -206,8 +207,9 @@ def test_a_level_arm_is_fitted_once_and_unchanged(level_logs, monkeypatch):
     assert a.info.notes == b.info.notes
 
 
-def test_identify_takes_the_gravity_the_note_gives(tilted_x, tmp_path):
+def test_identify_takes_the_gravity_the_note_gives(tilted_x, tmp_path, capsys):
     """dynid identify --gravity=GX,GY,GZ of the tilted arm, the vector its note printed:
+    a note says the gravity given and its tilt from the description's (0.3 deg about x),
     identified once with it (no note, no refit), identification.json's robot holds it and
     the held-out verdict is at the floor; two numbers are refused naming --gravity."""
     from dynid.cli.__main__ import main
@@ -223,7 +225,10 @@ def test_identify_takes_the_gravity_the_note_gives(tilted_x, tmp_path):
     args = ["identify", "--robot", "panda", "--data", *paths, "--terms", TERMS]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        assert main([*args, f"--gravity={given}", "--out", str(out), "--no-figures", "-q"]) == 0
+        assert main([*args, f"--gravity={given}", "--out", str(out), "--no-figures"]) == 0
+    said = [s for s in capsys.readouterr().err.splitlines() if "gravity given (--gravity)" in s]
+    m = re.search(r"tilted ([-0-9.]+) deg about x and ([-0-9.]+) deg about y", said[0])
+    assert m is not None and abs(float(m[1]) - 0.3) < 0.03 and abs(float(m[2])) < 0.03, said
     model = load_model_json(out / "identification.json")
     np.testing.assert_allclose(model.robot.gravity, res.gravity.gravity, rtol=1e-5)
     assert "gravity_fitted" not in model.info.extra

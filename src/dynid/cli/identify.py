@@ -125,6 +125,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+
 from ..exceptions import OptionError
 from ..identification.estimators import ESTIMATORS
 from ..identification.least_squares import STD_METHODS
@@ -133,6 +135,7 @@ from ..identification.verdict import Verdict
 from ..io.feasible_bundle import save_feasible_bundle
 from ..io.json_files import save_json
 from ..io.model_json import save_model_json
+from ..workflows.gravity_refit import tilt_rotation
 from ..workflows.identify import IdentifyOptions, identify_files
 from .applies import urdf_chain
 from .common import (
@@ -293,7 +296,15 @@ def run(args: argparse.Namespace, console: Console) -> int:
     print the summary; 0, or 1 when no consistent set satisfies the constraints."""
     robot = load_robot(args)
     if args.gravity is not None:
-        robot = robot.with_gravity(gravity_vector(args.gravity))
+        given = robot.with_gravity(gravity_vector(args.gravity))
+        ax, ay, _ = np.degrees(tilt_rotation(robot.gravity, given.gravity))
+        console.note(
+            "gravity given (--gravity): ["
+            + ", ".join(f"{x:.6g}" for x in given.gravity)
+            + f"] m/s^2 in the base frame, the description's tilted {ax:.2f} deg about x "
+            f"and {ay:.2f} deg about y"
+        )
+        robot = given
     options = options_from(
         args,
         IdentifyOptions,

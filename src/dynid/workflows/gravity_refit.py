@@ -36,7 +36,7 @@ from ..friction.heldout_torques import HeldOutTorques
 from ..identification.model import IdentifiedModel
 from ..model.robot import Robot
 
-__all__ = ["MAX_REFITS", "FittedGravity", "Refitted", "refit_gravity"]
+__all__ = ["MAX_REFITS", "FittedGravity", "Refitted", "refit_gravity", "tilt_rotation"]
 
 #: Most identifications again with the gravity vector read (the tilt columns are first
 #: order: a 0.3 deg tilt is read to about 1e-3 of itself by the first).
@@ -77,13 +77,7 @@ class FittedGravity:
     def rotation(self) -> NDArray[np.float64]:
         """The rotation vector [rad] (base frame) turning ``described`` into ``gravity``:
         its x and y components are the tilt about the base's x and y axes."""
-        a, b = self.described, self.gravity
-        axis = np.cross(a, b)
-        s = float(np.linalg.norm(axis))
-        if s == 0.0:
-            return np.zeros(3)
-        angle = float(np.arctan2(s, float(np.dot(a, b))))
-        return axis / s * angle
+        return tilt_rotation(self.described, self.gravity)
 
     @property
     def angle(self) -> NDArray[np.float64]:
@@ -142,6 +136,22 @@ class Refitted(Generic[_T]):
     searched: tuple[IdentifiedModel, HeldOutTorques | None, _T]
     gravity: FittedGravity | None
     said: list[warnings.WarningMessage]
+
+
+def tilt_rotation(
+    described: NDArray[np.float64], gravity: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The rotation vector [rad] (3,), base frame, of the smallest rotation turning the
+    gravity vector ``described`` (3,) into ``gravity`` (3,) [m/s^2]: its x and y components
+    are the tilt about the base's x and y axes; zeros for parallel vectors."""
+    a, b = np.asarray(described, dtype=np.float64), np.asarray(gravity, dtype=np.float64)
+    axis = np.cross(a, b)
+    s = float(np.linalg.norm(axis))
+    if s == 0.0:
+        return np.zeros(3)
+    angle = float(np.arctan2(s, float(np.dot(a, b))))
+    out: NDArray[np.float64] = axis / s * angle
+    return out
 
 
 def _error(held: HeldOutTorques | None) -> float:
