@@ -134,20 +134,25 @@ def smooth_noise_std(x: ArrayLike) -> NDArray[np.float64]:
     tells round-off (:func:`at_round_off`), it does not replace that estimate. Raises
     as :func:`velocity_noise_std` (N >= 3; fewer orders than ``N - 1`` are read).
     """
-    from math import comb
-
     a = _checks.as_array("x", x)
     if a.ndim != 2 or a.shape[0] < 3:
         raise ShapeError(f"x must have shape (N, n), N >= 3; got {a.shape}")
-    out = np.full(a.shape[1], np.inf)
-    for j in range(a.shape[1]):
-        d = np.ascontiguousarray(a[:, j])
-        for order in range(1, min(MAX_DIFFERENCE_ORDER, a.shape[0] - 1) + 1):
-            d = np.diff(d)
-            if order < 2:
-                continue
-            mad = float(np.median(np.abs(d - np.median(d))))
-            out[j] = min(out[j], 1.4826 * mad / np.sqrt(comb(2 * order, order)))
+    return _differences_noise(a)
+
+
+def _differences_noise(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """:func:`smooth_noise_std` of each stack of ``a`` (..., N, n) along its samples
+    (axis -2): (..., n)."""
+    from math import comb
+
+    d = a
+    out = np.full(a.shape[:-2] + a.shape[-1:], np.inf)
+    for order in range(1, min(MAX_DIFFERENCE_ORDER, a.shape[-2] - 1) + 1):
+        d = np.diff(d, axis=-2)
+        if order < 2:
+            continue
+        mad = np.median(np.abs(d - np.median(d, axis=-2, keepdims=True)), axis=-2)
+        out = np.minimum(out, 1.4826 * mad / np.sqrt(comb(2 * order, order)))
     return out
 
 
@@ -188,18 +193,9 @@ def _round_off(a: NDArray[np.float64]) -> NDArray[np.bool_]:
 def _blocks_noise_std(a: NDArray[np.float64]) -> NDArray[np.float64]:
     """The largest over the blocks of :data:`ROUND_OFF_BLOCK` consecutive samples of ``a``
     (N, n) (the last partial block left out) of :func:`smooth_noise_std` of each (n,)."""
-    from math import comb
-
     nb = a.shape[0] // ROUND_OFF_BLOCK
-    d = a[: nb * ROUND_OFF_BLOCK].reshape(nb, ROUND_OFF_BLOCK, a.shape[1])
-    best = np.full((nb, a.shape[1]), np.inf)
-    for order in range(1, MAX_DIFFERENCE_ORDER + 1):
-        d = np.diff(d, axis=1)
-        if order < 2:
-            continue
-        mad = np.median(np.abs(d - np.median(d, axis=1, keepdims=True)), axis=1)
-        best = np.minimum(best, 1.4826 * mad / np.sqrt(comb(2 * order, order)))
-    out: NDArray[np.float64] = best.max(axis=0)
+    blocks = a[: nb * ROUND_OFF_BLOCK].reshape(nb, ROUND_OFF_BLOCK, a.shape[1])
+    out: NDArray[np.float64] = _differences_noise(blocks).max(axis=0)
     return out
 
 
