@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
+from ..identification.input_noise import exact_to_round_off
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
@@ -185,10 +186,13 @@ def recorded_cutoff(
     as ``recording`` says, read together on its time axis; the median over the
     recordings, each weighted by its samples), so that every
     model is judged on the samples prepared the same way; the library default without a
-    log long enough to read it from."""
-    if isinstance(model, IdentifiedModel) and model.info.log is not None:
-        return model.info.log.cutoff_hz
+    log long enough to read it from. A model fitted unfiltered for its logs being exact
+    to round-off (``cutoff_source`` ``"exact"``) holds no cut-off for other logs: none
+    for exact ones, else the one read from their motion."""
     logs = [] if log is None else [log] if isinstance(log, TorqueLog) else list(log)
+    if isinstance(model, IdentifiedModel) and model.info.log is not None:
+        if model.info.log.cutoff_source != "exact" or exact_to_round_off(logs):
+            return model.info.log.cutoff_hz
     cut = common_cutoff(logs, recording)
     return DEFAULT_CUTOFF_HZ if cut is None else cut
 

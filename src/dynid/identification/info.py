@@ -65,8 +65,11 @@ class LogInfo:
         Length of the raw log [s].
     n_nan_rows, n_duplicates, n_gaps : int
         What cleaning the raw log found (:class:`~dynid.identification.log.LogCleaning`).
-    cutoff_source : {"given", "motion"}
-        The cut-off was given, or read from the motion (:mod:`dynid.identification.rate`).
+    cutoff_source : {"given", "motion", "exact"}
+        The cut-off was given, or read from the motion (:mod:`dynid.identification.rate`);
+        ``"exact"``: none, the logs being exact to round-off
+        (:func:`~dynid.identification.input_noise.exact_to_round_off`), and ``validate``
+        and ``friction`` read a recording's own from its motion unless it is exact too.
     motion_frequency_hz : float or None
         The motion's highest significant frequency [Hz] when the cut-off was read from it.
     resampled : bool

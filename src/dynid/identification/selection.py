@@ -1008,6 +1008,8 @@ def identify_recordings(
     combined = _combined(robot, data, structure, drive, model.base)
     notes = (*exact, *model.info.notes, *warned_negative_inertias(model))
     info = replace(model.info, combined=combined, heldout=heldout, notes=notes)
+    if exact and info.log is not None:  # unfiltered for being exact: validate reads its own
+        info = replace(info, log=replace(info.log, cutoff_source="exact"))
     extra = {**model.info.extra, "terms": list(structure.terms)}
     info = replace(info, selection=None if selection is None else selection.as_dict(), extra=extra)
     return replace(model, info=info)
