@@ -21,6 +21,8 @@ from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.io.model_json import load_model_json, save_model_json
 from dynid.io.torque_log import save_torque_log
+from dynid.report.identify import answer as report_answer
+from dynid.report.run import RunFiles, RunSummary
 from dynid.simulation.measurement import SensorNoise
 from dynid.workflows import identify as identify_workflow
 from dynid.workflows.gravity_refit import Refitted
@@ -158,6 +160,12 @@ def test_the_identification_file_carries_the_gravity_to_validate(tilted_x, tmp_p
     model = load_model_json(path)
     np.testing.assert_array_equal(model.robot.gravity, res.gravity.gravity)
     assert model.info.extra["gravity_fitted"]["gravity"] == res.gravity.gravity.tolist()
+    doc = json.loads(path.read_text())  # the report's first box says the tilt
+    page = report_answer(RunFiles(RunSummary("identify"), {}, {"identification.json": doc}))
+    assert page is not None
+    ax, ay = np.degrees(res.gravity.angle)
+    said = re.findall(r"base reads tilted ([-0-9.]+) deg about x and ([-0-9.]+) deg", page.verdict)
+    assert said == [(f"{ax:.2f}", f"{ay:.2f}")], said
     (log,) = _logs(truth, (64,))
     save_torque_log(tmp_path / "held.csv", log)
     with warnings.catch_warnings():

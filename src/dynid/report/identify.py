@@ -664,6 +664,27 @@ def used_structure(doc: Any) -> str | None:
         return None
 
 
+def _gravity_facts(doc: dict) -> list[str]:
+    """The fact (HTML) of a gravity vector fitted for a tilted base (``gravity_fitted``):
+    the angles [deg], both held-out errors [%] and the vector the model holds; none
+    without one."""
+    rec = _get(doc, "metadata", "gravity_fitted")
+    if not isinstance(rec, dict):
+        return []
+    try:
+        ax, ay = (float(a) for a in rec["angle_deg"])
+        level, fitted = float(rec["level_percent"]), float(rec["fitted_percent"])
+        g = ", ".join(f"{float(x):.6g}" for x in rec["gravity"])
+    except (KeyError, TypeError, ValueError):
+        return []
+    return [
+        f"<b>Gravity fitted: the base reads tilted {ax:.2f} deg about x and {ay:.2f} deg "
+        f"about y</b> (held-out error {level:.3g} % with the description's level gravity, "
+        f"{fitted:.3g} % with the fitted one); the model holds gravity = [{esc(g)}] m/s^2 "
+        "in the base frame, and validate, observe and the exports use it"
+    ]
+
+
 def _terms_fact(doc: dict) -> str:
     sel = _selection(doc)
     used = used_structure(doc)
@@ -721,6 +742,7 @@ def answer(run: RunFiles) -> Answer | None:
             problems = more + problems
         facts += spring_facts(held)  # where the verdict names a spring: its stiffness
         facts[:0] = delay_facts(doc)  # a named lag first: the hints after it may be the lag
+        facts[:0] = _gravity_facts(doc)  # the gravity every number above was fitted with
     rank, p = _rank_fact(doc)
     facts.append(rank)
     problems += p
