@@ -686,7 +686,8 @@ def _searched(
         model = fitted(structure, drive)
         held = _predicted_heldout(model, logs, separate)
     why = reason_to_judge_first(model, held)
-    first = None if why is None else gains_first(fitted, drive, logs, separate, why)
+    chosen = Structure.parse(",".join(model.info.extra.get("terms", ())) or "links")
+    first = None if why is None else gains_first(fitted, drive, logs, separate, why, chosen)
     if first is None:
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
