@@ -244,6 +244,7 @@ def test_validate_names_the_factors_beside_a_sign_finding(panda, current_log, ot
     said = got.verdict.reason
     assert "torque_constant of joint 2 looks 1.4" in said, said
     assert "torque_constant of joint 4 looks" in said, said
+    assert "the positions by" not in said and got.torque_delay is None, said  # no lag in the log
     assert got.metadata()["drive_gains"]["named"] == [1, 3]  # indices from 0
 
 
