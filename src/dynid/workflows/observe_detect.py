@@ -29,7 +29,7 @@ from .. import _checks
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
-from ..observer.events import ContactEvent, EventDetector
+from ..observer.events import ContactEvent, EventDetector, time_slack
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
@@ -191,7 +191,15 @@ def detected_log(
     the contact threshold."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
-    det = EventDetector(thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=starts)
+    steps = np.diff(log.t)
+    period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
+    det = EventDetector(
+        thresholds,
+        merge_s=merge_s,
+        min_duration_s=min_duration_s,
+        restarts=starts,
+        sample_period_s=period,
+    )
     keep = Series.new(prep, n, *wants) if keep_series else None
     ext = in_file(prep.path, lambda: true_torques(prep, model, mapped))
     stats = _Running(n)
@@ -325,6 +333,7 @@ def scored(
         source=source,
         look_ahead=look_ahead,
         lead_s=lead_for(t),
+        slack_s=time_slack(t),
     )
 
 
