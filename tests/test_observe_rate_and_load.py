@@ -1,9 +1,10 @@
 """What a detection says of logs unlike its calibration's, against simulated truth.
 
-* thresholds.json records the calibration logs' sample rate (the simulation's --rate);
-  a detection on a log sampled at another rate warns in one line (thresholds calibrated
-  at 1 kHz used on a 100 Hz log were silently too low), an older file without the rate
-  reads as before and says nothing;
+* thresholds.json records the calibration logs' sample rate (the simulation's --rate)
+  and their velocities' kind; a detection on a log sampled at another rate, or whose
+  velocities are derived from its positions where the calibration's were measured, warns
+  in one line (thresholds calibrated at 1 kHz used on a 100 Hz log were silently too
+  low), an older file without them reads as before and says nothing;
 * a load at the flange that the model lacks (simulated on the arm carrying it) is said
   with its mass, and nothing is said of the arm without it;
 * the report's events table leaves out the column of the log's clock when every log
@@ -72,11 +73,21 @@ def test_thresholds_record_their_rate_and_a_log_at_another_rate_is_warned(logs):
     assert "calibrate at this rate" in rate[0]
     _, said = _detect(d, "hit.csv")  # the calibration's rate: nothing said
     assert not [s for s in said if "calibrated at" in s]
+    assert doc["calibration"]["velocities"] == "measured"
+    lines = [x for x in (d / "hit.csv").read_text().splitlines() if not x.startswith("#")]
+    keep = [i for i, h in enumerate(lines[0].split(",")) if not h.startswith("dq")]
+    rows = (",".join(x.split(",")[i] for i in keep) for x in lines)
+    (d / "derived.csv").write_text("\n".join(rows) + "\n")  # no velocity column
+    _, said = _detect(d, "derived.csv")
+    kind = [s for s in said if "calibrated on measured" in s]
+    assert len(kind) == 1 and kind[0].startswith("derived.csv: velocities derived")
     del doc["calibration"]["sample_rate_hz"]  # a file of an earlier version
+    del doc["calibration"]["velocities"]
     (d / "old.json").write_text(json.dumps(doc))
-    result, said = _detect(d, "free250.csv", d / "old.json")
-    assert result.thresholds.sample_rate_hz is None
-    assert not [s for s in said if "calibrated at" in s]
+    for name in ("free250.csv", "derived.csv"):
+        result, said = _detect(d, name, d / "old.json")
+        assert result.thresholds.sample_rate_hz is None and result.thresholds.velocities is None
+        assert not [s for s in said if "calibrated" in s], name
 
 
 def test_a_load_the_model_lacks_is_said_with_its_mass_and_none_without_it(logs):

@@ -38,7 +38,9 @@ Two steps:
   thresholds.json records the model's files and a SHA-256 of their content: detecting with
   another model warns; and the calibration logs' sample rate: detecting on a log sampled
   more than 20 % away from it warns (the velocities' noise in the residual, and the
-  thresholds, change with the rate; calibrate at the log's rate). Whether the observer is
+  thresholds, change with the rate; calibrate at the log's rate), and so does a log whose
+  velocities are derived from its positions where the calibration's were measured, or the
+  reverse. Whether the observer is
   good enough is printed below the table, kept in thresholds.json's calibration and put
   first in the report: the false alarms the thresholds raise on the calibration logs (the
   events --thresholds would find there, and per minute) and the smallest external torque

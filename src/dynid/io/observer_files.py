@@ -14,6 +14,7 @@
                      "duration_s": T,     # s, the calibration logs' total duration
                      "sample_rate_hz": f, # Hz, the logs' sample rate (absent: not
                                           # recorded; observe warns at another rate)
+                     "velocities": "measured" | "derived" | "mixed",  # the logs'
                      "false_alarms": k,   # events on them (null: not counted)
                      "detectable": [...], # N m per joint, the smallest torque detected
                                           # while the joint moves (the largest contact
@@ -148,6 +149,7 @@ THRESHOLDS = Format(
                     {
                         "samples": Field("integer", low=0),
                         "sample_rate_hz": Field("number", low=0.0, unit="Hz"),
+                        "velocities": Field("string", choices=("measured", "derived", "mixed")),
                         "model_check": Field("object"),
                     },
                     open=True,
@@ -301,6 +303,7 @@ def save_thresholds(
         "calibration": {
             "samples": th.samples,
             **({} if th.sample_rate_hz is None else {"sample_rate_hz": th.sample_rate_hz}),
+            **({} if th.velocities is None else {"velocities": th.velocities}),
             **_fingerprint(th.model),
             **(calibration or {}),
         },
@@ -356,6 +359,7 @@ def load_thresholds(path: str | Path) -> Thresholds:
             standstill=bool(rule.get("standstill_margin", False)),
             model=model,
             sample_rate_hz=None if rate is None else float(rate),
+            velocities=cal.get("velocities"),
         )
     except DynidError as exc:
         raise DataError(str(exc), file=path.name) from None

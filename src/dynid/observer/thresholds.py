@@ -11,6 +11,9 @@ through ``M(q) dq``, and the observer's discretisation change with it. On a simu
 UR5 the wrist's contact threshold was 0.071 N m calibrated at 1 kHz and 0.123 N m at
 100 Hz. :attr:`Thresholds.sample_rate_hz` records the calibration's rate;
 :func:`rate_mismatch` says a log sampled more than :data:`RATE_TOLERANCE` away from it.
+For the same reason :attr:`Thresholds.velocities` records whether the calibration logs'
+velocities were measured or derived from the positions (a low-pass and differences: far
+less noise), and :func:`velocity_mismatch` says a log whose velocities are the other kind.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ __all__ = [
     "log_rate",
     "rate_mismatch",
     "threshold_series",
+    "velocity_mismatch",
 ]
 
 #: Relative difference between a log's sample rate and the calibration's above which
@@ -96,6 +100,9 @@ class Thresholds:
     sample_rate_hz : float or None
         The calibration logs' sample rate [Hz] (:func:`log_rate`; the median over the
         logs); None: not recorded (a file of an earlier version).
+    velocities : {"measured", "derived", "mixed"} or None
+        The calibration logs' velocities: columns of the logs, derived from the positions,
+        or some of each; None: not recorded (a file of an earlier version).
     """
 
     contact: NDArray[np.float64]
@@ -110,8 +117,14 @@ class Thresholds:
     standstill: bool = False
     model: ModelFingerprint | None = None
     sample_rate_hz: float | None = None
+    velocities: str | None = None
 
     def __post_init__(self) -> None:
+        if self.velocities not in (None, "measured", "derived", "mixed"):
+            raise DataError(
+                "thresholds: velocities must be measured, derived or mixed; got "
+                f"{self.velocities!r}"
+            )
         if self.sample_rate_hz is not None and not (
             np.isfinite(self.sample_rate_hz) and self.sample_rate_hz > 0
         ):
@@ -154,6 +167,22 @@ def rate_mismatch(rate_hz: float | None, thresholds: Thresholds, name: str) -> s
         "noise (the velocities' through M(q) dq times the gain) changes with the rate, so "
         f"the thresholds may be too low (false alarms) or too high (contacts missed); hint: "
         f"calibrate at this rate, on collision-free logs sampled at {rate_hz:.4g} Hz"
+    )
+
+
+def velocity_mismatch(derived: bool, thresholds: Thresholds, name: str) -> str | None:
+    """One line when a log's velocities (``derived`` from its positions, else measured)
+    are of the other kind than the calibration logs' (module docstring), ``name`` the
+    thresholds file; None otherwise, or when the calibration's are not recorded or mixed."""
+    cal = thresholds.velocities
+    kind = "derived" if derived else "measured"
+    if cal not in ("measured", "derived") or cal == kind:
+        return None
+    return (
+        f"velocities {kind}, {name} calibrated on {cal} ones: the residual's noise (the "
+        "velocities' through M(q) dq times the gain) is not the same, so the thresholds may "
+        "be too low (false alarms) or too high (contacts missed); hint: calibrate on "
+        f"collision-free logs with {kind} velocities"
     )
 
 

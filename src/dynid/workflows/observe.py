@@ -98,7 +98,7 @@ from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
-from ..observer.thresholds import ModelFingerprint, log_rate, rate_mismatch
+from ..observer.thresholds import ModelFingerprint, log_rate, rate_mismatch, velocity_mismatch
 from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import wrench_kind, wrench_rank
@@ -526,7 +526,11 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         )
         rates = [r for r in (log_rate(log.t) for log in read.logs) if r is not None]
         rate = float(np.median(rates)) if rates else None
-        th = dataclasses.replace(cal.thresholds, model=fingerprint, sample_rate_hz=rate)
+        kinds = {bool(log.dq_derived) for log in read.logs}
+        velocities = "mixed" if len(kinds) > 1 else ("derived" if True in kinds else "measured")
+        th = dataclasses.replace(
+            cal.thresholds, model=fingerprint, sample_rate_hz=rate, velocities=velocities
+        )
         return dataclasses.replace(cal, thresholds=th, fingerprint=fingerprint, friction_source=own)
     paths = tuple(map(Path, read.paths))
     logs = []
@@ -541,7 +545,10 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         wrench_rank(model.robot, opts.frame, kind)
     assert opts.thresholds is not None
     for path, log in zip(paths, read.logs, strict=True):
-        if (other := rate_mismatch(log_rate(log.t), given, opts.thresholds.name)) is not None:
+        name = opts.thresholds.name
+        if (other := rate_mismatch(log_rate(log.t), given, name)) is not None:
+            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=2)
+        if (other := velocity_mismatch(bool(log.dq_derived), given, name)) is not None:
             warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=2)
     for k, (path, log) in enumerate(zip(paths, read.logs, strict=True)):
         rows = log.t.shape[0]
