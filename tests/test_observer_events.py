@@ -378,3 +378,55 @@ def test_without_merging_a_run_over_the_threshold_is_one_event():
     det = EventDetector(th, merge_s=0.0, min_duration_s=0.0)
     got = [e for a in range(0, N, 7) for e in det.feed(t[a : a + 7], r[a : a + 7])]
     assert _as_tuples(got + det.finish()) == _as_tuples(whole)
+
+
+def _impact_log(t0, fs=100.0, seconds=2.0, at=1.0, samples=2, rng=None):
+    """A 100 Hz log stamped from ``t0`` (``t0 + k / fs``, as a logger writes them) whose
+    residual is noise under 0.5 N m but for a contact of ``samples`` samples at 1.2 N m
+    from ``at`` s after its start: (t, r, first and last sample of the contact)."""
+    rng = rng or np.random.default_rng(5)
+    k = np.arange(int(seconds * fs))
+    t = t0 + k / fs
+    r = 0.1 * rng.standard_normal((k.size, 1))
+    a = int(round(at * fs))
+    r[a : a + samples, 0] = 1.2
+    return t, r, a, a + samples - 1
+
+
+def _one_joint(contact=0.5, collision=5.0):
+    return Thresholds(
+        contact=np.full(1, contact), collision=np.full(1, collision), margin=1.5,
+        quantile=1.0, collision_factor=10.0, options=ObserverOptions(), samples=1,
+    )  # fmt: skip
+
+
+def test_a_short_contact_is_kept_or_dropped_whatever_the_clock_it_is_stamped_on():
+    """A 2-sample contact at 100 Hz spans one period, 10 ms, the --min-duration: it is a
+    contact at every clock offset, although the stamps' difference falls on either side
+    of 0.01 s by their rounding (at 48.03 s it was 0.00999999999999801 s and the contact
+    was dropped; 0.02 s later it was kept). A 1-sample crossing is dropped at every
+    offset, and a 3-sample one kept; two one-sample crossings exactly merge_s / 2 apart
+    are not isolated at any offset. Fed a sample at a time as in one block."""
+    offsets = [0.0, 0.02, 47.03 - 1.0, 48.03 - 1.0, 1234.567, 1.7e9 + 0.13]
+    signs = set()
+    for t0 in offsets:
+        for samples, kept in ((1, False), (2, True), (3, True)):
+            t, r, a, b = _impact_log(t0, samples=samples)
+            if samples == 2:
+                signs.add(np.sign(round((t[b] - t[a] - 0.01) / 1e-18)))
+            for got in (detect(t, r, _one_joint()), _fed_one_at_a_time(t, r, _one_joint())):
+                assert [(e.start, e.end) for e in got] == ([(t[a], t[b])] if kept else []), (
+                    t0,
+                    samples,
+                )
+        t, r, a, _ = _impact_log(t0, samples=1)
+        c = a + 10  # 0.1 s later: merge_s / 2 of 0.2 s
+        r[c, 0] = 1.2
+        got = detect(t, r, _one_joint(), merge_s=0.2)
+        assert [(e.start, e.end) for e in got] == [(t[a], t[c])], t0
+    assert signs >= {-1.0, 1.0}  # the stamps' rounding went both ways
+
+
+def _fed_one_at_a_time(t, r, th):
+    det = EventDetector(th)
+    return [e for k in range(t.size) for e in det.feed(t[k : k + 1], r[k : k + 1])] + det.finish()

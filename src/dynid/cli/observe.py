@@ -35,15 +35,19 @@ Two steps:
   --units q6=-1,tau6=-1) and, among several --calibrate logs (collision-free), one whose
   motor the links barely load reads with the opposite sign to the others' (--units
   b.csv:tau5=-1).
-  thresholds.json records the model's files and a SHA-256 of their content: detecting
-  with another model warns. Whether the observer is good enough is printed below the
-  table, kept in thresholds.json's calibration and put first in the report: the false
-  alarms the thresholds raise on the calibration logs (the events --thresholds would
-  find there, and per minute) and the smallest external torque detected per joint while
-  it moves (the largest contact threshold along the motion; at rest: its column), and
-  how well the model predicts the calibration logs' torques, judged as `dynid validate`
-  judges it (relative error against the noise floor, validate's verdict): a model above
-  the floor makes the thresholds wider, and the line says so.
+  thresholds.json records the model's files and a SHA-256 of their content: detecting with
+  another model warns; and the calibration logs' sample rate: detecting on a log sampled
+  more than 20 % away from it warns (the velocities' noise in the residual, and the
+  thresholds, change with the rate; calibrate at the log's rate), and so does a log whose
+  velocities are derived from its positions where the calibration's were measured, or the
+  reverse. Whether the observer is
+  good enough is printed below the table, kept in thresholds.json's calibration and put
+  first in the report: the false alarms the thresholds raise on the calibration logs (the
+  events --thresholds would find there, and per minute) and the smallest external torque
+  detected per joint while it moves (the largest contact threshold along the motion; at
+  rest: its column), and how well the model predicts the calibration logs' torques, judged
+  as `dynid validate` judges it (relative error against the noise floor, validate's
+  verdict): a model above the floor makes the thresholds wider, and the line says so.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with
@@ -57,6 +61,10 @@ Two steps:
   against it per joint, and the score below), and prints the largest |r| of each log and
   the events with the time they cover (seconds and % of the logs' duration;
   events.json's flagged_s and duration_s per log): fewer events can cover more time.
+A residual off contacts that follows the weight of a load at the flange the model lacks
+(a fit of its mass and centre of mass explaining more than a quarter of the residual under
+the threshold and reaching 15 % of some joint's threshold) gets a note with the mass and
+the way out: dynid payload on collision-free logs with the load, or identify again.
 A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN none)
 named collision, contact or label (the first the log has), or mapped with --columns
 label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in

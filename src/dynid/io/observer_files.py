@@ -12,6 +12,9 @@
                      "model_files": [...], "model_sha256": "...",  # what the model was
                      "at_rest": [...],    # N m per joint, with the standstill margin
                      "duration_s": T,     # s, the calibration logs' total duration
+                     "sample_rate_hz": f, # Hz, the logs' sample rate (absent: not
+                                          # recorded; observe warns at another rate)
+                     "velocities": "measured" | "derived" | "mixed",  # the logs'
                      "false_alarms": k,   # events on them (null: not counted)
                      "detectable": [...], # N m per joint, the smallest torque detected
                                           # while the joint moves (the largest contact
@@ -143,7 +146,12 @@ THRESHOLDS = Format(
             "calibration": Field(
                 "object",
                 record=Record(
-                    {"samples": Field("integer", low=0), "model_check": Field("object")},
+                    {
+                        "samples": Field("integer", low=0),
+                        "sample_rate_hz": Field("number", low=0.0, unit="Hz"),
+                        "velocities": Field("string", choices=("measured", "derived", "mixed")),
+                        "model_check": Field("object"),
+                    },
                     open=True,
                 ),
             ),
@@ -292,7 +300,13 @@ def save_thresholds(
             "discretisation": o.discretisation,
             "rule": o.rule,
         },
-        "calibration": {"samples": th.samples, **_fingerprint(th.model), **(calibration or {})},
+        "calibration": {
+            "samples": th.samples,
+            **({} if th.sample_rate_hz is None else {"sample_rate_hz": th.sample_rate_hz}),
+            **({} if th.velocities is None else {"velocities": th.velocities}),
+            **_fingerprint(th.model),
+            **(calibration or {}),
+        },
         "units": {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"},
     }
     return save_document(path, THRESHOLDS, doc)
@@ -318,6 +332,7 @@ def load_thresholds(path: str | Path) -> Thresholds:
     d = load_document(path, THRESHOLDS)
     rule, obs, unc = d["rule"], d["observer"], d.get("uncertainty")
     cal = d.get("calibration", {})
+    rate = cal.get("sample_rate_hz")
     files, sha = cal.get("model_files"), cal.get("model_sha256")
     model = None
     if isinstance(sha, str) and isinstance(files, list):
@@ -343,6 +358,8 @@ def load_thresholds(path: str | Path) -> Thresholds:
             noise=None if unc is None else np.array(unc["noise"], dtype=float),
             standstill=bool(rule.get("standstill_margin", False)),
             model=model,
+            sample_rate_hz=None if rate is None else float(rate),
+            velocities=cal.get("velocities"),
         )
     except DynidError as exc:
         raise DataError(str(exc), file=path.name) from None

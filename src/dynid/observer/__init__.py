@@ -29,6 +29,8 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
   block of samples at a time (:class:`EventDetector`);
 * :mod:`~dynid.observer.scoring`: the events against labelled contacts (a 0/1 column or
   the true external torques): detected, missed, false alarms and delays.
+* :mod:`~dynid.observer.unmodelled_load`: the weight of a load at the flange that the
+  model lacks, fitted to the residual off contacts.
 """
 
 from .detection import calibrate, residual_std

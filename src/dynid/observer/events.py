@@ -37,6 +37,12 @@ detector counts every one (:attr:`EventDetector.dropped_count`) and keeps the
 records (:attr:`EventDetector.dropped`: start, end, joints, peaks, the largest ``|r|``
 over the threshold and the rule that dropped it, ``isolated`` or ``short``), so that a
 joint whose residual passed its threshold with no event says why.
+
+Every span is compared with ``merge_s``, ``min_duration_s`` and the isolation window with
+a slack of :data:`SLACK_FRACTION` of the sample period (:func:`time_slack`): a span of
+whole sample periods read from stamps carries their rounding, and at 100 Hz a two-sample
+crossing from 48.03 s to 48.04 s spans 0.00999999999999801 s, which a bare comparison
+dropped as shorter than 0.01 s while the same crossing 0.02 s later was kept.
 """
 
 from __future__ import annotations
@@ -56,10 +62,12 @@ __all__ = [
     "DEFAULT_MIN_DURATION_S",
     "ISOLATION_FRACTION",
     "MAX_DROPPED",
+    "SLACK_FRACTION",
     "ContactEvent",
     "DroppedCrossing",
     "EventDetector",
     "detect",
+    "time_slack",
 ]
 
 #: Runs over the threshold closer than this [s] are one event (module docstring).
@@ -73,6 +81,18 @@ DEFAULT_MIN_DURATION_S = 0.01
 ISOLATION_FRACTION = 0.5
 #: Dropped crossings kept as records (those furthest over the threshold); all are counted.
 MAX_DROPPED = 100
+#: The slack of every comparison of a span with a duration, as a fraction of the sample
+#: period (module docstring): far above the stamps' rounding, far below a sample.
+SLACK_FRACTION = 0.01
+
+
+def time_slack(t: ArrayLike) -> float:
+    """The slack [s] of a comparison of spans between the samples ``t`` (N,) [s] with a
+    duration: :data:`SLACK_FRACTION` of the median positive step (0: fewer than two
+    distinct samples)."""
+    steps = np.diff(np.asarray(t, dtype=np.float64).reshape(-1))
+    steps = steps[steps > 0]
+    return SLACK_FRACTION * float(np.median(steps)) if steps.size else 0.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -251,11 +271,15 @@ class EventDetector:
         Samples of the log (counted from its first, over every block) where the observer
         started again (the first of each piece of a log cut at its gaps): no event spans
         one.
+    sample_period_s : float, optional
+        The log's sample period [s], whose :data:`SLACK_FRACTION` is the slack of every
+        comparison of a span with a duration (module docstring); default: the median
+        step of the first samples fed (the first block of two or more).
 
     Raises
     ------
     OptionError
-        A negative ``merge_s`` or ``min_duration_s``.
+        A negative ``merge_s``, ``min_duration_s`` or ``sample_period_s``.
 
     Examples
     --------
@@ -271,7 +295,10 @@ class EventDetector:
         merge_s: float = DEFAULT_MERGE_S,
         min_duration_s: float = DEFAULT_MIN_DURATION_S,
         restarts: ArrayLike | None = None,
+        sample_period_s: float | None = None,
     ) -> None:
+        if sample_period_s is not None and not sample_period_s >= 0:
+            raise OptionError(f"sample_period_s must be >= 0 [s]; got {sample_period_s}")
         if not merge_s >= 0:
             raise OptionError(f"merge_s must be >= 0 [s]; got {merge_s}")
         if not min_duration_s >= 0:
@@ -288,6 +315,20 @@ class EventDetector:
         self._ratio = np.full(thresholds.n, np.nan)
         self._dropped: list[DroppedCrossing] = []
         self._dropped_count = 0
+        #: The slack [s] of the comparisons of spans with durations (module docstring);
+        #: None until the sample period is known.
+        self.slack_s: float | None = (
+            None if sample_period_s is None else SLACK_FRACTION * float(sample_period_s)
+        )
+        self._last_t: float | None = None  # the last sample fed, for the period
+
+    def _longer(self, span: float, duration: float) -> bool:
+        """``span > duration`` [s] beyond the slack."""
+        return span > duration + (self.slack_s or 0.0)
+
+    def _shorter(self, span: float, duration: float) -> bool:
+        """``span < duration`` [s] beyond the slack."""
+        return span < duration - (self.slack_s or 0.0)
 
     @property
     def dropped(self) -> tuple[DroppedCrossing, ...]:
@@ -355,6 +396,12 @@ class EventDetector:
         ra = _checks.as_exact("r", r, (m, self.thresholds.n), allow_nonfinite=True)
         if np.any(np.isinf(ra)):
             raise ShapeError("r must be finite or NaN (not observed); got inf")
+        if m:
+            if self.slack_s is None:  # the period of the first steps fed
+                before = [] if self._last_t is None else [self._last_t]
+                if slack := time_slack(np.concatenate((before, ta))):
+                    self.slack_s = slack
+            self._last_t = float(ta[-1])
         seen: NDArray[np.bool_] = np.all(np.isfinite(ra), axis=1)
         if std is not None:  # NaN where not observed, as r
             std = np.where(seen[:, None], np.asarray(std, dtype=np.float64), 0.0)
@@ -390,7 +437,9 @@ class EventDetector:
             else:
                 near = False
                 if run is not None:
-                    near = p == run.piece and not ta[a] - run.last > self.isolation_s
+                    near = p == run.piece and not self._longer(
+                        float(ta[a]) - run.last, self.isolation_s
+                    )
                     run.tail = run.tail.then(gap)
                     out += self._judged(run, near)
                 else:
@@ -428,14 +477,19 @@ class EventDetector:
         joins an event); another run is joined to the open event when within ``merge_s``
         of it in the same piece, else the open event is closed (returned unless too
         short) and the run opens the next."""
-        short = run.last - run.start < self.min_duration_s and not run.held.collision
+        short = self._shorter(run.last - run.start, self.min_duration_s)
+        short = short and not run.held.collision
         if short and not (run.near or near):
             self._drop(run.held.dropped(run.start, run.last, "isolated"))
             self._between(run.held)
             self._between(run.tail)
             return []
         ev = self._open
-        if ev is not None and ev.piece == run.piece and not run.start - ev.last > self.merge_s:
+        if (
+            ev is not None
+            and ev.piece == run.piece
+            and not self._longer(run.start - ev.last, self.merge_s)
+        ):
             ev.held = ev.held.then(ev.after).then(run.held)
             ev.last, ev.after = run.last, run.tail
             return []
@@ -445,7 +499,10 @@ class EventDetector:
     def _closed(self, event: _Open) -> list[ContactEvent]:
         """The event closed, or none when it is shorter than ``min_duration_s`` and
         stayed at the contact level."""
-        if event.last - event.start < self.min_duration_s and not event.held.collision:
+        if (
+            self._shorter(event.last - event.start, self.min_duration_s)
+            and not event.held.collision
+        ):
             self._drop(event.held.dropped(event.start, event.last, "short"))
             return []
         return [event.closed()]
@@ -461,6 +518,7 @@ def detect(
     merge_s: float = DEFAULT_MERGE_S,
     min_duration_s: float = DEFAULT_MIN_DURATION_S,
     restarts: ArrayLike | None = None,
+    sample_period_s: float | None = None,
 ) -> list[ContactEvent]:
     """Contact events of a whole residual (module docstring): :class:`EventDetector` fed
     the log as one block.
@@ -485,6 +543,8 @@ def detect(
     restarts : array_like of int, optional
         Samples where the observer started again (the first of each piece of a log cut
         at its gaps): no event spans one.
+    sample_period_s : float, optional
+        See :class:`EventDetector` (default: the median step of ``t``).
 
     Returns
     -------
@@ -499,6 +559,10 @@ def detect(
         A negative ``merge_s`` or ``min_duration_s``.
     """
     det = EventDetector(
-        thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=restarts
+        thresholds,
+        merge_s=merge_s,
+        min_duration_s=min_duration_s,
+        restarts=restarts,
+        sample_period_s=sample_period_s,
     )
     return det.feed(t, r, std=std, standstill=standstill) + det.finish()

@@ -23,6 +23,7 @@ from .model import ObserverModel
 from .scoring import ContactScore, combined
 from .thresholds import ModelFingerprint
 from .unmodelled import MOST_FLAGGED, UnmodelledFriction, no_friction_note
+from .unmodelled_load import UnmodelledLoad, load_note
 from .wrench import FULL, WrenchEstimate, WrenchKind, underdetermined_note
 
 __all__ = [
@@ -213,7 +214,9 @@ class ObserveResult:
     residual shows at speed (:mod:`~dynid.observer.unmodelled`; None: a model with
     friction, or no sample at speed); ``check``, of a calibration: its false alarms on its
     own logs and the smallest external torques it detects
-    (:mod:`~dynid.observer.calibration_check`)."""
+    (:mod:`~dynid.observer.calibration_check`); ``load``, of a detection: a load at the
+    flange fitted to the residual off contacts (:mod:`~dynid.observer.unmodelled_load`;
+    None: not fitted)."""
 
     model: ObserverModel
     thresholds: Thresholds
@@ -227,6 +230,7 @@ class ObserveResult:
     merge_s: float | None = None
     unmodelled: UnmodelledFriction | None = None
     check: CalibrationCheck | None = None
+    load: UnmodelledLoad | None = None
 
     def dropped_count(self) -> int:
         """The crossings over the contact threshold every log's minimum duration dropped
@@ -261,7 +265,8 @@ class ObserveResult:
         noise band (:func:`~dynid.observer.friction.banding_note`); a wrench at a frame that
         fewer than six joints move is the least-norm one
         (:func:`~dynid.observer.wrench.underdetermined_note`), a force alone at a frame
-        that fewer than three joints move too."""
+        that fewer than three joints move too; a residual off contacts that follows the
+        weight of a load at the flange (:func:`~dynid.observer.unmodelled_load.load_note`)."""
         out: tuple[str, ...] = ()
         if self.model.friction is None:
             out = (no_friction_note(self.unmodelled, self.model.robot.joint_names),)
@@ -275,6 +280,9 @@ class ObserveResult:
         said = u is not None and u.overall is not None and u.flagged_share() > MOST_FLAGGED
         if not said and (flagged := self.mostly_flagged_note()) is not None:
             out += (flagged,)
+        identified = self.model.source == "identified"
+        if load := load_note(self.load, self.model.robot.joint_names, identified=identified):
+            out += (load,)
         if (
             self.frame is not None
             and (note := underdetermined_note(self.model.robot, self.frame, self.wrench))

@@ -152,6 +152,7 @@ def match_events(
     labels: ArrayLike,
     tolerance_s: float = DEFAULT_TOLERANCE_S,
     lead_s: float = DEFAULT_LEAD_S,
+    slack_s: float = 0.0,
 ) -> tuple[NDArray[np.intp], NDArray[np.bool_]]:
     """Which event detects each labelled contact, and which events are false alarms
     (module docstring).
@@ -168,6 +169,10 @@ def match_events(
         contacts closer than this form one group.
     lead_s : float
         How long before a contact's start [s] an event may start and still detect it.
+    slack_s : float
+        Added to ``tolerance_s`` and ``lead_s`` in the comparisons [s]: a span of whole
+        sample periods read from stamps carries their rounding
+        (:func:`~dynid.observer.events.time_slack`, a hundredth of the sample period).
 
     Returns
     -------
@@ -188,12 +193,12 @@ def match_events(
         return np.full(lab.shape[0], -1, dtype=np.intp), np.zeros(0, dtype=bool)
     if lab.shape[0] == 0:  # no contact: every event a false alarm
         return np.zeros(0, dtype=np.intp), np.ones(ev.shape[0], dtype=bool)
-    opens = np.concatenate(([True], lab[1:, 0] - lab[:-1, 1] > tolerance_s))
+    opens = np.concatenate(([True], lab[1:, 0] - lab[:-1, 1] > tolerance_s + slack_s))
     group = np.cumsum(opens) - 1  # each contact's group
     a = lab[opens, 0]  # the groups' first and last samples
     b = lab[np.concatenate((opens[1:], [True])), 1]
     s = ev[None, :, 0]
-    hit = (s >= a[:, None] - lead_s) & (s <= b[:, None] + tolerance_s)
+    hit = (s >= a[:, None] - lead_s - slack_s) & (s <= b[:, None] + tolerance_s + slack_s)
     over = hit[group]
     starts = np.where(over, ev[None, :, 0], np.inf)
     first = np.where(over.any(axis=1), np.argmin(starts, axis=1), -1).astype(np.intp)
@@ -282,6 +287,7 @@ def score_events(
     source: str = "",
     look_ahead: bool = False,
     lead_s: float = DEFAULT_LEAD_S,
+    slack_s: float = 0.0,
 ) -> ContactScore:
     """The score of one log's events against its labelled contacts.
 
@@ -301,7 +307,7 @@ def score_events(
         Where the labels came from.
     look_ahead : bool
         See :class:`ContactScore`.
-    lead_s : float
+    lead_s, slack_s : float
         See :func:`match_events`.
 
     Returns
@@ -318,7 +324,7 @@ def score_events(
     top = None if peaks is None else np.asarray(peaks, dtype=np.float64).reshape(-1)
     if top is not None and top.shape != (lab.shape[0],):
         raise ShapeError(f"peaks must be ({lab.shape[0]},); got {top.shape}")
-    first, false = match_events(ev, lab, tolerance_s, lead_s)
+    first, false = match_events(ev, lab, tolerance_s, lead_s, slack_s)
     missed = tuple(
         MissedContact(
             float(lab[k, 0]),

@@ -304,7 +304,8 @@ def _events_parts(name: str, run: RunFiles) -> list[str]:
     (HTML), then the rest of the file as tables. Start and end are seconds from the
     first sample of the event's log, the axis of its residual figure, with the log's
     clock said once above the table and each start as the log holds it beside them (to
-    find the row in the log, or in another record on the same clock); a log whose first
+    find the row in the log, or in another record on the same clock; the column left out
+    when every log starts at 0, where it would repeat the start); a log whose first
     stamp no residual table gives keeps its stamps, to the millisecond."""
     doc = run.docs[name]
     events = _events(doc)
@@ -339,6 +340,10 @@ def _events_parts(name: str, run: RunFiles) -> list[str]:
         "#", "log", "level", "joints", "start [s]", "end [s]", "duration [ms]",
         "start on the log's clock [s]", "peak [N m]",
     ]  # fmt: skip
+    clock = headers.index("start on the log's clock [s]")
+    if not any(row[clock] for row in rows):  # every log starts at 0: nothing to show
+        headers.pop(clock)
+        rows = [row[:clock] + row[clock + 1 :] for row in rows]
     rest = {k: v for k, v in doc.items() if k != "events"}
     return [head + table(headers, rows, cls="events"), json_section(name, rest)]
 

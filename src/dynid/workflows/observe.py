@@ -98,8 +98,9 @@ from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
-from ..observer.thresholds import ModelFingerprint
+from ..observer.thresholds import ModelFingerprint, log_rate, rate_mismatch, velocity_mismatch
 from ..observer.unmodelled import FrictionTally
+from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import wrench_kind, wrench_rank
 from ..progress import NOTE
 from .data_files import (
@@ -523,7 +524,13 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         cal = _calibrated(
             read, model, columns[0] is not None, opts, options, wants_std, wants_margin
         )
-        th = dataclasses.replace(cal.thresholds, model=fingerprint)
+        rates = [r for r in (log_rate(log.t) for log in read.logs) if r is not None]
+        rate = float(np.median(rates)) if rates else None
+        kinds = {bool(log.dq_derived) for log in read.logs}
+        velocities = "mixed" if len(kinds) > 1 else ("derived" if True in kinds else "measured")
+        th = dataclasses.replace(
+            cal.thresholds, model=fingerprint, sample_rate_hz=rate, velocities=velocities
+        )
         return dataclasses.replace(cal, thresholds=th, fingerprint=fingerprint, friction_source=own)
     paths = tuple(map(Path, read.paths))
     logs = []
@@ -532,9 +539,17 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         if model.friction is not None
         else FrictionTally(model.n, np.asarray(options.gain, dtype=np.float64))
     )
+    load = LoadTally(model.robot)
     kind = wrench_kind(opts.wrench)
     if opts.frame is not None:  # an unknown frame, a frame on the base: before any log
         wrench_rank(model.robot, opts.frame, kind)
+    assert opts.thresholds is not None
+    for path, log in zip(paths, read.logs, strict=True):
+        name = opts.thresholds.name
+        if (other := rate_mismatch(log_rate(log.t), given, name)) is not None:
+            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=2)
+        if (other := velocity_mismatch(bool(log.dq_derived), given, name)) is not None:
+            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=2)
     for k, (path, log) in enumerate(zip(paths, read.logs, strict=True)):
         rows = log.t.shape[0]
         table = None
@@ -563,12 +578,14 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 labels=labels,
                 tolerance_s=opts.label_tolerance_s,
                 unmodelled=unmodelled,
+                load=load,
             )  # fmt: skip
         )
     return ObserveResult(
         model, given, tuple(logs), fingerprint, own, opts.frame, kind,
         min_duration_s=opts.min_duration_s, merge_s=opts.merge_s,
         unmodelled=None if unmodelled is None else unmodelled.result(),
+        load=load.result(),
     )  # fmt: skip
 
 

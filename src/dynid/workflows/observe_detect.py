@@ -29,7 +29,7 @@ from .. import _checks
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
-from ..observer.events import ContactEvent, EventDetector
+from ..observer.events import ContactEvent, EventDetector, time_slack
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
@@ -46,6 +46,7 @@ from ..observer.scoring import (
 from ..observer.sign import TorqueSign, opposite_finding
 from ..observer.thresholds import Thresholds, threshold_series
 from ..observer.unmodelled import FrictionTally
+from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
@@ -179,6 +180,7 @@ def detected_log(
     labels: Labels | None = None,
     tolerance_s: float = DEFAULT_TOLERANCE_S,
     unmodelled: FrictionTally | None = None,
+    load: LoadTally | None = None,
 ) -> LogObservation:
     """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
     of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
@@ -187,11 +189,19 @@ def detected_log(
     the wrench or the force alone at ``frame``; the events scored against ``labels``
     (:func:`contact_labels`), else against the true torques stored beside the log (in
     contact above :data:`~dynid.observer.scoring.TRUTH_LEVEL`), with ``tolerance_s``
-    (:func:`scored`); ``unmodelled`` (a model without friction) is fed the samples under
-    the contact threshold."""
+    (:func:`scored`); ``unmodelled`` (a model without friction) and ``load`` (the fit of
+    a load at the flange) are fed the samples under the contact threshold."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
-    det = EventDetector(thresholds, merge_s=merge_s, min_duration_s=min_duration_s, restarts=starts)
+    steps = np.diff(log.t)
+    period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
+    det = EventDetector(
+        thresholds,
+        merge_s=merge_s,
+        min_duration_s=min_duration_s,
+        restarts=starts,
+        sample_period_s=period,
+    )
     keep = Series.new(prep, n, *wants) if keep_series else None
     ext = in_file(prep.path, lambda: true_torques(prep, model, mapped))
     stats = _Running(n)
@@ -218,9 +228,13 @@ def detected_log(
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
             sign.add(log.tau[a:b], blk.r)
-            if unmodelled is not None:  # the friction the model misses, contacts left out
+            if unmodelled is not None or load is not None:  # contacts left out
                 contact, _ = threshold_series(thresholds, b - a, blk.std, blk.margin)
-                unmodelled.add(log.t[a:b], prep.dq[a:b], blk.r, ~(np.abs(blk.r) > contact))
+                under = ~(np.abs(blk.r) > contact)
+                if unmodelled is not None:  # the friction the model misses
+                    unmodelled.add(log.t[a:b], prep.dq[a:b], blk.r, under)
+                if load is not None:  # a load at the flange the model misses
+                    load.add(log.q[a:b], blk.r, contact)
             if keep is not None:
                 keep.put(blk)
             if strided is not None:
@@ -325,6 +339,7 @@ def scored(
         source=source,
         look_ahead=look_ahead,
         lead_s=lead_for(t),
+        slack_s=time_slack(t),
     )
 
 
