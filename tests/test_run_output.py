@@ -511,3 +511,78 @@ def test_ctrl_c_once_the_program_ran_does_not_turn_its_exit_into_an_interrupt(tm
     assert r.returncode == 0, r.stderr
     assert "KeyboardInterrupt" not in r.stderr
     assert out.read_text().count("\n") > 5
+
+
+@pytest.mark.parametrize("where", ["as the folder is made", "locking it", "right after open"])
+def test_ctrl_c_as_the_staging_folder_is_made_leaves_nothing(tmp_path, monkeypatch, where):
+    """Ctrl-C once the hidden staging folder exists but before the run's block began (as
+    mkdtemp returns, as the folder is locked, or from opening to the block): the interrupt
+    goes through and neither the staging folder nor the new parent folder stays (before the
+    fix: 2 Ctrl-C in 180 in the first second of `dynid acquire-static` left
+    ``.big.csv.dynid-*`` behind, both raised in mkdtemp once its folder was made)."""
+    ro = importlib.import_module("dynid.outputs.run_output")
+    from dynid.io import atomic
+
+    if where == "as the folder is made":
+        real_mkdtemp = ro.tempfile.mkdtemp
+
+        def mkdtemp(**kw):
+            made = real_mkdtemp(**kw)
+            os.kill(os.getpid(), signal.SIGINT)
+            for _ in range(1000):  # (the interrupt is raised here, before mkdtemp returns)
+                pass
+            return made
+
+        monkeypatch.setattr(ro.tempfile, "mkdtemp", mkdtemp)
+    elif where == "locking it":
+        real_flock = ro._flock
+
+        def flock(fd, *, block):
+            if not block:  # the staging folder's own lock, taken once it is made
+                raise KeyboardInterrupt
+            return real_flock(fd, block=block)
+
+        monkeypatch.setattr(ro, "_flock", flock)
+    else:
+        real_open = ro.RunOutput.open
+
+        def opened(self):
+            real_open(self)
+            assert self.staging is not None and self.staging.is_dir()
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr(ro.RunOutput, "open", opened)
+    out = tmp_path / "new" / "s.csv"
+    with pytest.raises(KeyboardInterrupt), ro.run_output(out, command="t", kind="file"):
+        pytest.fail("the block must not run")
+    assert list(tmp_path.iterdir()) == []
+    assert atomic._REDIRECTS == []
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_signals_held_to_deliver_keep_the_step_whole_and_stop_after_it():
+    """``signals_held(deliver=True)``: a Ctrl-C inside the block lets the block run to its
+    end and is then raised; without ``deliver`` a block that ends normally drops it (a set
+    already in place), and one that raises delivers it."""
+    from dynid.outputs.held_signals import signals_held
+
+    steps = []
+    with pytest.raises(KeyboardInterrupt):
+        with signals_held(deliver=True) as arrived:
+            os.kill(os.getpid(), signal.SIGINT)
+            for _ in range(1000):
+                pass
+            steps.append("end of the block")
+        steps.append("after the block")
+    assert steps == ["end of the block"] and arrived == [signal.SIGINT]
+
+    with signals_held() as arrived:
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(1000):
+            pass
+    assert arrived == [signal.SIGINT]
+
+    with pytest.raises(KeyboardInterrupt), signals_held():
+        os.kill(os.getpid(), signal.SIGINT)
+        raise OSError("the move failed")
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler

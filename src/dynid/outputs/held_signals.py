@@ -18,10 +18,14 @@ HELD = tuple(
 
 
 @contextlib.contextmanager
-def signals_held() -> Iterator[list[int]]:
+def signals_held(*, deliver: bool = False) -> Iterator[list[int]]:
     """Hold the termination signals back inside the block; yields the list of those that
     arrived meanwhile (filled when the block ends), which are not delivered when the block
     ends normally and are delivered again when it raises.
+
+    With ``deliver`` they are delivered when the block ends, also normally: the block is a
+    step an interrupt must not cut in two (a folder made and its name not yet kept, which
+    then nothing would remove), and the run stops right after it as asked.
 
     Blocked in this thread, and, in the main thread, their handlers replaced by a record
     of their arrival: a signal that another thread takes still runs its handler in the
@@ -51,6 +55,6 @@ def signals_held() -> Iterator[list[int]]:
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
         for s, h in handlers.items():
             signal.signal(s, h)
-        if not ok:
-            for s in dict.fromkeys(arrived):  # the set did not move: stop as asked
+        if deliver or not ok:
+            for s in dict.fromkeys(arrived):  # (the set did not move): stop as asked
                 signal.raise_signal(s)

@@ -219,10 +219,12 @@ class RunOutput:
             self._created_parents = missing  # deepest first
             with _folder_lock(parent):
                 self._remove_stale_staging()
-                self.staging = Path(
-                    tempfile.mkdtemp(dir=parent, prefix=f".{out.name}{_STAGING}", suffix="")
-                )
-                self._fd = os.open(self.staging, os.O_RDONLY)
+                # held: a Ctrl-C as mkdtemp returns, once its folder exists, left it behind
+                with signals_held(deliver=True):
+                    self.staging = Path(
+                        tempfile.mkdtemp(dir=parent, prefix=f".{out.name}{_STAGING}", suffix="")
+                    )
+                    self._fd = os.open(self.staging, os.O_RDONLY)
                 _flock(self._fd, block=False)
         except OSError as exc:
             self._close(False)
@@ -550,9 +552,9 @@ def run_output(
         no run recorded (each without ``force``). Nothing has moved when it is raised.
     """
     run = RunOutput(Path(out), command=command, kind=kind, force=force, argv=argv)
-    run.open()
     ok = False
-    try:
+    try:  # (open inside: a Ctrl-C once the staging folder exists removes it too)
+        run.open()
         yield run
         ok = True
     finally:
