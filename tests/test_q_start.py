@@ -18,7 +18,7 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DataError, DynidWarning, OptionError
-from dynid.identification.log import TorqueLog
+from dynid.identification.log import TorqueLog, with_derived_velocities
 from dynid.identification.pieces import with_start_turns
 from dynid.identification.recordings import prepare_recordings
 from dynid.io.drive_file import load_drive
@@ -85,6 +85,21 @@ def test_with_q_start_the_joint_positions_are_the_truth(arm):
         a = prepare_recordings(robot, [log], ["w.csv"], cutoff_hz=5.0, drive=drive)
         b = prepare_recordings(robot, [true], ["m.csv"], cutoff_hz=5.0, drive=drive)
     np.testing.assert_allclose(a.pieces[0].log.q, b.pieces[0].log.q, rtol=0, atol=1e-9)
+
+
+def test_positions_only_the_velocities_are_those_of_the_unwrapped_angles(arm):
+    """Regression: a positions-only motor-side log kept the velocities derived from its
+    wrapped angles as read (a turn's jump at each wrap) once --q-start had unwrapped them,
+    and validate's sign check read motor 3 of a UR10 as of the opposite sign; now they are
+    those derived from the multi-turn angles (the never-wrapped log read alike)."""
+    robot, drive, traj, true, wrapped, _ = arm
+    derived = with_derived_velocities(wrapped)  # as a reader of a log without dq makes it
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        log = with_start_turns("w.csv", derived, robot, drive, traj.q[0])
+    truth = with_derived_velocities(TorqueLog(true.t, true.q, true.dq, true.tau))
+    assert log.dq_derived
+    np.testing.assert_allclose(log.dq, truth.dq, rtol=0, atol=1e-9 * np.abs(truth.dq).max())
 
 
 def test_q_start_midway_between_two_counts_is_refused(arm):

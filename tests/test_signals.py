@@ -140,6 +140,25 @@ def test_sample_rate_and_uniformity():
     assert not signals.is_uniform(t2)
 
 
+def test_epoch_stamps_exact_to_their_floats_are_uniform():
+    """Regression: stamps exactly 4000 us apart since the epoch (2024), read in seconds,
+    step by 4 ms give or take their floats' 2.4e-7 s, and the log was resampled as
+    jittered; uniform now, while a stamp 0.01 ms off (40 times that resolution) is not."""
+    from dynid.identification.log import TorqueLog
+    from dynid.identification.prepare import resamples
+
+    us = 1_733_000_000_000_000 + 4000 * np.arange(2000, dtype=np.int64)
+    t = us.astype(np.float64) * 1e-6
+    assert not np.all(np.diff(t) == np.diff(t)[0])  # the floats' steps do differ
+    assert signals.is_uniform(t)
+    z = np.zeros((t.size, 1))
+    assert not resamples(TorqueLog(t, z, z, z))
+    t2 = t.copy()
+    t2[10] += 1e-5
+    assert not signals.is_uniform(t2)
+    assert resamples(TorqueLog(t2, z, z, z))
+
+
 def test_sample_rate_with_jitter_and_dropped_samples():
     """Jitter and gaps do not bias the nominal rate (counted periods, or windowed median)."""
     rng = np.random.default_rng(6)

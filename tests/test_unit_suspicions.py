@@ -89,3 +89,22 @@ def test_recorded_velocities_in_ms_and_degrees_are_said_in_one_error(truth):
     msg = str(e.value)
     assert "the time column looks like ms" in msg and "degrees" in msg
     assert re.search(r"hint: --units t=ms,q=deg(,dq=deg/s)?$", msg), msg
+
+
+@pytest.mark.parametrize(("scale", "unit"), [(1e6, "us"), (1e9, "ns")])
+def test_a_time_column_in_us_or_ns_is_named_with_its_units(truth, tmp_path, scale, unit):
+    """Regression: positions only with stamps in us (epoch, 4000 per 4 ms step) were refused
+    as "sampled at 0.00025 Hz" without a hint; the error now names the unit and the
+    --units entry, and read with it the log is the simulated one."""
+    panda, log = truth
+    n = log.q.shape[1]
+    path = tmp_path / f"{unit}.csv"
+    head = ["t", *(f"q{j + 1}" for j in range(n)), *(f"tau{j + 1}" for j in range(n))]
+    rows = np.column_stack([np.round(log.t * scale), log.q, log.tau])
+    np.savetxt(path, rows, delimiter=",", header=",".join(head), comments="", fmt="%.17g")
+    with pytest.raises(DataError, match=rf"look like {'micro' if unit == 'us' else 'nano'}"):
+        read_recordings([path], panda)
+    with pytest.raises(DataError, match=rf"hint: --units t={unit}"):
+        read_recordings([path], panda)
+    ok = read_recordings([path], panda, columns=(None, f"t={unit}"))
+    np.testing.assert_allclose(ok.logs[0].t, log.t, atol=1e-9)

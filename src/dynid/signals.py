@@ -56,6 +56,7 @@ __all__ = [
     "lowpass_noise_gain",
     "resample_uniform",
     "sample_rate",
+    "stamp_resolution",
     "trim_edges",
 ]
 
@@ -292,11 +293,22 @@ def _run_steps(s: NDArray[np.float64], h: float) -> NDArray[np.int64]:
 
 
 def is_uniform(t: ArrayLike, *, rtol: float = 1e-6) -> bool:
-    """True when every step of ``t`` (N,) equals the median step within ``rtol``."""
+    """True when every step of ``t`` (N,) equals the median step within ``rtol`` of it, or
+    within the stamps' own resolution (:func:`stamp_resolution`: epoch stamps in seconds,
+    1.7e9 s, hold steps to 2.4e-7 s, 6e-5 of the exact 4 ms steps of a 250 Hz log)."""
     t = _time(t)
     dt = np.diff(t)
     h = np.median(dt)
-    return bool(np.all(np.abs(dt - h) <= rtol * h))
+    return bool(np.all(np.abs(dt - h) <= max(rtol * h, stamp_resolution(t))))
+
+
+def stamp_resolution(t: ArrayLike) -> float:
+    """The resolution [s] of float stamps ``t`` (N,): 4 units in the last place of the
+    largest in magnitude (a step between two stamps errs by up to 2 of them)."""
+    t = np.asarray(t, dtype=np.float64)
+    if t.size == 0:
+        return 0.0
+    return 4.0 * float(np.spacing(max(abs(float(t[0])), abs(float(t[-1])))))
 
 
 def resample_uniform(

@@ -419,17 +419,26 @@ def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ
     if log.t.shape[0] > 1:
         dt = float(np.median(np.diff(log.t)))
         if dt > 0 and cutoff_hz >= 0.5 / dt:
-            ms = (
-                f"; its time steps of {dt:g} look like milliseconds; {MILLISECONDS_HINT}"
-                if 0.5 <= dt <= 100
-                else ""
-            )
             raise DataError(
                 f"positions only, sampled at {1 / dt:.3g} Hz: velocities cannot be derived at "
-                f"{cutoff_hz:g} Hz (above half the rate){ms}"
+                f"{cutoff_hz:g} Hz (above half the rate){_time_unit_hint(dt)}"
             )
     dq = signals.filtered_derivative(log.t, log.q, cutoff_hz)
     return TorqueLog(log.t, log.q, dq, log.tau, log.ddq, log.cleaning, dq_derived=True)
+
+
+def _time_unit_hint(dt: float) -> str:
+    """What a median time step ``dt`` read as seconds looks like, with the ``--units`` that
+    reads it so: milliseconds for 0.5 to 100 (:data:`MILLISECONDS_HINT`), microseconds to
+    1e5 and nanoseconds to 1e8 (arms logged at 10 Hz to a few kHz); "" otherwise."""
+    for unit, hi, hint in (
+        ("milliseconds", 100.0, MILLISECONDS_HINT),
+        ("microseconds", 1e5, "hint: --units t=us"),
+        ("nanoseconds", 1e8, "hint: --units t=ns"),
+    ):
+        if 0.5 <= dt <= hi:
+            return f"; its time steps of {dt:g} look like {unit}; {hint}"
+    return ""
 
 
 def velocity_note(cutoff_hz: float) -> str:

@@ -569,7 +569,10 @@ def with_start_turns(
         DynidWarning,
         stacklevel=2,
     )
-    return TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
+    out = TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
+    if log.dq_derived:  # derived from the wrapped angles as read: a turn's jump at each wrap
+        out = with_derived_velocities(out, DEFAULT_CUTOFF_HZ)
+    return out
 
 
 def _check_q_start(q_start: NDArray[np.float64], robot: Robot, drive: Drive | None) -> None:

@@ -460,9 +460,9 @@ def _plan(log: TorqueLog, prep: Preprocessing) -> _Plan:
     _check_gaps(t, dt, prep.max_gap_s)
     fs, decimate = prep.fs, prep.decimate
     rate = signals.sample_rate(t) if fs is None else float(fs)
-    uniform = (
-        signals.is_uniform(t, rtol=prep.jitter_rtol) and abs(rate * np.median(dt) - 1.0) < 1e-9
-    )
+    h = float(np.median(dt))
+    off = max(1e-9, signals.stamp_resolution(t) / h)  # a step's error from the stamps' floats
+    uniform = signals.is_uniform(t, rtol=prep.jitter_rtol) and abs(rate * h - 1.0) < off
     del dt
     if not uniform:  # the grid of signals.resample_uniform
         m = int(np.floor((t[-1] - t[0]) * rate * (1.0 + 1e-12))) + 1
