@@ -319,3 +319,19 @@ def test_urdf_export_names_what_it_drops_and_mjcf_holds_it(tmp_path):
     np.testing.assert_allclose(model.dof_armature, arm, rtol=1e-12)
     np.testing.assert_allclose(model.dof_damping, damping, rtol=1e-12)
     np.testing.assert_allclose(model.dof_frictionloss, np.abs(np.diag(K)) * fc, rtol=1e-12)
+
+
+def test_a_coupled_drive_s_dropped_damping_reads_as_its_coupling():
+    """Regression: the export sentence read "without viscous friction (damping): the
+    coupling's off-diagonal terms have no per-joint term and are dropped" although the
+    damping is written; what is left out is the coupling's off-diagonal terms."""
+    from dynid.friction.mujoco import drive_joint_terms
+    from dynid.io.robot.export_options import friction_losses
+
+    K = np.eye(2)
+    K[1, 0] = 0.8  # motor 2 turns with joint 1 too: a coupled wrist
+    terms = drive_joint_terms(K, None, np.array([0.5, 0.3]), None)
+    _, left = friction_losses("smooth", terms.notes)
+    assert left.startswith("the coupling's off-diagonal terms of the viscous friction (damping)")
+    assert "(largest: joints 1-2, 0.24)" in left, left
+    np.testing.assert_allclose(terms.damping, [0.5 + 0.8**2 * 0.3, 0.3])  # written: K^T diag K

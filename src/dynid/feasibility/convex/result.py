@@ -183,6 +183,8 @@ def _active_and_implausible(
         kind, value, of = odd
         too = prior[1] if prior is not None and prior[0] == kind else None
         if kind == "mass":
+            if too is not None and abs(value - too) <= 0.2 * too:  # the description's own
+                continue  # a light last link (a UR10's wrist 3: 0.202 kg of 28) is no finding
             text = f"implausible: {names[i]} weighs {value:.3g} kg, under 1 % of the total"
             out.append(text + ("" if too is None else f"; the prior has it too ({too:.3g} kg)"))
             continue

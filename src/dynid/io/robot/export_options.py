@@ -171,6 +171,12 @@ def kept_elsewhere(
 _NO_TERM = " has no per-joint term"
 
 
+#: A coupled drive's note of terms dropped (:func:`~dynid.friction.mujoco.drive_joint_terms`).
+_COUPLED = re.compile(
+    r"(.+): the coupling's off-diagonal terms have no per-joint term and are dropped \((.+)\)"
+)
+
+
 def friction_losses(kind: str, lost: Sequence[str]) -> tuple[str, str]:
     """How a per-joint file (URDF ``<dynamics>``, MJCF ``damping`` and ``frictionloss``)
     writes a friction law of kind ``kind`` and what it leaves out, from the notes ``lost``
@@ -199,6 +205,8 @@ def friction_losses(kind: str, lost: Sequence[str]) -> tuple[str, str]:
             continue
         if text.endswith(_NO_TERM):
             text = text.removesuffix(_NO_TERM) + " (no per-joint term)"
+        if coupled := _COUPLED.fullmatch(text):  # "without" the coupling, not the friction
+            text = f"the coupling's off-diagonal terms of the {coupled[1]} ({coupled[2]})"
         left.append(text)
     joined = ", ".join(left[:-1]) + " and " + left[-1] if len(left) > 1 else "".join(left)
     return written, joined
