@@ -126,6 +126,36 @@ def test_predict_json_gives_m_g_and_with_dq_ddq_c_tau(identified, capsys):
     assert "M(q) [kg m^2]" in text and "g(q) [N m]" in text
 
 
+def test_predict_takes_feasible_parameters(tmp_path, capsys):
+    """Regression: ``predict --model feasible.json`` was refused ("expected
+    'dynid-identified-model/1'") and predict had no other source; ``--params feasible.json``
+    gives the feasible robot's M, g, c and tau (the Panda's, written as feasible.json);
+    a drive's rotor inertias add ``diag(I_a)`` through a gear ratio of 1."""
+    import dataclasses
+
+    from dynid.io.feasible import save_feasible_json
+    from dynid.model.drive import Drive
+    from dynid.workflows.predict import model_terms
+
+    robot = dynid.panda()
+    path = save_feasible_json(tmp_path / "feasible.json", robot)
+    q, dq, ddq = random_states(robot, 1, seed=302)
+    vec = lambda v: ",".join(repr(float(x)) for x in v)  # noqa: E731
+    argv = ["predict", "--params", str(path), f"--q={vec(q[0])}", f"--dq={vec(dq[0])}"]
+    assert main([*argv, f"--ddq={vec(ddq[0])}", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    np.testing.assert_allclose(d["M"], dynid.mass_matrix(robot, q[0]), atol=1e-12)
+    np.testing.assert_allclose(d["tau"], dynid.rnea(robot, q[0], dq[0], ddq[0]), atol=1e-10)
+    ia = np.linspace(0.1, 0.4, 7)
+    drive = dataclasses.replace(Drive.identity(7), rotor_inertia=ia)
+    got = model_terms(robot, q[0], dq[0], ddq[0], drive)
+    np.testing.assert_allclose(got["M"], dynid.mass_matrix(robot, q[0]) + np.diag(ia), atol=1e-12)
+    want = dynid.rnea(robot, q[0], dq[0], ddq[0]) + ia * ddq[0]
+    np.testing.assert_allclose(got["tau"], want, atol=1e-10)
+    assert main(["predict", "--model", str(path), f"--q={vec(q[0])}"]) == 2  # the schema said
+    assert capsys.readouterr().err.rstrip().endswith("hint: --params reads feasible.json")
+
+
 def test_npz_route_and_pruning_option(tmp_path, capsys):
     """acquire-static to .npz with noise, identify with --max-std-percent: pruned ones recorded."""
     npz = tmp_path / "static.npz"

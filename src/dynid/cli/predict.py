@@ -1,10 +1,11 @@
 """Evaluate an identified model: M(q), g(q), and c(q, dq), tau(q, dq, ddq) when given.
 
-Reads DIR/identification.json (from `dynid identify`) and evaluates, at one state,
-M [kg m^2] and g [N m]; with --dq also c [N m] (Coriolis and centrifugal torques); with
---dq and --ddq also tau = M ddq + c + g [N m] (friction not included). Vectors are
-comma-separated, in rad, rad/s, rad/s^2; write --q=-0.1,... when the first value is
-negative.
+Reads DIR/identification.json (from `dynid identify`), or with --params the feasible
+link parameters of feasible.json (from `dynid retrieve` or `identify --consistent`; its
+drive's rotor inertias included), and evaluates, at one state, M [kg m^2] and g [N m];
+with --dq also c [N m] (Coriolis and centrifugal torques); with --dq and --ddq also tau
+= M ddq + c + g [N m] (friction not included). Vectors are comma-separated, in rad,
+rad/s, rad/s^2; write --q=-0.1,... when the first value is negative.
 
 example:
   dynid predict --model result/identification.json --q=0,-0.785,0,-2.356,0,1.571,0.785 --json
@@ -15,8 +16,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..exceptions import DynidError
-from ..io.model_json import load_model_json
+from ..workflows.predict import load_predicting
 from .common import add_subcommand, format_matrix, parse_vector
 from .console import Console
 
@@ -28,7 +28,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = add_subcommand(
         subparsers, NAME, __doc__, help="M, g (and c, tau) of an identified model at one state"
     )
-    p.add_argument("--model", type=Path, required=True, help="identification.json")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--model", type=Path, help="identification.json (dynid identify)")
+    src.add_argument(
+        "--params", type=Path, help="feasible.json (dynid retrieve, identify --consistent)"
+    )
     p.add_argument("--q", required=True, help="joint positions [rad], comma-separated")
     p.add_argument("--dq", default=None, help="joint velocities [rad/s]")
     p.add_argument("--ddq", default=None, help="joint accelerations [rad/s^2] (needs --dq)")
@@ -38,18 +42,11 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Evaluate and print; returns the exit code."""
-    model = load_model_json(args.model)
-    n = model.robot.n
-    q = parse_vector(args.q, "--q", n)
-    out = {"M": model.mass_matrix(q), "g": model.gravity_torques(q)}
-    if args.ddq is not None and args.dq is None:
-        raise DynidError("--ddq needs --dq (tau = M ddq + c + g)")
-    if args.dq is not None:
-        dq = parse_vector(args.dq, "--dq", n)
-        out["c"] = model.coriolis(q, dq)
-        if args.ddq is not None:
-            ddq = parse_vector(args.ddq, "--ddq", n)
-            out["tau"] = model.torques(q, dq, ddq)
+    model = load_predicting(args.model, args.params)
+    q = parse_vector(args.q, "--q", model.n)
+    dq = None if args.dq is None else parse_vector(args.dq, "--dq", model.n)
+    ddq = None if args.ddq is None else parse_vector(args.ddq, "--ddq", model.n)
+    out = model.terms(q, dq, ddq)
     if args.json:
         console.json(out)
         return 0
