@@ -291,6 +291,24 @@ def test_panda_retrieval_is_feasible_with_margin_and_matches_the_coefficients(pa
     assert 16.0 < total < 20.0
 
 
+def test_penalty_retrieval_says_its_implausible_links():
+    """Regression: the penalty method said nothing of implausible links (run on a Panda's
+    coefficients it put 0.158 kg in link 7, under 1 % of 17.3 kg); a link 7 of 0.1 kg in
+    the coefficients (the description's 0.74) is now a note, as the convex method's; the
+    notes name exactly the links under 1 % of the retrieved total."""
+    panda = dynid.panda()
+    m = panda.mass.copy()
+    m[-1] = 0.1
+    model = exact_model(panda, panda.with_inertials(m, panda.com, panda.inertia))
+    res = retrieve(model, options=RetrievalOptions(runs=2), workers=1, seed=0)
+    light = [name for name, x in zip(panda.link_names[1:], res.mass, strict=True)
+             if x < 0.01 * float(np.sum(res.mass))]  # fmt: skip
+    said = [s for s in res.notes if "weighs" in s]
+    assert light == ["link7"] and abs(res.mass[-1] - 0.1) < 0.02, res.mass
+    assert len(said) == 1 and said[0].startswith("implausible: link7 weighs"), said
+    assert said[0].endswith("under 1 % of the total"), said  # the prior's link is not light
+
+
 def test_pruned_coefficients_are_ignored():
     """A coefficient removed by pruning (kept False) does not enter the objective."""
     panda = dynid.panda()

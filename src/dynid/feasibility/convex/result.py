@@ -17,7 +17,7 @@ from ...friction.model import combined
 from ...identification.model import IdentifiedModel
 from ...model.inertia import inertial_from_phi
 from ...model.robot import Robot
-from ..bounds import Bounds, link_points
+from ..bounds import Bounds
 from ..constraints import Constraint, FeasibilityReport, feasibility_report
 from ..heldout import HeldOutJudgement
 from ..lmi import (
@@ -25,6 +25,7 @@ from ..lmi import (
     pseudo_inertia,
     pseudo_inertia_margin,
 )
+from ..plausible import implausible_notes
 from ..prior import Prior
 from ..result import FeasibleResult
 from .data_term import DataTerm
@@ -150,9 +151,9 @@ def _active_and_implausible(
     prior_phi: NDArray[np.float64] | None = None,
 ) -> tuple[list[str], list[str]]:
     """Notes: the bounds the result sits on (they, not the data, decided those values) and
-    links whose mass or size is implausible (:func:`_implausible`; "the prior has it too"
-    when the prior's link, ``prior_phi`` (n, 10), is implausible the same way); and the
-    parameters on a bound, one string each."""
+    links whose mass or size is implausible
+    (:func:`~dynid.feasibility.plausible.implausible_notes`, against the prior's link,
+    ``prior_phi`` (n, 10)); and the parameters on a bound, one string each."""
     out: list[str] = []
     names = robot.link_names[1:]
     act: list[str] = []
@@ -173,55 +174,8 @@ def _active_and_implausible(
                 act.append(f"total mass {M:.4g} kg at the {side} end of its band")
     if act:
         out.append("decided by the bound, not the data: " + "; ".join(act))
-    found = _implausible(robot, m, I)
-    held: list[tuple[str, float, float] | None] = (
-        [None] * robot.n if prior_phi is None else _implausible(robot, *_mass_inertia(prior_phi))
-    )
-    for i, (odd, prior) in enumerate(zip(found, held, strict=True)):
-        if odd is None:
-            continue
-        kind, value, of = odd
-        too = prior[1] if prior is not None and prior[0] == kind else None
-        if kind == "mass":
-            if too is not None and abs(value - too) <= 0.2 * too:  # the description's own
-                continue  # a light last link (a UR10's wrist 3: 0.202 kg of 28) is no finding
-            text = f"implausible: {names[i]} weighs {value:.3g} kg, under 1 % of the total"
-            out.append(text + ("" if too is None else f"; the prior has it too ({too:.3g} kg)"))
-            continue
-        text = (
-            f"implausible: {names[i]} has a radius of gyration of {value:.3g} m about its CoM, "
-            f"more than 1.5 times its extent of {of:.3g} m"
-        )
-        why = " (rotor inertia the link absorbed, or inertia the data cannot see)"
-        out.append(text + (why if too is None else f": the prior has it too ({too:.3g} m)"))
+    out += implausible_notes(robot, m, I, prior_phi)
     return out, act
-
-
-def _mass_inertia(phi: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
-    """Masses (n,) [kg] and inertias about the CoM (n, 3, 3) [kg m^2] of ``phi`` (n, 10)."""
-    m, _, I = inertial_from_phi(phi)
-    return m, I
-
-
-def _implausible(
-    robot: Robot, m: NDArray[np.float64], I: NDArray[np.float64]
-) -> list[tuple[str, float, float] | None]:
-    """Per link, what is implausible: ``("mass", m, M)`` for a link under 1 % of the total
-    mass ``M`` [kg]; ``("gyration", r_g, extent)`` for a radius of gyration about the CoM
-    over 1.5 times the link's extent [m]; None when neither."""
-    M = float(m.sum())
-    lam = np.linalg.eigvalsh(I)
-    out: list[tuple[str, float, float] | None] = []
-    for i in range(robot.n):
-        ext = max(float(np.linalg.norm(np.ptp(link_points(robot, i), axis=0))), 0.05)
-        rg = math.sqrt(max(float(lam[i].sum()), 0.0) / (2.0 * m[i])) if m[i] > 0 else math.inf
-        if m[i] < 0.01 * M:
-            out.append(("mass", float(m[i]), M))
-        elif rg > 1.5 * ext:
-            out.append(("gyration", rg, ext))
-        else:
-            out.append(None)
-    return out
 
 
 def build_result(

@@ -56,9 +56,11 @@ from numpy.typing import NDArray
 
 from ..._parallel import process_pool
 from ...exceptions import InfeasibleError, OptionError
+from ...model.inertia import inertial_from_phi
 from ...model.robot import Robot
 from ..bounds import Bounds
 from ..constraints import Constraint, FeasibilityReport, feasibility_report
+from ..plausible import implausible_notes
 from .objective import (
     PenaltyProblem,
 )
@@ -326,6 +328,9 @@ def solve(
         _log.warning(msg)
         notes = (msg,)
     new_robot = robot.with_inertials(best.p[:, 0], best.p[:, 1:4], best.p[:, 4:])
+    # the masses the data do not give are the optimizer's: say the implausible ones
+    m, _, I = inertial_from_phi(new_robot.phi)
+    notes = (*notes, *implausible_notes(robot, m, I, robot.phi))
     return RetrievalResult(
         robot=new_robot,
         relative_residual=best.relative_residual,
