@@ -100,12 +100,17 @@ def test_the_observer_figure_draws_a_contact_of_three_samples():
     r += ext
     assert r[::10, 1].max() < 5.0  # the stride of the old drawing missed it
     fig = plot_residuals(t, r, np.full_like(r, 2.0), np.full_like(r, 4.0), tau_ext=ext)
+    def drawn(ax, label):  # the line of ``label``, whatever the thresholds drawn before it
+        (line,) = [x for x in ax.lines if x.get_label() == label]
+        return line
+
     for j in range(n):
-        residual, external = fig.axes[j].lines[:2]
+        residual = drawn(fig.axes[j], "residual")
+        external = drawn(fig.axes[j], "true external torque")
         d = np.asarray(residual.get_ydata(), dtype=float)
         assert d.max() == r[:, j].max() and d.min() == r[:, j].min()
         assert np.asarray(external.get_ydata()).max() == ext[:, j].max()
         assert all(np.asarray(line.get_ydata()).size <= 20000 for line in fig.axes[j].lines)
-    line = fig.axes[1].lines[0]
+    line = drawn(fig.axes[1], "residual")
     at = np.asarray(line.get_xdata())[np.argmax(line.get_ydata())]
     assert 54.321 - 1e-6 <= at <= 54.323 + 1e-6  # at its time from the log's start

@@ -1006,9 +1006,23 @@ def identify_recordings(
     warn_unphysical(model, terms)
     heldout = _heldout_record(model, data if validation is None else validation)
     combined = _combined(robot, data, structure, drive, model.base)
+    return _recorded(model, exact, combined, heldout, structure, selection)
+
+
+def _recorded(
+    model: IdentifiedModel,
+    exact: tuple[str, ...],
+    combined: dict[str, str],
+    heldout: Any,
+    structure: Structure,
+    selection: Selection | None,
+) -> IdentifiedModel:
+    """``model`` with its record completed: the note of exact logs (their cut-off source
+    ``"exact"``: validate reads a noisy log's own), the combined coefficients, the held-out
+    record, the warned negative inertias, the terms and the structure's selection."""
     notes = (*exact, *model.info.notes, *warned_negative_inertias(model))
     info = replace(model.info, combined=combined, heldout=heldout, notes=notes)
-    if exact and info.log is not None:  # unfiltered for being exact: validate reads its own
+    if exact and info.log is not None:
         info = replace(info, log=replace(info.log, cutoff_source="exact"))
     extra = {**model.info.extra, "terms": list(structure.terms)}
     info = replace(info, selection=None if selection is None else selection.as_dict(), extra=extra)

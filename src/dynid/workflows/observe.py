@@ -61,7 +61,7 @@ import dataclasses
 import hashlib
 import logging
 import warnings
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -72,6 +72,7 @@ from ..exceptions import DataError, DynidError, DynidWarning, OptionError, Shape
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
+from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.spikes import SPIKES_BEFORE_OBSERVER
 from ..io.columns import ColumnMap
@@ -485,26 +486,8 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         drive=opts.drive,
         snap_angles=opts.snap_angles,
     )
-    given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
-    if given is not None and given.n != model.n:
-        spec = None if opts.params is None else str(opts.params)
-        chain = None if spec is None else default_tip_hint(spec, model.robot, opts.tip)
-        raise OptionError(
-            f"{opts.thresholds}: thresholds for {given.n} joints; the model has {model.n}"
-            + ("" if chain is None else f"; {chain}")
-        )
     fingerprint = model_fingerprint(opts)
-    if given is not None and given.model is not None and given.model.sha256 != fingerprint.sha256:
-        assert opts.thresholds is not None
-        said = friction_difference(opts.thresholds.name, given.model, fingerprint)
-        warnings.warn(
-            said
-            or f"{opts.thresholds.name} was calibrated with {given.model}, not with this "
-            f"model ({fingerprint}): thresholds fit the residual of their own model; "
-            "calibrate again with this one",
-            DynidWarning,
-            stacklevel=2,
-        )
+    given = _given_thresholds(opts, model, fingerprint)
     own = friction_source(opts) if model.friction is not None else None
     options = _observer_options(opts, given)
     wants_std = (
@@ -524,13 +507,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         cal = _calibrated(
             read, model, columns[0] is not None, opts, options, wants_std, wants_margin
         )
-        rates = [r for r in (log_rate(log.t) for log in read.logs) if r is not None]
-        rate = float(np.median(rates)) if rates else None
-        kinds = {bool(log.dq_derived) for log in read.logs}
-        velocities = "mixed" if len(kinds) > 1 else ("derived" if True in kinds else "measured")
-        th = dataclasses.replace(
-            cal.thresholds, model=fingerprint, sample_rate_hz=rate, velocities=velocities
-        )
+        th = _recorded_calibration(cal.thresholds, read.logs, fingerprint)
         return dataclasses.replace(cal, thresholds=th, fingerprint=fingerprint, friction_source=own)
     paths = tuple(map(Path, read.paths))
     logs = []
@@ -544,12 +521,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     if opts.frame is not None:  # an unknown frame, a frame on the base: before any log
         wrench_rank(model.robot, opts.frame, kind)
     assert opts.thresholds is not None
-    for path, log in zip(paths, read.logs, strict=True):
-        name = opts.thresholds.name
-        if (other := rate_mismatch(log_rate(log.t), given, name)) is not None:
-            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=2)
-        if (other := velocity_mismatch(bool(log.dq_derived), given, name)) is not None:
-            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=2)
+    _warn_mismatches(paths, read.logs, given, opts.thresholds.name)
     for k, (path, log) in enumerate(zip(paths, read.logs, strict=True)):
         rows = log.t.shape[0]
         table = None
@@ -587,6 +559,57 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         unmodelled=None if unmodelled is None else unmodelled.result(),
         load=load.result(),
     )  # fmt: skip
+
+
+def _given_thresholds(
+    opts: ObserveOptions, model: ObserverModel, fingerprint: ModelFingerprint
+) -> Thresholds | None:
+    """The thresholds of ``opts.thresholds`` (None: calibrating), refused for another
+    joint count and warned when calibrated with another model."""
+    given = None if opts.thresholds is None else load_thresholds(opts.thresholds)
+    if given is not None and given.n != model.n:
+        spec = None if opts.params is None else str(opts.params)
+        chain = None if spec is None else default_tip_hint(spec, model.robot, opts.tip)
+        raise OptionError(
+            f"{opts.thresholds}: thresholds for {given.n} joints; the model has {model.n}"
+            + ("" if chain is None else f"; {chain}")
+        )
+    if given is not None and given.model is not None and given.model.sha256 != fingerprint.sha256:
+        assert opts.thresholds is not None
+        said = friction_difference(opts.thresholds.name, given.model, fingerprint)
+        warnings.warn(
+            said
+            or f"{opts.thresholds.name} was calibrated with {given.model}, not with this "
+            f"model ({fingerprint}): thresholds fit the residual of their own model; "
+            "calibrate again with this one",
+            DynidWarning,
+            stacklevel=3,
+        )
+    return given
+
+
+def _recorded_calibration(
+    th: Thresholds, logs: Sequence[TorqueLog], fingerprint: ModelFingerprint
+) -> Thresholds:
+    """``th`` with what they were calibrated on: the model, the logs' sample rate [Hz]
+    (the median of theirs) and their velocities (measured, derived or mixed)."""
+    rates = [r for r in (log_rate(log.t) for log in logs) if r is not None]
+    kinds = {bool(log.dq_derived) for log in logs}
+    velocities = "mixed" if len(kinds) > 1 else ("derived" if True in kinds else "measured")
+    rate = float(np.median(rates)) if rates else None
+    return dataclasses.replace(th, model=fingerprint, sample_rate_hz=rate, velocities=velocities)
+
+
+def _warn_mismatches(
+    paths: Sequence[Path], logs: Sequence[TorqueLog], given: Thresholds, name: str
+) -> None:
+    """A warning per log whose sample rate or kind of velocities is not the one the
+    thresholds of the file ``name`` were calibrated on."""
+    for path, log in zip(paths, logs, strict=True):
+        if (other := rate_mismatch(log_rate(log.t), given, name)) is not None:
+            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=3)
+        if (other := velocity_mismatch(bool(log.dq_derived), given, name)) is not None:
+            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=3)
 
 
 def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
