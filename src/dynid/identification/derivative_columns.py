@@ -72,6 +72,9 @@ STILL_SHARE = 0.05
 #: Acceleration columns whose noise at the cut-off exceeds the velocities' derivative's
 #: by this factor (std; 9 times the variance) are left out.
 DDQ_NOISE_RATIO = 3.0
+#: A step of the positions this many robust standard deviations (of the steps' second
+#: differences) off its neighbours and the recorded velocity is a jump (samples lost).
+JUMP_SPREAD = 20.0
 #: Samples read at most (the first ones): enough for a lag to a hundredth of a sample.
 MAX_SAMPLES = 200_000
 
@@ -105,14 +108,23 @@ class VelocityCheck:
 
 
 def _position_derivative(log: TorqueLog, m: int) -> tuple[NDArray[np.float64], float]:
-    """Central differences of the first ``m`` positions [rad/s] (m, n), the rows at a gap
-    or a jump of half a turn or more set to the recorded velocity (not motion), and the
-    median step [s]."""
+    """Central differences of the first ``m`` positions [rad/s] (m, n), the rows at a gap,
+    a jump of half a turn or more, or a jump the recorded velocities do not explain (a
+    stretch of samples lost under even stamps: a step of the positions more than
+    :data:`JUMP_SPREAD` robust standard deviations of the steps' differences from its
+    neighbours' and from the mean recorded velocity) set to the recorded velocity (not
+    motion), and the median step [s]."""
     t, q, dq = log.t[:m], log.q[:m], log.dq[:m]
     dt = float(np.median(np.diff(t)))
     v = np.gradient(q, t, axis=0)
     steps = np.diff(t)
-    bad_step = (steps > 1.5 * dt)[:, None] | (np.abs(np.diff(q, axis=0)) >= np.pi)
+    dqdt = np.diff(q, axis=0) / steps[:, None]
+    r = dqdt - 0.5 * (dq[1:] + dq[:-1])
+    e = np.zeros_like(dqdt)  # a step against its neighbours: a spike, not the motion
+    e[1:-1] = dqdt[1:-1] - 0.5 * (dqdt[:-2] + dqdt[2:])
+    spread = 1.4826 * np.median(np.abs(e), axis=0)
+    jump = (spread > 0) & (np.abs(e) > JUMP_SPREAD * spread) & (np.abs(r) > JUMP_SPREAD * spread)
+    bad_step = (steps > 1.5 * dt)[:, None] | (np.abs(np.diff(q, axis=0)) >= np.pi) | jump
     bad = np.zeros(q.shape, dtype=bool)
     bad[1:] |= bad_step
     bad[:-1] |= bad_step
@@ -181,14 +193,18 @@ def velocity_finding(log: TorqueLog, joint_names: tuple[str, ...] | None = None)
             f"{_joints(found.still, joint_names)}, whose positions move"
         )
     if found.lag_joints and abs(found.lag_samples) >= MAX_LAG_SAMPLES:
-        late = "lag" if found.lag_samples > 0 else "lead"
+        late = found.lag_samples > 0
         size = abs(found.lag_samples)
         at = f"at least {size:.0f}" if found.at_edge else f"{size:.2f}"
+        cause = (
+            "a logger writing an earlier sample's velocity, or a filtered estimate's delay"
+            if late
+            else "positions logged late against their velocities"
+        )
         parts.append(
-            f"its velocity columns {late} the derivative of its positions by {at} "
-            f"sample(s) ({size * found.dt * 1e3:.3g} ms, read on "
-            f"{_joints(found.lag_joints, joint_names)}): a logger writing an earlier "
-            "sample's velocity, or a filtered estimate's delay; not a torque delay"
+            f"its velocity columns {'lag' if late else 'lead'} the derivative of its "
+            f"positions by {at} sample(s) ({size * found.dt * 1e3:.3g} ms, read on "
+            f"{_joints(found.lag_joints, joint_names)}): {cause}; not a torque delay"
         )
     if not parts:
         return None
