@@ -8,7 +8,8 @@ ways a logger breaks that, each found here on the log as read (SI, joint order):
   causal velocity filter's delay): the lag ``L`` [samples] at which ``dq[i]`` matches the
   central difference of ``q`` at ``i - L`` best, over the joints that move
   (:func:`velocity_lag`: the normalized cross-correlation of the two, both low-passed at
-  :data:`LAG_FILTER_SHARE` of the rate by one zero-phase filter, which shifts neither,
+  :data:`LAG_FILTER_SHARE` of the rate (at least :data:`LAG_FILTER_MIN_HZ`, at most a
+  fifth of the rate) by one zero-phase filter, which shifts neither,
   over ``|s| <= MAX_SHIFT`` samples; the peak refined to a fraction of a sample by the
   parabola through its neighbours). A lag of :data:`MAX_LAG_SAMPLES` or more is refused
   (:func:`velocity_finding`): a one-sample lag at 1 kHz turned six of the 43 base
@@ -18,7 +19,8 @@ ways a logger breaks that, each found here on the log as read (SI, joint order):
   noisy 20 s log errs by a few hundredths of a sample;
 * **velocity columns that hold no motion** (zeros written where the velocity was not
   logged, or a constant): joints whose positions move while their ``dq`` varies by less
-  than :data:`STILL_SHARE` of the positions' derivative (:func:`velocity_finding`);
+  than :data:`STILL_SHARE` of the positions' derivative, both low-passed as above
+  (:func:`velocity_finding`);
 * **acceleration columns noisier than the derivative of the velocities**
   (:func:`acceleration_noise_ratio`): a finite difference of noisy velocities logged as
   ``ddq`` holds the noise of the velocities times ``1 / dt``; the identification would
@@ -44,10 +46,11 @@ from .. import signals
 from .input_noise import derived_noise_gains, quantized_noise_std
 from .log import TorqueLog
 from .rate import cutoff_from_motion
-from .velocity_noise import at_round_off, moving_joints
+from .velocity_noise import at_round_off, moving_joints, velocity_noise_std
 
 __all__ = [
     "DDQ_NOISE_RATIO",
+    "LAG_FILTER_MIN_HZ",
     "LAG_FILTER_SHARE",
     "MAX_LAG_SAMPLES",
     "MAX_SHIFT",
@@ -66,6 +69,9 @@ MAX_LAG_SAMPLES = 0.75
 #: The cut-off of the filter both signals pass before the lag is read, as a share of the
 #: rate (at 1 kHz: 50 Hz; a shift commutes with the filter).
 LAG_FILTER_SHARE = 0.05
+#: The filter's cut-off [Hz] at least (a fifth of the rate at most): a slow log's motion
+#: kept (at 100 Hz: 20 Hz, not 5).
+LAG_FILTER_MIN_HZ = 20.0
 #: A joint whose velocity column varies by less than this share of its positions'
 #: derivative (standard deviations) holds no motion.
 STILL_SHARE = 0.05
@@ -144,17 +150,20 @@ def velocity_lag(log: TorqueLog) -> VelocityCheck | None:
     if not (dt > 0 and np.all(np.isfinite(v))):
         return None
     dq = np.asarray(log.dq[:m], dtype=np.float64)
-    moves = moving_joints(v)
-    sd_v = v.std(axis=0)
-    sd_dq = dq.std(axis=0)
-    still = moves & (sd_dq < STILL_SHARE * sd_v)
-    use = moves & ~still
-    found = tuple(int(j) for j in np.flatnonzero(still))
-    if not use.any():
+    fs = 1.0 / dt  # both filtered alike: the noise of q's differences out
+    fc = max(LAG_FILTER_SHARE * fs, min(LAG_FILTER_MIN_HZ, 0.2 * fs))
+    vf = signals.lowpass(v, fs, fc)
+    moves = moving_joints(vf, velocity_noise_std(v) * signals.lowpass_noise_gain(fs, fc))
+    if not moves.any():
+        return VelocityCheck(float("nan"), dt, (), ())
+    a = signals.lowpass(dq[:, moves], fs, fc)
+    b = vf[:, moves]
+    flat = a.std(axis=0) < STILL_SHARE * b.std(axis=0)
+    joints = np.flatnonzero(moves)
+    found = tuple(int(j) for j in joints[flat])
+    if flat.all():
         return VelocityCheck(float("nan"), dt, (), found)
-    fc = LAG_FILTER_SHARE / dt
-    a = signals.lowpass(dq[:, use], 1.0 / dt, fc)
-    b = signals.lowpass(v[:, use], 1.0 / dt, fc)
+    a, b, joints = a[:, ~flat], b[:, ~flat], joints[~flat]
     a, b = a[shift:-shift], b  # dq[i] against v[i - s], s in [-shift, shift]
     k = a.shape[0]
     na = np.sqrt(np.sum(a * a, axis=0))
@@ -171,8 +180,7 @@ def velocity_lag(log: TorqueLog) -> VelocityCheck | None:
         den = y0 - 2.0 * y1 + y2
         if den < 0:
             lag += 0.5 * (y0 - y2) / den
-    joints = tuple(int(j) for j in np.flatnonzero(use))
-    return VelocityCheck(lag, dt, joints, found, edge)
+    return VelocityCheck(lag, dt, tuple(int(j) for j in joints), found, edge)
 
 
 def _joints(joints: tuple[int, ...], names: tuple[str, ...] | None) -> str:
