@@ -598,7 +598,9 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         metavar="MAP|FILE.toml",
         help="column names of --data: 'q=position_{i0},tau=effort_{i0}' ({i} from 1, {i0} "
         "from 0) or a TOML file with [columns] and [units]; positions only: velocities "
-        "from the zero-phase filtered derivative",
+        "from the zero-phase filtered derivative; dq=none reads the log without its velocity "
+        "(and acceleration) columns, derived from the positions instead; ddq=none without "
+        "its acceleration columns",
     )
     p.add_argument(
         "--units",

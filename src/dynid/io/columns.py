@@ -20,6 +20,12 @@ A :class:`ColumnMap` names, per quantity, the column template of a file and its 
   name, ``rec2.csv:tau4=-1``, it flips that joint in that file only (a recording logged
   with another convention among several).
 
+* ``none`` for ``dq`` or ``ddq`` reads the log without those columns, present or not
+  (``--columns dq=none``): velocities derived from the positions as for a log without
+  them (recorded velocities that lag the positions, or zeros written where they were not
+  logged); ``dq=none`` leaves out the acceleration columns too (derived from the derived
+  velocities), ``ddq=none`` those alone (a finite difference of noisy velocities).
+
 Written on the command line as ``--columns 'q=position_{i0},tau=effort_{i0}'`` and
 ``--units 'q=deg,tau=mNm'``, or as a TOML file with tables ``[columns]`` and ``[units]``.
 
@@ -62,6 +68,8 @@ from .torque_log import LABEL_COLUMNS, _where
 
 __all__ = [
     "CURRENT_UNITS",
+    "IGNORED",
+    "LEFT_OUT",
     "LABEL_COLUMNS",
     "ColumnMap",
     "MappedLog",
@@ -87,6 +95,12 @@ _DEFAULT = {
     "g": "g{i}",
     "label": "label",
 }
+#: The template that reads a log without a quantity's columns (``--columns dq=none``).
+IGNORED = "none"
+#: What a note says of a log read with ``dq=none`` (rather than "no velocity columns").
+LEFT_OUT = "velocity columns left out (--columns dq=none)"
+#: The quantities :data:`IGNORED` applies to.
+_IGNORABLE = ("dq", "ddq")
 _TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3}
 _TORQUE = {"Nm": 1.0, "N m": 1.0, "N": 1.0, "mNm": 1e-3, "mN m": 1e-3}
@@ -162,6 +176,13 @@ class ColumnMap:
         for key in list(self.columns) + list(self.factors):
             if key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
+        for key, tpl in self.columns.items():
+            if str(tpl).strip().lower() == IGNORED and key not in _IGNORABLE:
+                raise DataError(
+                    f"{key}={tpl}: only the recorded derivatives can be left out "
+                    f"({', '.join(f'{k}={IGNORED}' for k in _IGNORABLE)}); {key!r} is read "
+                    "from its columns"
+                )
         own = [*(k for f in self.file_flips.values() for k in f), *chain(*self.file_signs.values())]
         for key in [*self.flips, *own]:
             if key not in _FLIPPABLE:
@@ -292,6 +313,12 @@ class ColumnMap:
     def mapped(self, quantity: str) -> bool:
         """Whether the quantity was given a template."""
         return quantity in self.columns
+
+    def ignored(self, quantity: str) -> bool:
+        """Whether the log is read without the columns of ``quantity`` (``dq=none``;
+        ``ddq`` also with ``dq=none``: accelerations from the derived velocities)."""
+        said = {k for k, v in self.columns.items() if str(v).strip().lower() == IGNORED}
+        return quantity in said or (quantity == "ddq" and "dq" in said)
 
 
 #: The quantities whose single joints' columns ``--units`` can flip (``tau2=-1``).
@@ -587,6 +614,8 @@ def _check_distinct(table: _Table, cmap: ColumnMap, quantities: tuple[str, ...],
     (``tau = "q{i}"``: the positions were read as torques too)."""
     owner: dict[str, str] = {}
     for quantity in quantities:
+        if cmap.ignored(quantity):
+            continue
         tpl = cmap.template(quantity)
         if "{" not in tpl:
             names = [tpl]
@@ -680,7 +709,7 @@ def load_mapped_torque_log(
     -------
     MappedLog
         The cleaned log; velocities from the filtered derivative of the positions when the
-        file has none (said in ``notes``).
+        file has none or the map leaves them out (``dq=none``; said in ``notes``).
 
     Raises
     ------
@@ -702,8 +731,8 @@ def load_mapped_torque_log(
     q = _need(table, columns, "q", n)
     n = q.shape[1]
     tau = _need(table, columns, "tau", n)
-    dq = _vector(table, columns, "dq", n)
-    ddq = _vector(table, columns, "ddq", n)
+    dq = None if columns.ignored("dq") else _vector(table, columns, "dq", n)
+    ddq = None if columns.ignored("ddq") else _vector(table, columns, "ddq", n)
     _check_distinct(table, columns, ("t", "q", "dq", "tau", "ddq"), n)
     said = conversion_notes(
         columns, [k for k in _DEFAULT if k in {**columns.factors, **columns.flips}]
@@ -722,6 +751,8 @@ def load_mapped_torque_log(
     except DataError as exc:
         raise DataError(str(exc), file=path.name) from exc
     notes = (velocity_note(columns.velocity_cutoff_hz),)
+    if columns.ignored("dq"):
+        notes = (notes[0].replace("no velocity columns", LEFT_OUT, 1),)
     try:
         log = with_derived_velocities(raw, columns.velocity_cutoff_hz)
     except DataError as exc:  # a rate too low for the cut-off: the file named

@@ -96,6 +96,7 @@ from .recordings import (
     check_torque_unit,
     check_unit_findings,
     check_units,
+    checked_accelerations,
     given_start,
     unwrapped_recorded,
 )
@@ -767,6 +768,7 @@ def _read_logs(
         for p in paths
     ]
     names = [p.name for p in paths]
+    logs = list(checked_accelerations(logs, names, velocity_cutoff(opt.cutoff_hz)))
     logs = list(given_start(logs, names, robot, opt.drive, opt.q_start, opt.max_gap_s))
     held: list[tuple[TorqueLog, Path]] = []
     if heldout is not None and opt.validate_on is not None:

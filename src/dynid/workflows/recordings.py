@@ -11,6 +11,15 @@ line naming the file, never a recording dropped silently:
 * a time column in ms, us or ns (:func:`~dynid.identification.angle_time_units.time_unit_finding`)
   and positions in degrees, checked together (:func:`check_unit_findings`): one error
   naming the file, every unit found and one hint, ``--units t=ms,q=deg``;
+* a recording whose velocity columns lag the derivative of its positions (by 0.75 sample
+  or more) or hold no motion (zeros, a constant) on joints whose positions move
+  (:func:`check_velocity_columns`, from :func:`check_units`, so on every route): an error
+  naming it, the joints and the lag in samples and ms, with the remedy ``--columns
+  dq=none`` (velocities derived from the positions);
+* acceleration columns much noisier than the derivative of the velocities at the cut-off
+  (a finite difference of noisy velocities): left out, with a note naming the file and the
+  ratio; a note says whenever acceleration columns are used
+  (:func:`checked_accelerations`);
 * a recording in other units than the others (its torques, or its velocities against the
   derivative of its positions on the joints that move, a power of ten away from the other
   recordings'): an error naming it (a recording at rest, or without velocity columns, has
@@ -52,6 +61,11 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError, DynidWarning, OptionError
+from ..identification.derivative_columns import (
+    DDQ_NOISE_RATIO,
+    acceleration_noise_ratio,
+    velocity_finding,
+)
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, velocity_note
 from ..identification.model_sign import sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
@@ -65,7 +79,7 @@ from ..identification.unit_mix import (
     unit_findings,
 )
 from ..identification.velocity_noise import moving_joints
-from ..io.columns import CURRENT_UNITS, ColumnMap, parse_column_map
+from ..io.columns import CURRENT_UNITS, LEFT_OUT, ColumnMap, parse_column_map
 from ..io.torque_log import declared_tau_unit
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -86,6 +100,8 @@ __all__ = [
     "Recorded",
     "check_degrees",
     "check_derived_velocities",
+    "check_velocity_columns",
+    "checked_accelerations",
     "check_limits",
     "check_signs",
     "sign_findings",
@@ -233,6 +249,7 @@ def read_recordings(
         )
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
+    logs = checked_accelerations(logs, [p.name for p in paths], cutoff_hz)
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths), drive)
     checked = unwrapped_recorded(out, robot, max_gap_s)  # as the preparation reads them
@@ -357,18 +374,82 @@ def _scales(log: TorqueLog) -> tuple[float, float]:
     return rms, num / den if den > 0 else float("nan")
 
 
+def check_velocity_columns(rec: Recorded) -> None:
+    """Refuse a recording whose velocity columns lag the derivative of its positions or
+    hold no motion on joints whose positions move
+    (:func:`~dynid.identification.derivative_columns.velocity_finding`), naming it, the
+    joints and the lag [samples, ms], with the remedy ``--columns dq=none``. ``rec`` as the
+    preparation reads it (:func:`unwrapped_recorded`).
+
+    Raises
+    ------
+    DataError
+        The first such recording, named.
+    """
+    for name, log in zip(rec.names, rec.logs, strict=True):
+        if (found := velocity_finding(log)) is not None:
+            raise DataError(found, file=name)
+
+
+def checked_accelerations(
+    logs: Sequence[TorqueLog], names: Sequence[str], cutoff_hz: float | None = None
+) -> tuple[TorqueLog, ...]:
+    """The logs with acceleration columns noisier than the derivative of their velocities
+    at ``cutoff_hz`` [Hz] (None: the motion's, ``identify``'s default) by more than
+    :data:`~dynid.identification.derivative_columns.DDQ_NOISE_RATIO` on some joint
+    (:func:`~dynid.identification.derivative_columns.acceleration_noise_ratio`) left out,
+    the accelerations derived from the velocities instead, with a note naming each and the
+    ratio; a note names the logs whose acceleration columns are used (exact to round-off,
+    or no noisier than that): without it nothing said a recorded ``ddq`` was read."""
+    out, used = [], []
+    for name, log in zip(names, logs, strict=True):
+        if log.ddq is None:
+            out.append(log)
+            continue
+        ratio = acceleration_noise_ratio(log, cutoff_hz)
+        worst = float(np.max(ratio)) if ratio is not None and ratio.size else 0.0
+        if worst > DDQ_NOISE_RATIO:
+            _log.log(
+                NOTE,
+                "%s: acceleration columns left out: their noise is %.3g times that of the "
+                "derivative of the velocities at the cut-off (above %g: a finite difference "
+                "of noisy velocities?); accelerations derived from the velocities",
+                name,
+                worst,
+                DDQ_NOISE_RATIO,
+            )
+            out.append(dataclasses.replace(log, ddq=None))
+            continue
+        used.append(name)
+        out.append(log)
+    if used:
+        which = ", ".join(used) if len(used) <= 4 else f"{len(used)} recordings ({used[0]}, ...)"
+        _log.log(
+            NOTE,
+            "%s: acceleration columns used as recorded (exact, or no noisier than %g times "
+            "the derivative of the velocities); --columns ddq=none derives them instead",
+            which,
+            DDQ_NOISE_RATIO,
+        )
+    return tuple(out)
+
+
 def check_units(rec: Recorded) -> None:
-    """Refuse a recording whose torque scale or velocity unit is a power of ten away from
-    the median of the other recordings' (several recordings only; of two, the second is
-    named). The velocity unit is compared among the recordings with velocity columns
-    only: velocities derived from the positions are their derivative by construction.
+    """Refuse a recording whose velocity columns lag its positions or hold no motion
+    (:func:`check_velocity_columns`); then one whose torque scale or velocity unit is a
+    power of ten away from the median of the other recordings' (several recordings only;
+    of two, the second is named). The velocity unit is compared among the recordings with
+    velocity columns only: velocities derived from the positions are their derivative by
+    construction.
     ``rec`` as the preparation reads it (:func:`unwrapped_recorded`).
 
     Raises
     ------
     DataError
-        Naming the recording, the ratio and the recordings it was compared with.
+        Naming the recording, the ratio and the recordings it was compared with; or its
+        velocity columns' finding.
     """
+    check_velocity_columns(rec)
     if len(rec.logs) < 2:
         return
     scales = np.array([_scales(log) for log in rec.logs])
@@ -407,7 +488,10 @@ def check_derived_velocities(rec: Recorded, cmap: ColumnMap | None = None) -> No
         return
     cutoff = DEFAULT_CUTOFF_HZ if cmap is None else cmap.velocity_cutoff_hz
     which = ", ".join(names) if len(names) <= 4 else f"{len(names)} recordings ({names[0]}, ...)"
-    _log.log(NOTE, "%s: %s", which, velocity_note(cutoff))
+    said = velocity_note(cutoff)
+    if cmap is not None and cmap.ignored("dq"):
+        said = said.replace("no velocity columns", LEFT_OUT, 1)
+    _log.log(NOTE, "%s: %s", which, said)
 
 
 def check_unit_findings(rec: Recorded, robot: Robot) -> None:
