@@ -100,6 +100,7 @@ def test_the_observer_figure_draws_a_contact_of_three_samples():
     r += ext
     assert r[::10, 1].max() < 5.0  # the stride of the old drawing missed it
     fig = plot_residuals(t, r, np.full_like(r, 2.0), np.full_like(r, 4.0), tau_ext=ext)
+
     def drawn(ax, label):  # the line of ``label``, whatever the thresholds drawn before it
         (line,) = [x for x in ax.lines if x.get_label() == label]
         return line
