@@ -25,7 +25,7 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 import dynid
-from dynid.exceptions import DataError
+from dynid.exceptions import DataError, DynidWarning
 from dynid.identification.derivative_columns import (
     DDQ_NOISE_RATIO,
     MAX_LAG_SAMPLES,
@@ -77,58 +77,59 @@ def test_clean_and_known_lags_are_read_to_a_fraction_of_a_sample(sim):
 
 
 @pytest.mark.parametrize("k", [1, 10])
-def test_lagging_velocities_are_refused_naming_the_lag(sim, tmp_path, k):
-    """Velocity columns one or ten samples late are refused in one line naming the file,
-    the lag in samples and ms and the remedy; read with --columns dq=none the log's
-    velocities are the ones derived from its positions (those of the clean log so read,
-    bit for bit)."""
+def test_lagging_velocities_are_derived_again_naming_the_lag(sim, tmp_path, k):
+    """Velocity columns one or ten samples late: one warning naming the file, the lag in
+    samples and ms, and that the velocities are derived from the positions instead; the
+    log read is then the one --columns dq=none reads (the clean log's so read, bit for
+    bit)."""
     panda, _, g = sim
     path = save_torque_log(tmp_path / "lag.csv", TorqueLog(g.t, g.q, _lagged(g.dq, k), g.tau))
-    with pytest.raises(DataError) as exc:
-        read_recordings([path], panda)
-    msg = str(exc.value)
-    assert msg.startswith("lag.csv: ") and "\n" not in msg
-    assert f"lag the derivative of its positions by {k}.0" in msg, msg
-    assert f"({k * 1000 / FS:.3g} ms" in msg and "--columns dq=none" in msg
-    assert "not a torque delay" in msg
+    with pytest.warns(DynidWarning) as said:
+        got = read_recordings([path], panda).logs[0]
+    msg = [str(w.message) for w in said if "velocity columns" in str(w.message)]
+    assert len(msg) == 1 and msg[0].startswith("lag.csv: ") and "\n" not in msg[0], msg
+    assert f"lag the derivative of its positions by {k}.0" in msg[0], msg
+    assert f"({k * 1000 / FS:.3g} ms" in msg[0] and "not a torque delay" in msg[0]
+    assert "velocities derived from the positions instead" in msg[0]
     clean = save_torque_log(tmp_path / "clean.csv", TorqueLog(g.t, g.q, g.dq, g.tau))
-    got = read_recordings([path], panda, columns=("dq=none", None)).logs[0]
     ref = read_recordings([clean], panda, columns=("dq=none", None)).logs[0]
-    assert got.dq_derived and ref.dq_derived
+    assert got.dq_derived and ref.dq_derived and got.ddq is None
     np.testing.assert_array_equal(got.dq, ref.dq)
 
 
 @pytest.mark.parametrize("joints", [tuple(range(7)), (4, 5, 6)])
-def test_velocity_columns_of_zeros_are_refused_naming_the_joints(sim, tmp_path, joints):
-    """Velocity columns of zeros (every joint, or joints 5-7) while the positions move are
-    refused naming exactly those joints and the remedy; a constant column too."""
+def test_velocity_columns_of_zeros_are_derived_again_naming_the_joints(sim, tmp_path, joints):
+    """Velocity columns of zeros (every joint, or joints 5-7) while the positions move: a
+    warning naming exactly those joints, the velocities derived from the positions; a
+    constant column is found too."""
     panda, _, g = sim
     dq = g.dq.copy()
     dq[:, list(joints)] = 0.0
     path = save_torque_log(tmp_path / "zero.csv", TorqueLog(g.t, g.q, dq, g.tau))
-    with pytest.raises(DataError) as exc:
-        read_recordings([path], panda)
-    msg = str(exc.value)
+    with pytest.warns(DynidWarning) as said:
+        got = read_recordings([path], panda).logs[0]
+    msg = " ".join(str(w.message) for w in said)
     named = ", ".join(f"joint {j + 1}" for j in joints)
     assert f"hold no motion (zero or constant) on {named}, whose positions move" in msg, msg
-    assert "--columns dq=none" in msg and "lag" not in msg
+    assert "velocities derived from the positions instead" in msg and "lag the" not in msg
+    assert got.dq_derived
     dq[:, 2] = 0.7
     found = velocity_lag(TorqueLog(g.t, g.q, dq, g.tau))
     assert found is not None and found.still == tuple(sorted({2, *joints}))
 
 
-def test_the_remedy_fits_as_the_clean_log(sim, tmp_path):
-    """identify refuses the one-sample lag; with --columns dq=none its fit is the clean
-    log's (recorded velocities) within 3 std on every base parameter, and the one of the
-    clean log read with dq=none bit for bit (same positions)."""
+def test_a_lagging_log_fits_as_the_clean_log(sim, tmp_path):
+    """identify on the one-sample lag (its velocities derived again, said) fits as the
+    clean log read with dq=none bit for bit, and as the clean log's recorded velocities
+    within 3 std on every base parameter."""
     panda, _, g = sim
     lag = save_torque_log(tmp_path / "lag.csv", TorqueLog(g.t, g.q, _lagged(g.dq, 1), g.tau))
     clean = save_torque_log(tmp_path / "clean.csv", TorqueLog(g.t, g.q, g.dq, g.tau))
-    with pytest.raises(DataError, match="lag.csv: its velocity columns lag"):
-        identify_files(panda, [lag], IdentifyOptions(terms="viscous"))
-    opt = IdentifyOptions(terms="viscous", columns=("dq=none", None))
-    fixed = identify_files(panda, [lag], opt).model.fit
-    same = identify_files(panda, [clean], opt).model.fit
+    with pytest.warns(DynidWarning, match="lag.csv: its velocity columns lag"):
+        fixed = identify_files(panda, [lag], IdentifyOptions(terms="viscous")).model.fit
+    same = identify_files(
+        panda, [clean], IdentifyOptions(terms="viscous", columns=("dq=none", None))
+    ).model.fit
     ref = identify_files(panda, [clean], IdentifyOptions(terms="viscous")).model.fit
     np.testing.assert_array_equal(fixed.beta, same.beta)
     sd = np.hypot(fixed.std, ref.std)

@@ -11,9 +11,10 @@ ways a logger breaks that, each found here on the log as read (SI, joint order):
   :data:`LAG_FILTER_SHARE` of the rate (at least :data:`LAG_FILTER_MIN_HZ`, at most a
   fifth of the rate) by one zero-phase filter, which shifts neither,
   over ``|s| <= MAX_SHIFT`` samples; the peak refined to a fraction of a sample by the
-  parabola through its neighbours). A lag of :data:`MAX_LAG_SAMPLES` or more is refused
-  (:func:`velocity_finding`): a one-sample lag at 1 kHz turned six of the 43 base
-  parameters of a simulated FR3 more than 3 std from the truth, ten samples 33 of them,
+  parabola through its neighbours). A lag of :data:`MAX_LAG_SAMPLES` or more is a finding
+  (:func:`velocity_finding`; the velocities are then derived from the positions): a
+  one-sample lag at 1 kHz turned six of the 43 base parameters of a simulated FR3 more
+  than 3 std from the truth, ten samples 33 of them,
   read by the fit as a torque delay. Half a sample (a backward difference ``(q[i] -
   q[i-1]) / dt`` logged as ``dq[i]``, a common convention) passes; the estimate on a
   noisy 20 s log errs by a few hundredths of a sample;
@@ -63,7 +64,7 @@ __all__ = [
 
 #: Shifts [samples] searched each way for the velocities' lag.
 MAX_SHIFT = 40
-#: A lag of the velocities [samples] from which they are refused (half a sample, a
+#: A lag of the velocities [samples] from which they are not used (half a sample, a
 #: backward difference, passes).
 MAX_LAG_SAMPLES = 0.75
 #: The cut-off of the filter both signals pass before the lag is read, as a share of the

@@ -99,6 +99,7 @@ from .recordings import (
     checked_accelerations,
     given_start,
     unwrapped_recorded,
+    usable_velocities,
 )
 
 __all__ = [
@@ -768,6 +769,7 @@ def _read_logs(
         for p in paths
     ]
     names = [p.name for p in paths]
+    logs = list(usable_velocities(logs, names))
     logs = list(checked_accelerations(logs, names, velocity_cutoff(opt.cutoff_hz)))
     logs = list(given_start(logs, names, robot, opt.drive, opt.q_start, opt.max_gap_s))
     held: list[tuple[TorqueLog, Path]] = []

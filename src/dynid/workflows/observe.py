@@ -131,6 +131,7 @@ from .recordings import (
     despiked_recordings,
     given_start,
     unwrapped_recorded,
+    usable_velocities,
 )
 
 __all__ = [
@@ -714,6 +715,7 @@ def _read_logs(
         for p in map(Path, paths)
     ]
     names = [Path(p).name for p in paths]
+    logs = list(usable_velocities(logs, names))
     logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
     read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
     checked = unwrapped_recorded(read, model.robot, opts.max_gap)  # as prepared_log reads

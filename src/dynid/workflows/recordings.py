@@ -13,9 +13,10 @@ line naming the file, never a recording dropped silently:
   naming the file, every unit found and one hint, ``--units t=ms,q=deg``;
 * a recording whose velocity columns lag the derivative of its positions (by 0.75 sample
   or more) or hold no motion (zeros, a constant) on joints whose positions move
-  (:func:`check_velocity_columns`, from :func:`check_units`, so on every route): an error
-  naming it, the joints and the lag in samples and ms, with the remedy ``--columns
-  dq=none`` (velocities derived from the positions);
+  (:func:`usable_velocities`, as each route reads its logs): a warning naming it, the
+  joints and the lag in samples and ms, and its velocities derived from the positions
+  instead, as ``--columns dq=none`` reads it (:func:`check_velocity_columns`, from
+  :func:`check_units`, refuses a log that still has such columns);
 * acceleration columns much noisier than the derivative of the velocities at the cut-off
   (a finite difference of noisy velocities): left out, with a note naming the file and the
   ratio; a note says whenever acceleration columns are used
@@ -66,7 +67,13 @@ from ..identification.derivative_columns import (
     acceleration_noise_ratio,
     velocity_finding,
 )
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, velocity_note
+from ..identification.log import (
+    DEFAULT_CUTOFF_HZ,
+    TorqueLog,
+    joint_side_log,
+    velocity_note,
+    with_derived_velocities,
+)
 from ..identification.model_sign import sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
 from ..identification.recorded_signs import SignFinding, recording_sign_findings
@@ -101,6 +108,7 @@ __all__ = [
     "check_degrees",
     "check_derived_velocities",
     "check_velocity_columns",
+    "usable_velocities",
     "checked_accelerations",
     "check_limits",
     "check_signs",
@@ -249,6 +257,7 @@ def read_recordings(
         )
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
+    logs = usable_velocities(logs, [p.name for p in paths])
     logs = checked_accelerations(logs, [p.name for p in paths], cutoff_hz)
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths), drive)
@@ -389,6 +398,34 @@ def check_velocity_columns(rec: Recorded) -> None:
     for name, log in zip(rec.names, rec.logs, strict=True):
         if (found := velocity_finding(log)) is not None:
             raise DataError(found, file=name)
+
+
+def usable_velocities(logs: Sequence[TorqueLog], names: Sequence[str]) -> tuple[TorqueLog, ...]:
+    """The logs whose velocity columns lag the derivative of their positions or hold no
+    motion where the positions move
+    (:func:`~dynid.identification.derivative_columns.velocity_finding`) read as
+    ``--columns dq=none`` reads them: the velocities derived from the positions, the
+    acceleration columns left out, with a warning naming the file and the finding. A real
+    arm's log is then fitted, not refused: a logger whose velocities are a filtered
+    estimate a few samples late is common, and its positions give what it lost (a one-sample
+    lag at 1 kHz: 6 of 43 base parameters of a simulated FR3 beyond 3 std of the truth; 0
+    with the velocities derived)."""
+    out = []
+    for name, log in zip(names, logs, strict=True):
+        found = velocity_finding(log)
+        if found is None:
+            out.append(log)
+            continue
+        said = found.split("; hint:")[0]
+        warnings.warn(
+            f"{name}: {said}: velocities derived from the positions instead, as --columns "
+            "dq=none reads the log (its acceleration columns left out too)",
+            DynidWarning,
+            stacklevel=3,
+        )
+        positions = TorqueLog(log.t, log.q, log.dq, log.tau, None, log.cleaning)
+        out.append(with_derived_velocities(positions, DEFAULT_CUTOFF_HZ))
+    return tuple(out)
 
 
 def checked_accelerations(
