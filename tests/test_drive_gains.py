@@ -88,6 +88,9 @@ def test_known_factors_come_back_within_their_noise(panda):
     assert relative is not None and not relative.scaled
     ratio = relative.factor / relative.factor[0]
     np.testing.assert_allclose(ratio[[1, 3, 5]], truth[[1, 3, 5]], rtol=0.02)
+    # at the scale of the motors it does not name (they were right): the factors to apply
+    assert relative.named == (1, 3, 5)
+    np.testing.assert_allclose(relative.factor[[1, 3, 5]], truth[[1, 3, 5]], rtol=0.02)
     words = dataclasses.replace(relative, effort="current", per="motor").sentence()
     assert words is not None and "relative to each other" in words and "motor 2's by" in words
 
