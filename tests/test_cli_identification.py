@@ -124,6 +124,8 @@ def test_predict_json_gives_m_g_and_with_dq_ddq_c_tau(identified, capsys):
     assert main(["predict", "--model", model, f"--q={vec(q[0])}"]) == 0
     text = capsys.readouterr().out
     assert "M(q) [kg m^2]" in text and "g(q) [N m]" in text
+    assert main(["predict", "--params", model, f"--q={vec(q[0])}"]) == 2  # the other file
+    assert capsys.readouterr().err.rstrip().endswith("hint: --model reads identification.json")
 
 
 def test_predict_takes_feasible_parameters(tmp_path, capsys):

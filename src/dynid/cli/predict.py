@@ -1,11 +1,12 @@
 """Evaluate an identified model: M(q), g(q), and c(q, dq), tau(q, dq, ddq) when given.
 
-Reads DIR/identification.json (from `dynid identify`), or with --params the feasible
-link parameters of feasible.json (from `dynid retrieve` or `identify --consistent`; its
-drive's rotor inertias included), and evaluates, at one state, M [kg m^2] and g [N m];
-with --dq also c [N m] (Coriolis and centrifugal torques); with --dq and --ddq also tau
-= M ddq + c + g [N m] (friction not included). Vectors are comma-separated, in rad,
-rad/s, rad/s^2; write --q=-0.1,... when the first value is negative.
+Reads the identification.json that `dynid identify` writes into its --out folder, or
+with --params the feasible link parameters of feasible.json (from `dynid retrieve` or
+`identify --consistent`; its drive's rotor inertias included), and evaluates, at one
+state, M [kg m^2] and g [N m]; with --dq also c [N m] (Coriolis and centrifugal
+torques); with --dq and --ddq also tau = M ddq + c + g [N m] (friction not included).
+Vectors are comma-separated, in rad, rad/s, rad/s^2; write --q=-0.1,... when the first
+value is negative.
 
 example:
   dynid predict --model result/identification.json --q=0,-0.785,0,-2.356,0,1.571,0.785 --json

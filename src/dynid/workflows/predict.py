@@ -20,7 +20,7 @@ from ..dynamics.terms import coriolis, gravity_torques, mass_matrix
 from ..exceptions import DataError, OptionError
 from ..identification.model import IdentifiedModel
 from ..io.feasible import FEASIBLE_SCHEMA, load_feasible_drive, load_feasible_json
-from ..io.model_json import load_model_json
+from ..io.model_json import MODEL_SCHEMA, load_model_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 
@@ -105,7 +105,12 @@ def load_predicting(model: str | Path | None, params: str | Path | None) -> Pred
             "feasible.json (dynid retrieve, identify --consistent)"
         )
     if params is not None:
-        return Predicting(load_feasible_json(params), load_feasible_drive(params))
+        try:
+            return Predicting(load_feasible_json(params), load_feasible_drive(params))
+        except DataError as exc:
+            if MODEL_SCHEMA not in str(exc):
+                raise
+            raise DataError(f"{exc}; hint: --model reads identification.json") from exc
     assert model is not None
     try:
         return Predicting(load_model_json(model))
