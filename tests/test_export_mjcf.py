@@ -333,5 +333,5 @@ def test_a_coupled_drive_s_dropped_damping_reads_as_its_coupling():
     terms = drive_joint_terms(K, None, np.array([0.5, 0.3]), None)
     _, left = friction_losses("smooth", terms.notes)
     assert left.startswith("the coupling's off-diagonal terms of the viscous friction (damping)")
-    assert "(largest: joints 1-2, 0.24)" in left, left
+    assert "(largest: joints 1-2, 0.24 N m s/rad)" in left, left
     np.testing.assert_allclose(terms.damping, [0.5 + 0.8**2 * 0.3, 0.3])  # written: K^T diag K

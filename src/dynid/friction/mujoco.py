@@ -151,20 +151,30 @@ def drive_joint_terms(
     Kf = K if friction_at_motor else np.eye(n)
     notes: list[str] = []
 
-    def reflected(d: NDArray[np.float64], T: NDArray[np.float64], what: str) -> NDArray[np.float64]:
+    def reflected(
+        d: NDArray[np.float64], T: NDArray[np.float64], what: str, unit: str
+    ) -> NDArray[np.float64]:
         A = T.T @ (d[:, None] * T)
         off = A - np.diag(np.diag(A))
         if np.any(np.abs(off) > 1e-12 * max(float(np.abs(A).max()), 1e-300)):
             i, j = np.unravel_index(int(np.argmax(np.abs(off))), off.shape)
             notes.append(
                 f"{what}: the coupling's off-diagonal terms have no per-joint term and are "
-                f"dropped (largest: joints {i + 1}-{j + 1}, {A[i, j]:.4g})"
+                f"dropped (largest: joints {i + 1}-{j + 1}, {A[i, j]:.4g} {unit})"
             )
         return np.diag(A).copy()
 
     z = np.zeros(n)
-    arm = z if rotor_inertia is None else reflected(np.asarray(rotor_inertia), K, "armature")
-    damp = z if fv is None else reflected(np.asarray(fv), Kf, "viscous friction (damping)")
+    arm = (
+        z
+        if rotor_inertia is None
+        else reflected(np.asarray(rotor_inertia), K, "armature", "kg m^2")
+    )
+    damp = (
+        z
+        if fv is None
+        else reflected(np.asarray(fv), Kf, "viscous friction (damping)", "N m s/rad")
+    )
     loss = z
     if fc is not None:
         fcv = np.asarray(fc)
