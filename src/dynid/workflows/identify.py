@@ -99,7 +99,7 @@ from .recordings import (
     checked_accelerations,
     given_start,
     unwrapped_recorded,
-    usable_velocities,
+    usable_recorded,
 )
 
 __all__ = [
@@ -769,7 +769,6 @@ def _read_logs(
         for p in paths
     ]
     names = [p.name for p in paths]
-    logs = list(usable_velocities(logs, names))
     logs = list(checked_accelerations(logs, names, velocity_cutoff(opt.cutoff_hz)))
     logs = list(given_start(logs, names, robot, opt.drive, opt.q_start, opt.max_gap_s))
     held: list[tuple[TorqueLog, Path]] = []
@@ -777,13 +776,14 @@ def _read_logs(
         held.append((heldout, Path(opt.validate_on)))
     rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
     check_derived_velocities(rec, cmap)
-    rec = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
-    check_unit_findings(rec, robot)
-    check_limits(rec, robot)
-    check_units(rec)
-    check_signs(rec.select(slice(len(logs), None)), robot)  # the held-out log's
-    check_torque_unit(rec, robot, cmap)
-    return logs
+    checked = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
+    check_unit_findings(checked, robot)
+    check_limits(checked, robot)
+    rec, checked = usable_recorded(rec, checked, robot, opt.max_gap_s)
+    check_units(checked)
+    check_signs(checked.select(slice(len(logs), None)), robot)  # the held-out log's
+    check_torque_unit(checked, robot, cmap)
+    return list(rec.logs[: len(logs)])
 
 
 def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:

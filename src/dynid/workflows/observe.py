@@ -131,7 +131,7 @@ from .recordings import (
     despiked_recordings,
     given_start,
     unwrapped_recorded,
-    usable_velocities,
+    usable_recorded,
 )
 
 __all__ = [
@@ -715,12 +715,12 @@ def _read_logs(
         for p in map(Path, paths)
     ]
     names = [Path(p).name for p in paths]
-    logs = list(usable_velocities(logs, names))
     logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
     read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
     checked = unwrapped_recorded(read, model.robot, opts.max_gap)  # as prepared_log reads
     check_unit_findings(checked, model.robot)
     check_limits(checked, model.robot)
+    read, checked = usable_recorded(read, checked, model.robot, opts.max_gap)
     check_units(checked)
     check_derived_velocities(read, cmap)
     # detection logs hold contacts; a model's recorded sign map judged first

@@ -108,6 +108,7 @@ __all__ = [
     "check_degrees",
     "check_derived_velocities",
     "check_velocity_columns",
+    "usable_recorded",
     "usable_velocities",
     "checked_accelerations",
     "check_limits",
@@ -257,13 +258,13 @@ def read_recordings(
         )
 
     logs = tuple(in_file(p, lambda p=p: read(p)) for p in paths)  # type: ignore[misc]
-    logs = usable_velocities(logs, [p.name for p in paths])
     logs = checked_accelerations(logs, [p.name for p in paths], cutoff_hz)
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths), drive)
     checked = unwrapped_recorded(out, robot, max_gap_s)  # as the preparation reads them
     check_unit_findings(checked, robot)  # the time unit and degrees, named first
     check_limits(checked, robot)
+    out, checked = usable_recorded(out, checked, robot, max_gap_s)  # units known right
     check_units(checked)
     check_derived_velocities(out, cmap)
     if signs:  # said, naming the joints: the verdict judges the log as it is
@@ -426,6 +427,20 @@ def usable_velocities(logs: Sequence[TorqueLog], names: Sequence[str]) -> tuple[
         positions = TorqueLog(log.t, log.q, log.dq, log.tau, None, log.cleaning)
         out.append(with_derived_velocities(positions, DEFAULT_CUTOFF_HZ))
     return tuple(out)
+
+
+def usable_recorded(
+    rec: Recorded, checked: Recorded, robot: Robot, max_gap_s: float | None = None
+) -> tuple[Recorded, Recorded]:
+    """``rec`` with :func:`usable_velocities` and its unwrapped form (``checked``, as
+    :func:`unwrapped_recorded` makes it), both as given when no recording's velocities
+    were replaced. After the unit checks: a log in other units is named for them first
+    (its velocities against a derivative read in other units would read as no motion)."""
+    logs = usable_velocities(rec.logs, rec.names)
+    if all(a is b for a, b in zip(logs, rec.logs, strict=True)):
+        return rec, checked
+    rec = dataclasses.replace(rec, logs=logs)
+    return rec, unwrapped_recorded(rec, robot, max_gap_s)
 
 
 def checked_accelerations(
