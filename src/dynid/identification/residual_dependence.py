@@ -379,8 +379,11 @@ def _sentence(
     offsets: Mapping[int, tuple[str, bool]] | None = None,
     left_out: Mapping[int, tuple[str, ...]] | None = None,
     inertia: str | None = None,
+    still_as: str | None = None,
 ) -> str:
-    """One joint's diagnosis in words (a residual that follows the acceleration first:
+    """One joint's diagnosis in words (a residual that concentrates at standstill first:
+    the holding torque at rest, its why said once, ``still_as`` the joint it was said
+    at; then a residual that follows the acceleration:
     an inertia the model lacks, with ``inertia`` the remedy where the caller knows it,
     else :func:`_inertia_remedy`); ``terms`` the model's term names (:func:`held_terms`),
     so that the remedy names what the model lacks, not what it holds; ``springs`` the
@@ -393,12 +396,17 @@ def _sentence(
     fc7, and its validation had suggested comparing the laws)."""
     head = f"{name}: "
     if still_led(d):
-        return (
+        said = (
             f"{head}{d.rms:.2g} N m RMS residual, {d.still:.2g} over the "
             f"{100 * d.still_share:.0f} % of samples at standstill against {d.moving:.2g} "
-            "while moving: the holding torque at rest (static friction, anything within its "
-            "limits, which no term of the model holds; no spring or friction term fits it: "
-            "judge the model on moving samples, or record without rests)"
+            "while moving: the holding torque at rest"
+        )
+        if still_as is not None:
+            return f"{said}, as {still_as}"
+        return (
+            f"{said} (static friction, anything within its limits, which no term of the "
+            "model holds; no spring or friction term fits it: judge the model on moving "
+            "samples, or record without rests)"
         )
     if acceleration_led(d):
         return (
@@ -561,14 +569,15 @@ def dependence_hint(
     if not found:
         return None
     worst = sorted(found, key=lambda d: d.ratio, reverse=True)
-    clauses, first = [], None  # the inertia's remedy said once, at its first joint
+    clauses, first, still = [], None, None  # the inertia's remedy said once, as the rest's
     for d in worst[:NAMED]:
         remedy = inertia if first is None else f"as for {first}"
-        clauses.append(
-            _sentence(d, joint_names[d.joint], terms, springs, offsets, left_out, remedy)
-        )
-        if first is None and acceleration_led(d):
-            first = joint_names[d.joint]
+        name = joint_names[d.joint]
+        clauses.append(_sentence(d, name, terms, springs, offsets, left_out, remedy, still))
+        if first is None and acceleration_led(d) and not still_led(d):
+            first = name
+        if still is None and still_led(d):
+            still = name
     said = "; ".join(clauses)
     more = len(worst) - NAMED
     return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
