@@ -17,6 +17,7 @@ import pytest
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.selection import identify_recordings
+from dynid.report.identify import _structure_section
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
 from dynid.simulation.trajectories import random_fourier
 
@@ -64,6 +65,8 @@ def test_recordings_whose_friction_and_offsets_differ_are_said_to_disagree(
     per = [r["heldout_error_percent"] for r in sel["heldout_per_recording"]]
     assert sel["outlying_recordings"] == []
     assert bool(notes) is said, (per, sel["notes"])
+    report = _structure_section({"metadata": {"selection": sel}})
+    assert ("The recordings disagree" in report) is said
     if said:
         assert f"{min(per):.3g} to {max(per):.3g} %" in notes[0]
         assert "standard deviations" in notes[0]

@@ -409,6 +409,8 @@ def _warn_outlying(skip: tuple[int, ...], per: tuple[tuple[str, float], ...]) ->
 #: Recordings disagree (:func:`_disagreement_note`) when each one's held-out error is at
 #: least this many times the noise floor and their spread (largest less smallest) too.
 DISAGREE_RATIO = 3.0
+#: How the note of recordings that disagree begins (:func:`_disagreement_note`).
+DISAGREE_NOTE = "the recordings disagree"
 
 
 def _disagreement_note(
@@ -432,7 +434,7 @@ def _disagreement_note(
     if not (errors.min() >= DISAGREE_RATIO * fl and spread >= DISAGREE_RATIO * fl):
         return []
     return [
-        f"the recordings disagree: their held-out errors ({errors.min():.3g} to "
+        f"{DISAGREE_NOTE}: their held-out errors ({errors.min():.3g} to "
         f"{errors.max():.3g} %, each left out of the others' fit) are all "
         f"{errors.min() / fl:.3g} x the noise floor ({fl:.3g} %) or more, and spread "
         f"{spread / fl:.3g} x it, none outlying: effects that differ between recordings "
