@@ -182,10 +182,10 @@ def still_led(d: Dependence) -> bool:
     return above > 0 and d.still_share * (d.still**2 - d.noise**2) >= FOLLOWS * above
 
 
-def _still(V: NDArray[np.float64], E: NDArray[np.float64], j: int) -> tuple[float, float, float]:
-    """Joint ``j``'s share of samples at standstill and the residual's RMS [N m] there and
-    while moving."""
-    rest = at_standstill(V)[:, j]
+def _still(R: NDArray[np.bool_], E: NDArray[np.float64], j: int) -> tuple[float, float, float]:
+    """Joint ``j``'s share of samples at standstill (``R``, :func:`at_standstill`) and the
+    residual's RMS [N m] there and while moving."""
+    rest = R[:, j]
     if not rest.any() or rest.all():
         return 0.0, 0.0, 0.0
     e = E[:, j]
@@ -256,10 +256,10 @@ def residual_dependence(
         return ()
     rms = np.sqrt(np.mean(E**2, axis=0))
     judged = rms / s if ratios is None else np.asarray(ratios, dtype=np.float64)
-    out = []
+    out, R = [], at_standstill(V)
     for j in np.flatnonzero((judged > SYSTEMATIC_RATIO) & (rms > s)):  # a part to diagnose
         position, velocity = _parts(Q, V, E, int(j), float(s[j]) ** 2)
-        share, still, moving = _still(V, E, int(j))
+        share, still, moving = _still(R, E, int(j))
         out.append(
             Dependence(
                 joint=int(j),
