@@ -113,6 +113,7 @@ from .structure import (
     structure_terms,
     width_text,
 )
+from .verdict import ROUND_OFF_PERCENT
 from .widths import per_joint_widths, regressor_widths
 
 __all__ = [
@@ -347,7 +348,7 @@ def select_structure(
         tuple(judged),
         chosen,
         how + (f", judged without {', '.join(data.names[i] for i in skip)}" if skip else ""),
-        notes=tuple(notes),
+        notes=(*notes, *_disagreement_note(per, skip, _with_floor({}, data))),
         per_recording=per,
         outlying=tuple(data.names[i] for i in skip),
         determined=determined,
@@ -403,6 +404,45 @@ def _warn_outlying(skip: tuple[int, ...], per: tuple[tuple[str, float], ...]) ->
             DynidWarning,
             stacklevel=3,
         )
+
+
+#: Recordings disagree (:func:`_disagreement_note`) when each one's held-out error is at
+#: least this many times the noise floor and their spread (largest less smallest) too.
+DISAGREE_RATIO = 3.0
+#: How the note of recordings that disagree begins (:func:`_disagreement_note`).
+DISAGREE_NOTE = "the recordings disagree"
+
+
+def _disagreement_note(
+    per: tuple[tuple[str, float], ...], skip: tuple[int, ...], floor: Any
+) -> list[str]:
+    """A note when the recordings' held-out errors (each left out of the others' fit,
+    ``per``) are every one far above the noise floor (``floor["noise_floor_percent"]``)
+    and spread widely: at least :data:`DISAGREE_RATIO` x the floor both. Consistent
+    recordings of an adequate model sit near the floor and within about a floor of one
+    another (a 7-DoF arm's four: 1.62 to 1.91 % against 0.59 %); recordings whose friction
+    differs by 10 to 20 % and whose offsets shift spread far wider (5.2 to 10.7 %), none
+    of them outlying (:data:`~.candidates.OUTLIER_RATIO` x the others' median), and the
+    standard deviations, computed within the recordings, do not hold that spread (fv1
+    2.04 +- 3.5 % for a truth of 1.46). None with an outlying recording (``skip``, said
+    on its own), fewer than three recordings or a floor at round-off."""
+    fl = floor.get("noise_floor_percent") if isinstance(floor, dict) else None
+    if skip or len(per) < 3 or fl is None or not fl > ROUND_OFF_PERCENT:
+        return []  # a floor at round-off: noise-free logs, whose errors say nothing of it
+    errors = np.array([e for _, e in per], dtype=np.float64)
+    spread = float(errors.max() - errors.min())
+    if not (errors.min() >= DISAGREE_RATIO * fl and spread >= DISAGREE_RATIO * fl):
+        return []
+    return [
+        f"{DISAGREE_NOTE}: their held-out errors ({errors.min():.3g} to "
+        f"{errors.max():.3g} %, each left out of the others' fit) are all "
+        f"{errors.min() / fl:.3g} x the noise floor ({fl:.3g} %) or more, and spread "
+        f"{spread / fl:.3g} x it, none outlying: effects that differ between recordings "
+        "(friction with temperature, sensor offsets that shift, a payload) or a motion "
+        "that excites what the model lacks more than the others; the standard deviations, "
+        "computed within the recordings, do not include this (the coefficients are "
+        "uncertain by more than they say)"
+    ]
 
 
 def _candidate_notes(judged: Sequence[Candidate]) -> list[str]:

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..exceptions import DynidError
 from ..identification.determined import determined_sentence
+from ..identification.selection import DISAGREE_NOTE
 from ..identification.structure import Structure
 from ..identification.verdict import (
     FLOOR_GOOD,
@@ -885,6 +886,8 @@ def _structure_section(doc: dict) -> str:
             "<p>Held-out error of the chosen structure per recording (fitted on the others).</p>"
             + table(head, rows)
         )
+        disagree = [n for n in sel.get("notes") or () if str(n).startswith(DISAGREE_NOTE)]
+        parts += [f"<p>{esc(capitalised(str(n)))}.</p>" for n in disagree]
     return section("structure", "Model structure", *parts)
 
 
