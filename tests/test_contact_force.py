@@ -170,8 +170,9 @@ def test_notes_and_words_say_what_the_joints_determine():
     assert full is not None and "5 of the 6 wrench components" in full
     assert full.endswith("is determined: --wrench force")
     assert underdetermined_note(robot, "flange", "force") is None
-    two = underdetermined_note(robot, "link2", "force")
-    assert two is not None and "2 of the 3 force components" in two and "--wrench" not in two
+    two = underdetermined_note(robot, "link2", "force")  # its origin on joint 2's axis
+    assert two is not None and "1 of the 3 force components" in two and "--wrench" not in two
+    assert "the 2 joints moving link2 determine (structurally" in two
     words = estimate_words(robot, "flange", "force")
     assert words.startswith("the force of a point contact (moment zero) at flange's origin")
     assert "3 components from 5 joints" in words
@@ -267,3 +268,34 @@ def test_observe_files_takes_the_estimate_as_an_option(observed, arm5_urdf):
     with pytest.raises(dynid.OptionError) as err:
         observe_files(dataclasses.replace(opts, frame=None))
     assert err.value.field == "wrench"
+
+
+def test_structural_rank_at_the_panda_link4_is_pinocchios_and_the_fit_leaves_what_it_misses():
+    """The force at the Panda's link4 origin (on joint 4's axis): Pinocchio's linear
+    Jacobian rows have rank 2 at random poses, and so does the estimate (the note says
+    2 of 3, structurally); a force there is explained whole (nothing left), while at
+    the flange what the wrench leaves of its torques is Pinocchio's least-squares
+    residual of J_flange^T w = r."""
+    from dynid.observer.wrench import structural_rank
+
+    robot = dynid.panda()
+    q, *_ = random_states(robot, 5, seed=4)
+    fingers = ("panda_finger_joint1", "panda_finger_joint2")
+    J4 = _pin_jacobians(pinocchio_panda_urdf(), "panda_link4", q, fingers)
+    assert {int(np.linalg.matrix_rank(J[:3], tol=1e-9)) for J in J4} == {2}
+    assert structural_rank(robot, "link4", FORCE) == 2
+    note = underdetermined_note(robot, "link4", "force")
+    assert note is not None and "only 2 of the 3 force components" in note
+    f = np.array([0.0, 50.0, 0.0])
+    r = np.einsum("sji,j->si", J4[:, :3], f)
+    est = external_wrench(robot, q, r, "link4", kind="force")
+    assert est.unexplained is not None and np.all(est.unexplained < 1e-18 * np.sum(r**2, axis=1))
+    JF = _panda_flange(q)
+    full = external_wrench(robot, q, r, "flange")
+    assert not full.damped.all()
+    for k in range(q.shape[0]):
+        w, *_ = np.linalg.lstsq(JF[k].T, r[k], rcond=None)
+        left = float(np.sum((r[k] - JF[k].T @ w) ** 2))
+        if not full.damped[k]:
+            assert full.unexplained is not None
+            assert full.unexplained[k] == pytest.approx(left, rel=1e-6, abs=1e-12)

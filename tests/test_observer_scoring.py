@@ -5,6 +5,7 @@ log with a label column, whose counts equal the contacts simulated."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -16,8 +17,10 @@ from dynid.observer.scoring import (
     combined,
     interval_peaks,
     label_intervals,
+    lead_for,
     match_events,
     score_events,
+    shifted_labels_note,
     truth_flags,
 )
 
@@ -387,3 +390,92 @@ def test_delays_of_look_ahead_velocities_carry_their_caveat_in_the_score_line():
     assert combined([plain, ahead]).look_ahead and not combined([plain, plain]).look_ahead
     none = score_events(np.zeros((0, 2)), lab, (0.0, 5.0), look_ahead=True)
     assert LOOK_AHEAD_WORDS not in score_words(none)  # no delay to qualify
+
+
+def test_hand_labels_late_by_60_ms_count_with_the_default_tolerance_and_are_noted_without(
+    pushes, capsys
+):
+    """Labels 60 ms late (each true contact from simulated tau_ext, shifted): with the
+    default --label-tolerance 0.1 s, which a label column applies before its start too,
+    3 labelled, 3 detected, no false alarm; with --label-tolerance 0.03 s the three events
+    start before their labels: 3 missed, 3 false alarms, each marked false_alarm in
+    events.json and the report, and a note says the labels look late by ~60 ms. Scored
+    against the true torques the lead stays 0.02 s."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures"]
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, *th, "--data", str(d / "hit.csv"), "--out", str(d / "truth")]) == 0
+    capsys.readouterr()
+    truth = json.loads((d / "truth" / "events.json").read_text())["score"]
+    assert truth["lead_s"] == pytest.approx(0.02)
+    contacts = np.array(truth["logs"][0]["contacts"])
+    t = np.loadtxt(d / "hit.csv", delimiter=",", comments="#", skiprows=3)[:, 0]
+    late = np.zeros(t.shape)
+    for a, b in contacts:
+        late[(t >= a + 0.06) & (t <= b + 0.06)] = 1.0
+    _with_column(d / "hit.csv", d / "late.csv", "collision", late)
+    data = ["--data", str(d / "late.csv")]
+    assert main([*p, *th, *data, "--out", str(d / "late")]) == 0
+    out = capsys.readouterr()
+    assert "3 labelled, 3 detected, 0 missed; 0 false alarm(s)" in out.out
+    assert "from 0.1 s before a contact's start" in out.out
+    doc = json.loads((d / "late" / "events.json").read_text())
+    assert [e["false_alarm"] for e in doc["events"]] == [False] * 3
+    assert main([*p, *th, *data, "--label-tolerance", "0.03", "--out", str(d / "tight")]) == 0
+    out = capsys.readouterr()
+    assert "3 labelled, 0 detected, 3 missed; 3 false alarm(s)" in out.out
+    (note,) = [x for x in out.err.splitlines() if "look shifted late" in x]
+    lead = float(re.search(r"late by ~(\d+) ms", note).group(1))
+    assert 40.0 <= lead <= 60.0  # 60 ms less each event's delay after the true start
+    doc = json.loads((d / "tight" / "events.json").read_text())
+    assert [e["false_alarm"] for e in doc["events"]] == [True] * 3
+    (log,) = doc["score"]["logs"]
+    assert [e["start"] for e in log["false_alarm_events"]] == [e["start"] for e in doc["events"]]
+    page = re.sub(r"<[^>]+>", " ", (d / "tight" / "report.html").read_text())
+    assert page.count("false alarm ") >= 3
+
+
+def test_a_wrench_at_the_flange_that_leaves_a_link4_push_unexplained_is_warned(pushes, capsys):
+    """--frame flange on pushes at link6, the flange and link4: the flange push leaves
+    under 2 % of |r| unexplained by the wrench there (events.json) and is not named; the
+    link4 push (at link4's origin, on joint 4's axis: joints 4-6 feel nothing of it,
+    which a wrench at the flange would load) is warned, and so is the link6 push (at
+    link6's origin, where joints 5 and 6's axes meet), named with joint 4, the last
+    joint over its noise in them, and a --frame hint."""
+    d = pushes
+    p = ["observe", "--params", "panda", "--no-figures", "--frame", "flange"]
+    th = ["--thresholds", str(d / "cal" / "thresholds.json")]
+    assert main([*p, *th, "--data", str(d / "hit.csv"), "--out", str(d / "flange")]) == 0
+    err = capsys.readouterr().err
+    doc = json.loads((d / "flange" / "events.json").read_text())
+    flange = next(e for e in doc["events"] if 1.85 < e["start"] < 2.0)
+    elbow = next(e for e in doc["events"] if 2.95 < e["start"] < 3.1)
+    assert flange["unexplained_share"] < 0.02
+    (warned,) = [x for x in err.splitlines() if "does not fit" in x]
+    link6 = next(e for e in doc["events"] if 0.75 < e["start"] < 0.9)
+    assert f"{elbow['start']:.3f} s" in warned and f"{link6['start']:.3f} s" in warned
+    assert f"{flange['start']:.3f} s" not in warned
+    assert "likely on a link before flange" in warned and "try --frame link4" in warned
+    assert "joint4, so on link4" in warned
+
+
+def test_a_label_columns_lead_is_its_tolerance_and_late_labels_are_said():
+    """lead_for: 0.02 s at 1 kHz, 3 samples at 100 Hz, the tolerance where given (a label
+    column, both sides). Events at 1.00 and 2.00 s against labels 80 ms late: with the
+    exact lead both are false alarms that run into a missed label, 80 ms early each (the
+    note says ~80 ms and a tolerance of 0.1 s), false_events naming both; with a 0.1 s
+    lead both detect."""
+    t = np.arange(0.0, 5.0, 0.001)
+    assert lead_for(t) == pytest.approx(0.02)
+    assert lead_for(np.arange(0.0, 5.0, 0.01)) == pytest.approx(0.03)
+    assert lead_for(t, 0.1) == pytest.approx(0.1)
+    ev = [[1.0, 1.3], [2.0, 2.2], [4.0, 4.1]]
+    lab = [[1.08, 1.3], [2.08, 2.2]]
+    sc = score_events(ev, lab, (0.0, 5.0), lead_s=0.02)
+    assert (sc.detected, sc.false_alarms, sc.false_events) == (0, 3, (0, 1, 2))
+    np.testing.assert_allclose(sc.early, [0.08, 0.08])
+    note = shifted_labels_note(sc)
+    assert note is not None and "~80 ms" in note and "--label-tolerance 0.1 " in note
+    wide = score_events(ev, lab, (0.0, 5.0), lead_s=0.1)
+    assert (wide.detected, wide.false_events, wide.early) == (2, (2,), ())
+    assert shifted_labels_note(wide) is None

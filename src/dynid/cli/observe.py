@@ -69,10 +69,14 @@ A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN no
 named collision, contact or label (the first the log has), or mapped with --columns
 label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in
 contact where some joint's |tau_ext| exceeds 0.1 N m). A contact is detected when an
-event starts from 0.02 s (or 3 samples) before it to --label-tolerance (0.1 s, the
-observer's lag) after its end (an event still open over a later contact detects only the
-one it started in); an event that detects no contact is a false alarm (one starting long
-before any contact, such as a whole-log event: the contacts it covers are missed). The
+event starts from --label-tolerance (0.1 s) before a label column's contact (labels made
+by hand are late or early by tens of ms; from tau_ext, the true start: 0.02 s or 3
+samples) to --label-tolerance (0.1 s, the observer's lag) after its end (an event still
+open over a later contact detects only the one it started in); an event that detects no
+contact is a false alarm (one starting long before any contact, such as a whole-log
+event: the contacts it covers are missed), marked so in events.json (false_alarm) and the
+report's events table; several false alarms that each start shortly before a missed
+contact and run into it get a note: the labels look shifted by about that much. The
 summary prints per log
 and in total the contacts labelled, detected and missed (each missed one with its times
 and, from tau_ext, its peak true torque), the false alarms and their rate per minute of
@@ -233,8 +237,10 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="SECONDS",
         help="logs with labelled contacts (a label column, or the true tau_ext of a "
         "simulated log): an event starting up to this long after a contact's end still "
-        f"detects it, the observer's lag (default {DEFAULT_TOLERANCE_S:g} s); contacts "
-        "closer than this are one, which one event detects",
+        f"detects it, the observer's lag (default {DEFAULT_TOLERANCE_S:g} s), and, of a "
+        "label column (made by hand, off either way), up to this long before its start "
+        "(from tau_ext: 0.02 s or 3 samples); contacts closer than this are one, which "
+        "one event detects",
     )
     add_column_options(p)
     add_drop_invalid(p)

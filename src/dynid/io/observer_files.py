@@ -51,7 +51,12 @@ units line says what was estimated there: the wrench, or the force of a point co
 (``--wrench force``: ``mx, my, mz`` written 0). ``events.json`` then says it too
 (``wrench``: the frame, the estimate and the components determined), and each event its
 ``damped_share`` (0 to 1: the share of its samples where the estimate was damped, near a
-singular configuration, where the wrench is unreliable).
+singular configuration, where the wrench is unreliable) and ``unexplained_share`` (0 to
+1, null: no sample: the share of its ``|r|`` the estimate leaves unexplained,
+``sqrt(sum |r - J^T w|^2 / sum |r|^2)``; large for a contact on another link than the
+frame's). Events of a log with labelled contacts say whether they were counted as a
+``false_alarm``; ``score`` lists them per log (``false_alarm_events``, ``{"start",
+"end"}`` [s]) with the leads of those that run into a missed contact (``early_ms``).
 """
 
 from __future__ import annotations
@@ -177,6 +182,7 @@ _SCORE_FIELDS = {
     "delay_median_ms": Field("number", nullable=True, unit="ms"),
     "delay_max_ms": Field("number", nullable=True, unit="ms"),
     "delays_look_ahead": Field("bool"),
+    "early_ms": Field("numbers", shape=(None,), low=0.0, unit="ms"),
     "missed_contacts": Field(
         "objects",
         required=True,
@@ -201,6 +207,15 @@ SCORE = Record(
                     "log": Field("string", required=True),
                     **_SCORE_FIELDS,
                     "contacts": Field("numbers", required=True, shape=(None, 2), unit="s"),
+                    "false_alarm_events": Field(
+                        "objects",
+                        record=Record(
+                            {
+                                "start": Field("number", required=True, unit="s"),
+                                "end": Field("number", required=True, unit="s"),
+                            }
+                        ),
+                    ),
                 }
             ),
         ),
@@ -255,6 +270,8 @@ EVENTS = Format(
                         "level": Field("string", required=True, choices=("contact", "collision")),
                         "log": Field("string"),
                         "damped_share": Field("number", low=0.0, high=1.0),
+                        "unexplained_share": Field("number", nullable=True, low=0.0, high=1.0),
+                        "false_alarm": Field("bool"),
                     }
                 ),
             ),
@@ -373,12 +390,16 @@ def save_events(
     logs: Sequence[str] | None = None,
     joints: Sequence[str] | None = None,
     damped: Sequence[float] | None = None,
+    unexplained: Sequence[float] | None = None,
+    false_alarm: Sequence[bool | None] | None = None,
 ) -> Path:
     """Write ``events.json`` (schema ``dynid-events/1``; ``logs``: each event's log name,
     written as its ``log``; ``joints``: the model's joint names, written beside the
     model's and each event's 1-based joints; ``damped``: each event's share of samples
-    where the wrench estimate was damped, written as its ``damped_share``); returns the
-    path."""
+    where the wrench estimate was damped, written as its ``damped_share``;
+    ``unexplained``: the share of its residual the estimate leaves, its
+    ``unexplained_share`` (NaN written null); ``false_alarm``: whether the score counted
+    it a false alarm, None where its log was not scored); returns the path."""
     doc = {
         "dynid_version": __version__,
         **({} if joints is None else {"joints": list(joints)}),
@@ -392,6 +413,12 @@ def save_events(
                 "level": e.level,
                 **({} if logs is None else {"log": logs[k]}),
                 **({} if damped is None else {"damped_share": damped[k]}),
+                **({} if unexplained is None else {"unexplained_share": _finite(unexplained[k])}),
+                **(
+                    {}
+                    if false_alarm is None or false_alarm[k] is None
+                    else {"false_alarm": bool(false_alarm[k])}
+                ),
             }
             for k, e in enumerate(events)
         ],
@@ -401,6 +428,11 @@ def save_events(
         | ({"dropped": _DROPPED_UNITS} if "dropped" in (meta or {}) else {}),
     }
     return save_document(path, EVENTS, doc)
+
+
+def _finite(x: float) -> float | None:
+    """``x``, None where NaN."""
+    return float(x) if np.isfinite(x) else None
 
 
 #: The units of ``events.json``'s ``dropped``.
@@ -616,11 +648,17 @@ def save_observation(
         )
     labels = log_labels([x.path for x in result.logs])
     shares: list[float] | None = None if result.frame is None else []
+    left: list[float] | None = None if result.frame is None else []
+    false: list[bool | None] = []
     for x, label in zip(result.logs, labels, strict=True):
         events += x.events
         logs_of += [label] * len(x.events)
         if shares is not None:
             shares += x.damped if x.damped is not None else [0.0] * len(x.events)
+        if left is not None:
+            left += x.unexplained if x.unexplained is not None else [np.nan] * len(x.events)
+        sc = x.score
+        false += [None if sc is None else k in sc.false_events for k in range(len(x.events))]
     info = {
         "data": labels,
         "samples": [int(x.t.shape[0]) for x in result.logs],
@@ -635,7 +673,14 @@ def save_observation(
     paths.insert(
         0,
         save_events(
-            out / "events.json", events, meta=info, logs=logs_of, joints=joints, damped=shares
+            out / "events.json",
+            events,
+            meta=info,
+            logs=logs_of,
+            joints=joints,
+            damped=shares,
+            unexplained=left,
+            false_alarm=None if all(f is None for f in false) else false,
         ),
     )
     return paths
@@ -684,6 +729,7 @@ def _score_record(sc: ContactScore) -> dict[str, Any]:
         "delay_median_ms": None if sc.delay_median is None else 1e3 * sc.delay_median,
         "delay_max_ms": None if sc.delay_max is None else 1e3 * sc.delay_max,
         "delays_look_ahead": sc.look_ahead,
+        "early_ms": [1e3 * d for d in sc.early],
         "missed_contacts": [{"start": m.start, "end": m.end, "peak": m.peak} for m in sc.missed],
     }
 
@@ -694,7 +740,14 @@ def _score_info(result: ObserveResult, total: ContactScore) -> dict[str, Any]:
     ``contacts``, ``[start, end]`` [s])."""
     labels = log_labels([x.path for x in result.logs])
     per = [
-        {"log": lab, **_score_record(x.score), "contacts": [list(c) for c in x.score.intervals]}
+        {
+            "log": lab,
+            **_score_record(x.score),
+            "contacts": [list(c) for c in x.score.intervals],
+            "false_alarm_events": [
+                {"start": x.events[k].start, "end": x.events[k].end} for k in x.score.false_events
+            ],
+        }
         for x, lab in zip(result.logs, labels, strict=True)
         if x.score is not None
     ]

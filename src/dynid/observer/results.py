@@ -20,7 +20,7 @@ from .events import DroppedCrossing
 from .friction import banding_note
 from .gain_noise import GainNoise
 from .model import ObserverModel
-from .scoring import ContactScore, combined
+from .scoring import ContactScore, combined, shifted_labels_note
 from .thresholds import ModelFingerprint
 from .unmodelled import MOST_FLAGGED, UnmodelledFriction, no_friction_note
 from .unmodelled_load import UnmodelledLoad, load_note
@@ -123,6 +123,12 @@ class LogObservation:
         event's samples where the estimate was damped (near a singular configuration of
         the joints that move the frame: the wrench there is unreliable), in the order of
         ``events``; None: no wrench estimated.
+    unexplained : tuple of float or None
+        Of a detection with a wrench estimated at a frame: the share (0 to 1; NaN: no
+        sample) of each event's ``|r|`` the estimate leaves unexplained,
+        ``sqrt(sum |r - J^T w|^2 / sum |r|^2)``
+        (:func:`~dynid.observer.wrench_fit.unexplained_shares`), in the order of
+        ``events``; None: no wrench estimated.
     """
 
     path: Path
@@ -144,6 +150,7 @@ class LogObservation:
     dropped: tuple[DroppedCrossing, ...] = ()
     dropped_count: int = 0
     damped: tuple[float, ...] | None = None
+    unexplained: tuple[float, ...] | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -266,7 +273,9 @@ class ObserveResult:
         fewer than six joints move is the least-norm one
         (:func:`~dynid.observer.wrench.underdetermined_note`), a force alone at a frame
         that fewer than three joints move too; a residual off contacts that follows the
-        weight of a load at the flange (:func:`~dynid.observer.unmodelled_load.load_note`)."""
+        weight of a load at the flange (:func:`~dynid.observer.unmodelled_load.load_note`);
+        false alarms that each start shortly before a missed labelled contact: labels that
+        look late (:func:`~dynid.observer.scoring.shifted_labels_note`)."""
         out: tuple[str, ...] = ()
         if self.model.friction is None:
             out = (no_friction_note(self.unmodelled, self.model.robot.joint_names),)
@@ -289,6 +298,8 @@ class ObserveResult:
             is not None
         ):
             out += (note,)
+        if (total := self.score()) is not None and (shifted := shifted_labels_note(total)):
+            out += (shifted,)
         return out
 
     def mostly_flagged_note(self) -> str | None:

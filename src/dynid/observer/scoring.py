@@ -17,14 +17,19 @@ torques of a simulated log, in contact where some joint's ``|tau_ext|`` exceeds
   the group it started in: the later one, with no onset of its own, is missed unless
   another event starts in its window. An event that starts earlier than ``lead`` before
   any contact (a whole-log event of a joint with a flipped torque sign, say) detects
-  nothing: it is a *false alarm*, and the contacts it covers are missed;
+  nothing: it is a *false alarm*, and the contacts it covers are missed. Hand-made labels
+  are late or early by up to ~0.1 s: the lead of a label column is the tolerance itself
+  (:func:`lead_for`: an event starting up to ``tolerance`` before a label's start detects
+  it), while the true torques of a simulated log keep the few samples of the exact lead;
 * :func:`score_events`: the counts of one log (:class:`ContactScore`), the missed
   contacts with their times and peak true torque where known, the false alarms per minute
   of contact-free time (the log's duration less the labelled contacts, the lead before
   and the tolerance after each) and the detection delays (the first detecting event's
   start less the contact's start, never below ``-lead``; none for a contact whose event
-  was already open over an earlier contact of its group); :func:`combined` the total over
-  logs.
+  was already open over an earlier contact of its group), which events were false alarms
+  (:attr:`ContactScore.false_events`) and how long before a missed contact each false
+  alarm that runs into it started (:attr:`ContactScore.early`: several such, labels that
+  look late, :func:`shifted_labels_note`); :func:`combined` the total over logs.
 
 Delays measured on velocities from a zero-phase low-pass (derived from the positions)
 are shorter than an online observer's: the filter sees ahead. A score says so
@@ -47,6 +52,7 @@ from ..exceptions import ShapeError
 __all__ = [
     "DEFAULT_LEAD_S",
     "DEFAULT_TOLERANCE_S",
+    "EARLY_WINDOW_S",
     "LEAD_SAMPLES",
     "LOOK_AHEAD_WORDS",
     "TRUTH_LEVEL",
@@ -60,6 +66,7 @@ __all__ = [
     "match_events",
     "score_events",
     "score_words",
+    "shifted_labels_note",
     "truth_flags",
 ]
 
@@ -73,6 +80,9 @@ DEFAULT_TOLERANCE_S = 0.1
 DEFAULT_LEAD_S = 0.02
 #: The fewest sample periods of lead (:func:`lead_for`).
 LEAD_SAMPLES = 3
+#: A false alarm starting up to this long [s] before a missed contact's start, and running
+#: into it, reads as the same contact under a late label (:attr:`ContactScore.early`).
+EARLY_WINDOW_S = 1.0
 #: A simulated log is in contact where some joint's true external torque exceeds this
 #: [N m] (``tau_ext`` of ``dynid simulate --contact``, zero outside its windows).
 TRUTH_LEVEL = 0.1
@@ -139,12 +149,15 @@ def _as_intervals(x: ArrayLike, name: str) -> NDArray[np.float64]:
     return a
 
 
-def lead_for(t: ArrayLike) -> float:
+def lead_for(t: ArrayLike, tolerance_s: float | None = None) -> float:
     """The lead [s] of a log sampled at times ``t`` (N,) [s]: :data:`DEFAULT_LEAD_S`, or
-    :data:`LEAD_SAMPLES` median sample periods where that is longer."""
+    :data:`LEAD_SAMPLES` median sample periods where that is longer; with ``tolerance_s``
+    [s] (labels made by hand, off by tens of ms either way), that tolerance where it is
+    longer still: the tolerance then applies on both sides of a label."""
     t = np.asarray(t, dtype=np.float64)
     dt = float(np.median(np.diff(t))) if t.shape[0] > 1 else 0.0
-    return max(DEFAULT_LEAD_S, LEAD_SAMPLES * dt)
+    lead = max(DEFAULT_LEAD_S, LEAD_SAMPLES * dt)
+    return lead if tolerance_s is None else max(lead, float(tolerance_s))
 
 
 def match_events(
@@ -247,6 +260,14 @@ class ContactScore:
         delays are shorter than an online observer's.
     lead_s : float
         How long before a contact's start [s] an event may start and still detect it.
+    false_events : tuple of int
+        The indices (0-based, in the log's event order) of the events counted as false
+        alarms (empty for a total over logs: :func:`combined`).
+    early : tuple of float
+        For each false alarm that starts up to :data:`EARLY_WINDOW_S` before a missed
+        contact and runs to within ``tolerance_s`` of its start: how long before the
+        contact's start it started [s]. Several such read as labels late by about that
+        much (:func:`shifted_labels_note`).
     """
 
     source: str
@@ -260,6 +281,8 @@ class ContactScore:
     intervals: tuple[tuple[float, float], ...] = ()
     look_ahead: bool = False
     lead_s: float = DEFAULT_LEAD_S
+    false_events: tuple[int, ...] = ()
+    early: tuple[float, ...] = ()
 
     @property
     def false_alarms_per_min(self) -> float | None:
@@ -338,6 +361,7 @@ def score_events(
         start = ev[first[k], 0]
         if k == 0 or start > lab[k - 1, 1]:  # not an event still open from the last one
             delays.append(float(start - lab[k, 0]))
+    early = _early(ev, lab, first, false, tolerance_s, lead_s + slack_s)
     t0, t1 = span
     covered = _union_length(np.clip(lab + [-lead_s, tolerance_s], t0, t1))
     return ContactScore(
@@ -352,6 +376,47 @@ def score_events(
         tuple((float(a), float(b)) for a, b in lab),
         look_ahead,
         float(lead_s),
+        tuple(int(i) for i in np.flatnonzero(false)),
+        early,
+    )
+
+
+def _early(
+    ev: NDArray[np.float64],
+    lab: NDArray[np.float64],
+    first: NDArray[np.intp],
+    false: NDArray[np.bool_],
+    tolerance_s: float,
+    lead_s: float,
+) -> tuple[float, ...]:
+    """How long [s] before each missed contact's start the latest false alarm that runs
+    into it started (:attr:`ContactScore.early`): one starting ``lead_s`` to
+    :data:`EARLY_WINDOW_S` before it and ending no earlier than ``tolerance_s`` before
+    it."""
+    out = []
+    for k in np.flatnonzero(first < 0):
+        a = lab[k, 0]
+        near = false & (ev[:, 0] < a - lead_s) & (ev[:, 0] >= a - EARLY_WINDOW_S)
+        near &= ev[:, 1] >= a - tolerance_s
+        if near.any():
+            out.append(float(a - ev[np.flatnonzero(near)[-1], 0]))
+    return tuple(out)
+
+
+def shifted_labels_note(sc: ContactScore) -> str | None:
+    """One line when two or more false alarms each start shortly before a missed contact
+    and run into it (:attr:`ContactScore.early`): the labels look late by about the median
+    of those leads, and a ``--label-tolerance`` covering the longest would count them;
+    None otherwise."""
+    if len(sc.early) < 2:
+        return None
+    med, top = 1e3 * float(np.median(sc.early)), max(sc.early)
+    return (
+        f"{len(sc.early)} false alarm(s) each start shortly before a missed labelled contact "
+        f"and run into it ({1e3 * min(sc.early):.0f} to {1e3 * top:.0f} ms before its "
+        f"start): the labels look shifted late by ~{med:.0f} ms (labels made by hand?); "
+        f"--label-tolerance {np.ceil(top * 20.0) / 20.0:g} (s, applied before a label's "
+        "start too) would count those events as detections"
     )
 
 
@@ -367,8 +432,8 @@ def _union_length(iv: NDArray[np.float64]) -> float:
 
 def combined(scores: Sequence[ContactScore]) -> ContactScore:
     """The total of several logs' scores (their counts, times, misses and delays pooled);
-    ``source`` and ``tolerance_s`` of the first, ``intervals`` left empty, ``look_ahead``
-    where any log's is, ``lead_s`` the longest.
+    ``source`` and ``tolerance_s`` of the first, ``intervals`` and ``false_events`` left
+    empty, ``look_ahead`` where any log's is, ``lead_s`` the longest, ``early`` pooled.
 
     Raises
     ------
@@ -388,6 +453,7 @@ def combined(scores: Sequence[ContactScore]) -> ContactScore:
         tuple(d for s in scores for d in s.delays),
         look_ahead=any(s.look_ahead for s in scores),
         lead_s=max(s.lead_s for s in scores),
+        early=tuple(d for s in scores for d in s.early),
     )
 
 

@@ -26,8 +26,20 @@ not flagged (:func:`underdetermined_note`).
 A contact on a link is most often a point contact: a force at a known point, no moment.
 The estimate of ``kind="force"`` (:data:`WRENCH_KINDS`) takes that as its model: the
 moment at the frame's origin is zero and the force alone, three unknowns, is solved the
-same way on the linear rows ``J_v`` of the Jacobian (``D = E / L``, ``k = min(3, joints
-moving the frame)``), so that three to five joints determine it whole. A moment about
+same way on the linear rows ``J_v`` of the Jacobian (``D = E / L``, ``k`` at most 3),
+so that three to five joints determine it whole where their axes allow.
+
+``k`` is the Jacobian's structural rank (:func:`wrench_rank`): its rank at generic poses,
+at most the joints moving the frame and the rows solved on. A frame on a joint's axis
+(a Panda's ``link4``, whose origin lies on joint 4's axis) leaves that joint out of its
+linear rows, so that the force there has a direction no joint feels at any pose: that is
+structural, not a singular configuration, and is not flagged either.
+
+What the estimate leaves of the residual, ``r - J^T w``, is kept per sample
+(:attr:`WrenchEstimate.unexplained`): a contact on a link before the frame gives torques
+no wrench at the frame explains (those of the joints between the contact and the frame
+vanish, which no wrench at the frame reproduces), and a large unexplained share over an
+event says so. A moment about
 the origin (a force elsewhere on the link, a twist) is outside that model: the force
 that best explains its torques is written, off the true one.
 """
@@ -54,6 +66,7 @@ __all__ = [
     "chain_length",
     "estimate_words",
     "external_wrench",
+    "structural_rank",
     "underdetermined_note",
     "wrench_kind",
     "wrench_rank",
@@ -138,6 +151,9 @@ class WrenchEstimate:
     kind : WrenchKind
         What was estimated: :data:`FULL` (the wrench) or :data:`FORCE` (the force of a
         point contact at the frame's origin).
+    unexplained : ndarray, shape (...), or None
+        ``|r - J^T w|^2`` [N^2 m^2]: what the estimate leaves of the residual at each
+        sample (NaN where ``r`` is); None: not computed.
     """
 
     frame: str
@@ -146,6 +162,7 @@ class WrenchEstimate:
     damped: NDArray[np.bool_]
     determined: int = 6
     kind: WrenchKind = FULL
+    unexplained: NDArray[np.float64] | None = None
 
 
 def external_wrench(
@@ -207,7 +224,9 @@ def external_wrench(
     coef = gain * (Vt @ ra[..., None])[..., 0]
     w = np.zeros((*qa.shape[:-1], 6))
     w[..., : kd.rows] = D * (U @ coef[..., None])[..., 0]
-    return WrenchEstimate(frame, w, smin, damped, k, kd)
+    fit = (np.swapaxes(Vt, -1, -2) @ (s * coef)[..., None])[..., 0]  # J^T w, (D J)^T D^-1 w
+    left = np.sum((ra - fit) ** 2, axis=-1)
+    return WrenchEstimate(frame, w, smin, damped, k, kd, left)
 
 
 def chain_length(robot: Robot, frame: str) -> float:
@@ -227,21 +246,59 @@ def chain_length(robot: Robot, frame: str) -> float:
     return length if length > 0.0 else 1.0
 
 
-def wrench_rank(robot: Robot, frame: str, kind: str | WrenchKind = FULL) -> int:
-    """The components at ``frame`` that joint torques determine: the joints that move it
-    (those up to its link), at most 6 for the wrench and 3 for the force alone
-    (``kind``).
+#: Poses at which :func:`structural_rank` reads the Jacobian's rank (random, fixed seed).
+RANK_POSES = 4
+#: A singular value below this share of the largest is zero in :func:`structural_rank`.
+RANK_TOL = 1e-8
+
+
+def structural_rank(robot: Robot, frame: str, kind: str | WrenchKind = FULL) -> int:
+    """The rank of the Jacobian at ``frame`` (its ``kind.rows`` first rows, the linear
+    rows scaled by :func:`chain_length`) at generic poses: the largest over
+    :data:`RANK_POSES` random ones (a fixed seed; the rank is the same at almost every
+    pose, lower only at singular ones). Below the joints moving the frame when a joint's
+    axis passes through its origin (the force there) or axes line up by construction.
 
     Raises
     ------
     UnknownNameError
         An unknown frame.
     OptionError
-        A frame on the base (no joint moves it), an unknown ``kind``.
+        An unknown ``kind``.
     """
-    k = min(wrench_kind(kind).rows, int(robot.frame(frame).link))
+    kd = wrench_kind(kind)
+    if int(robot.frame(frame).link) == 0:
+        return 0
+    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (RANK_POSES, robot.n))
+    D = np.repeat([1.0 / chain_length(robot, frame), 1.0], 3)[: kd.rows]
+    s = np.linalg.svd(D[:, None] * jacobian(robot, q, frame)[..., : kd.rows, :], compute_uv=False)
+    return int(np.max(np.sum(s > RANK_TOL * np.maximum(s[..., :1], 1e-300), axis=-1)))
+
+
+def wrench_rank(robot: Robot, frame: str, kind: str | WrenchKind = FULL) -> int:
+    """The components at ``frame`` that joint torques determine: the structural rank of
+    its Jacobian (:func:`structural_rank`), at most the joints that move it (those up to
+    its link), 6 for the wrench and 3 for the force alone (``kind``).
+
+    Raises
+    ------
+    UnknownNameError
+        An unknown frame.
+    OptionError
+        A frame on the base (no joint moves it) or, for the force, with its origin on the
+        axes of every joint moving it (structural rank 0), an unknown ``kind``.
+    """
+    kd = wrench_kind(kind)
+    k = min(kd.rows, int(robot.frame(frame).link))
     if k == 0:
         raise OptionError(f"frame {frame!r} is fixed to the base: no joint torque tells its wrench")
+    k = min(k, structural_rank(robot, frame, kd))
+    if k == 0:
+        raise OptionError(
+            f"frame {frame!r}'s origin lies on the axes of the joints moving it: no joint "
+            f"torque tells a {kd.noun} there; estimate the wrench (--wrench full) or at a "
+            "frame further out"
+        )
     return k
 
 
@@ -263,17 +320,24 @@ def underdetermined_note(robot: Robot, frame: str, kind: str | WrenchKind = FULL
         return None
     what = kd.noun
     hint = ""
-    if kd.rows > FORCE.rows and k >= FORCE.rows:
+    if kd.rows > FORCE.rows and wrench_rank(robot, frame, FORCE) >= FORCE.rows:
         hint = (
             f"; the force of a point contact at {frame}'s origin (3 components, moment zero) "
             "is determined: --wrench force"
         )
+    joints = int(robot.frame(frame).link)
+    who = f"{k} joint torques determine"
+    if joints > k:  # more joints than components: their axes leave a direction out
+        who = (
+            f"the {joints} joints moving {frame} determine (structurally, at every pose: "
+            f"its Jacobian has rank {k}, a joint's axis through its origin or axes lined up)"
+        )
     return (
-        f"{k} joint torques determine only {k} of the {kd.rows} {what} components at {frame} "
+        f"{who} only {k} of the {kd.rows} {what} components at {frame} "
         f"(those in the range of its Jacobian, turning with the pose): the {what} written is "
         f"the least-norm one that explains the residual, blind to any {what} the joints do "
         f"not feel (J^T a = 0), so a force's components can differ from the true ones; "
-        f"'damped' flags only poses where the {k} joints lose one more direction" + hint
+        f"'damped' flags only poses where the joints lose one more direction" + hint
     )
 
 

@@ -306,7 +306,10 @@ def _events_parts(name: str, run: RunFiles) -> list[str]:
     clock said once above the table and each start as the log holds it beside them (to
     find the row in the log, or in another record on the same clock; the column left out
     when every log starts at 0, where it would repeat the start); a log whose first
-    stamp no residual table gives keeps its stamps, to the millisecond."""
+    stamp no residual table gives keeps its stamps, to the millisecond. Events of a scored
+    log say whether they counted as a detection or a false alarm (``false_alarm``), and
+    with a wrench, the share of the residual it leaves unexplained
+    (``unexplained_share``)."""
     doc = run.docs[name]
     events = _events(doc)
     if not isinstance(doc, dict) or not events or not all(isinstance(e, dict) for e in events):
@@ -340,6 +343,16 @@ def _events_parts(name: str, run: RunFiles) -> list[str]:
         "#", "log", "level", "joints", "start [s]", "end [s]", "duration [ms]",
         "start on the log's clock [s]", "peak [N m]",
     ]  # fmt: skip
+    if any("false_alarm" in e for e in events):  # scored against labels: which were false
+        headers.append("scored")
+        for row, e in zip(rows, events, strict=True):
+            f = e.get("false_alarm")
+            row.append("" if f is None else "false alarm" if f is True else "detection")
+    if any(is_number(e.get("unexplained_share")) for e in events):
+        headers.append("|r| unexplained by the wrench [%]")
+        for row, e in zip(rows, events, strict=True):
+            v = e.get("unexplained_share")
+            row.append(f"{100.0 * v:.3g}" if is_number(v) else "")
     clock = headers.index("start on the log's clock [s]")
     if not any(row[clock] for row in rows):  # every log starts at 0: nothing to show
         headers.pop(clock)

@@ -51,6 +51,9 @@ the command applies, so that the Python API behaves as the command does.
   of the column map, else ``collision``, ``contact`` or ``label``;
   :func:`~dynid.workflows.observe_detect.contact_labels`), else the true external torques
   of a simulated log (:func:`~dynid.workflows.observe_detect.scored`).
+* With a frame, each event's share of the residual the wrench there leaves unexplained,
+  and a warning naming the events it does not fit
+  (:mod:`dynid.observer.wrench_fit`).
 """
 
 from __future__ import annotations
@@ -241,7 +244,8 @@ class ObserveOptions:
     label_tolerance_s : float
         Detecting a log with labelled contacts (a label column, or the true torques of a
         simulated log): how long after a contact's end [s] an event may start and still
-        detect it (:mod:`dynid.observer.scoring`).
+        detect it and, of a label column (made by hand), how long before its start
+        (:mod:`dynid.observer.scoring`; the true torques keep the exact lead, 0.02 s).
     """
 
     data: tuple[Path, ...]

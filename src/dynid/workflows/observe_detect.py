@@ -48,6 +48,7 @@ from ..observer.thresholds import Thresholds, threshold_series
 from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
+from ..observer.wrench_fit import off_frame_warning, unexplained_shares
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
 
@@ -210,6 +211,9 @@ def detected_log(
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
     damped = None if frame is None else np.zeros(log.t.shape[0], dtype=bool)
+    left = None if frame is None else np.full(log.t.shape[0], np.nan)  # |r - J^T w|^2
+    rows = None if frame is None else np.full((log.t.shape[0], n), np.nan)
+    determined = n
     seen = model.friction
     if unmodelled is not None:
         unmodelled.new_log()
@@ -224,6 +228,9 @@ def detected_log(
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
             if w is not None and damped is not None:
                 damped[a:b] = w.damped
+            if w is not None and left is not None and rows is not None:
+                left[a:b] = np.nan if w.unexplained is None else w.unexplained
+                rows[a:b], determined = blk.r, w.determined
             if w is not None and keep is not None:
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
@@ -244,6 +251,17 @@ def detected_log(
         warnings.warn(  # a whole-log "collision" on each such joint follows
             f"{prep.path.name}: {opposite}", DynidWarning, stacklevel=3
         )
+    unexplained = None
+    if frame is not None and left is not None and rows is not None:
+        shares, over = unexplained_shares(log.t, events, left, rows, thresholds.contact, determined)
+        unexplained = shares
+        robot = model.robot
+        said = off_frame_warning(
+            prep.path.name, frame, kind.noun, events, shares, over, thresholds.contact,
+            robot.joint_names, robot.link_names, int(robot.frame(frame).link),
+        )  # fmt: skip
+        if said is not None:
+            warnings.warn(said, DynidWarning, stacklevel=3)
     return LogObservation(
         prep.path,
         log.t,
@@ -264,6 +282,7 @@ def detected_log(
         dropped=det.dropped,
         dropped_count=det.dropped_count,
         damped=None if damped is None else damped_shares(log.t, events, damped),
+        unexplained=unexplained,
     )
 
 
@@ -316,16 +335,20 @@ def scored(
     against the true external torques ``ext`` (N, n) [N m] (in contact where some joint
     exceeds :data:`~dynid.observer.scoring.TRUTH_LEVEL`); the missed contacts' peaks known
     wherever the true torques are, the labels' contacts too; None with neither
-    (:mod:`dynid.observer.scoring`, the lead of :func:`~dynid.observer.scoring.lead_for`);
+    (:mod:`dynid.observer.scoring`, the lead of :func:`~dynid.observer.scoring.lead_for`:
+    ``tolerance_s`` on both sides of a label column's contacts, made by hand, a few
+    samples before the true torques' exact ones);
     ``look_ahead``: the velocities came from a zero-phase
     low-pass (:attr:`~dynid.observer.scoring.ContactScore.look_ahead`)."""
-    if labels is not None:
+    if labels is not None:  # made by hand: off either way, the tolerance on both sides
         intervals, source = label_intervals(t, labels.flags), labels.source
         peaks = None if ext is None else interval_peaks(t, ext, intervals)
-    elif ext is not None:
+        lead = lead_for(t, tolerance_s)
+    elif ext is not None:  # the true contacts: the exact lead
         intervals = label_intervals(t, truth_flags(ext))
         source = f"tau_ext > {TRUTH_LEVEL:g} N m"
         peaks = interval_peaks(t, ext, intervals)
+        lead = lead_for(t)
     else:
         return None
     ev = np.array([(e.start, e.end) for e in events], dtype=np.float64).reshape(-1, 2)
@@ -338,7 +361,7 @@ def scored(
         peaks=peaks,
         source=source,
         look_ahead=look_ahead,
-        lead_s=lead_for(t),
+        lead_s=lead,
         slack_s=time_slack(t),
     )
 
@@ -355,12 +378,14 @@ def observed_wrench(
         return external_wrench(model.robot, q, r, frame, kind=kind)
     m = r.shape[0]
     wrench, smin = np.full((m, 6), np.nan), np.full(m, np.nan)
-    damped = np.zeros(m, dtype=bool)
+    damped, left = np.zeros(m, dtype=bool), np.full(m, np.nan)
     if seen.any():
         w = external_wrench(model.robot, q[seen], r[seen], frame, kind=kind)
         wrench[seen], smin[seen], damped[seen] = w.wrench, w.sigma_min, w.damped
+        if w.unexplained is not None:
+            left[seen] = w.unexplained
     k = wrench_rank(model.robot, frame, kind)
-    return WrenchEstimate(frame, wrench, smin, damped, k, kind)
+    return WrenchEstimate(frame, wrench, smin, damped, k, kind, left)
 
 
 def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate | None:
@@ -374,6 +399,9 @@ def _joined(blocks: list[WrenchEstimate], frame: str | None) -> WrenchEstimate |
         np.concatenate([w.damped for w in blocks]),
         blocks[0].determined,
         blocks[0].kind,
+        None
+        if any(w.unexplained is None for w in blocks)
+        else np.concatenate([w.unexplained for w in blocks if w.unexplained is not None]),
     )
 
 
