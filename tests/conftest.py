@@ -29,6 +29,18 @@ from dynid.simulation.trajectories import Trajectory, random_fourier
 from dynid.simulation.unmodelled import UnmodelledEffects
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    """Ctrl-C as Python sets it, in this process and so in the workers and commands it
+    starts: a shell starts a background job (``make test &``, a script run with ``&``) with
+    SIGINT ignored, which Python keeps and every process it starts inherits, and the tests
+    of Ctrl-C (``test_run_output.py``, ``test_cli_truthful_errors.py``) then saw no
+    interrupt (8 failed in a fresh clone's ``make test`` started so)."""
+    import signal
+
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def pytest_sessionstart(session: pytest.Session) -> None:
     """With several test workers, compile the numba kernels first, in parallel groups
     (``tests/warm_kernels.py``), so that no two workers compile the same kernel at once on

@@ -253,15 +253,8 @@ def detected_log(
         )
     unexplained = None
     if frame is not None and left is not None and rows is not None:
-        shares, over = unexplained_shares(log.t, events, left, rows, thresholds.contact, determined)
-        unexplained = shares
-        robot = model.robot
-        said = off_frame_warning(
-            prep.path.name, frame, kind.noun, events, shares, over, thresholds.contact,
-            robot.joint_names, robot.link_names, int(robot.frame(frame).link),
-        )  # fmt: skip
-        if said is not None:
-            warnings.warn(said, DynidWarning, stacklevel=3)
+        unexplained = _off_frame(prep, model, frame, kind, events, left, rows, thresholds,
+                                 determined)  # fmt: skip
     return LogObservation(
         prep.path,
         log.t,
@@ -284,6 +277,32 @@ def detected_log(
         damped=None if damped is None else damped_shares(log.t, events, damped),
         unexplained=unexplained,
     )
+
+
+def _off_frame(
+    prep: PreparedLog,
+    model: ObserverModel,
+    frame: str,
+    kind: Any,
+    events: Sequence[ContactEvent],
+    left: NDArray[np.float64],
+    rows: NDArray[np.float64],
+    thresholds: Thresholds,
+    determined: int,
+) -> Any:
+    """Each event's share of the residual the wrench at ``frame`` leaves unexplained
+    (:func:`unexplained_shares`), with the warning of contacts on a link before the frame
+    (:func:`off_frame_warning`) said."""
+    t, contact = prep.log.t, thresholds.contact
+    shares, over = unexplained_shares(t, events, left, rows, contact, determined)
+    robot = model.robot
+    said = off_frame_warning(
+        prep.path.name, frame, kind.noun, events, shares, over, thresholds.contact,
+        robot.joint_names, robot.link_names, int(robot.frame(frame).link),
+    )  # fmt: skip
+    if said is not None:
+        warnings.warn(said, DynidWarning, stacklevel=4)
+    return shares
 
 
 def damped_shares(
