@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.cut_loss import left_out_finding
-from ..identification.input_noise import StateNoise, exact_to_round_off, state_noise
+from ..identification.input_noise import StateNoise, state_noise
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
@@ -56,6 +56,7 @@ from .pooled import pooled_errors
 from .validation import (
     RECORDED,
     Validation,
+    holds_cutoff,
     recorded_cutoff,
     validated,
     validated_log,
@@ -296,7 +297,7 @@ def _raw_pieces(
     jpieces, labels = [p for _, p in raw], [r for r, _ in raw]
     # joint-side pieces of a motor-side log differ by turns of the motors, not joints
     jturns = None if robot is None or (d is not None and d.side == "motor") else wrappable(robot)
-    read = isinstance(cutoff_hz, str) and _no_recorded_cutoff(model, jpieces)
+    read = isinstance(cutoff_hz, str) and not holds_cutoff(model, jpieces)
     cut = common_cutoff(jpieces, labels, jturns) if read else None
     from_motion = cut is not None
     if cut is None:
@@ -305,15 +306,6 @@ def _raw_pieces(
         trim_s = edge_seconds(jpieces, labels, cut, from_motion=from_motion, turns=jturns)
     check_below_nyquist(jpieces, None if isinstance(cutoff_hz, str) else cut)  # as given
     return _Raw(raw, names, cut, trim_s, tuple(sorted(turned)), d)
-
-
-def _no_recorded_cutoff(model: TorqueModel, logs: Sequence[TorqueLog]) -> bool:
-    """Whether ``model`` holds no cut-off of its own for ``logs`` (not a model identified
-    from logs, or one fitted unfiltered on exact logs while ``logs`` are not exact):
-    identification's would be read from the recordings' motion."""
-    if not (isinstance(model, IdentifiedModel) and model.info.log is not None):
-        return True
-    return model.info.log.cutoff_source == "exact" and not exact_to_round_off(logs)
 
 
 def _say_left_out(raw: _Raw, left: list[tuple[int, str]], max_gap_s: float | None) -> None:

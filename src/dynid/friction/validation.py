@@ -64,6 +64,7 @@ __all__ = [
     "Validation",
     "errors_from_sums",
     "own_friction",
+    "holds_cutoff",
     "recorded_cutoff",
     "validate_newton_euler",
     "validate_torques",
@@ -190,11 +191,23 @@ def recorded_cutoff(
     to round-off (``cutoff_source`` ``"exact"``) holds no cut-off for other logs: none
     for exact ones, else the one read from their motion."""
     logs = [] if log is None else [log] if isinstance(log, TorqueLog) else list(log)
-    if isinstance(model, IdentifiedModel) and model.info.log is not None:
-        if model.info.log.cutoff_source != "exact" or exact_to_round_off(logs):
-            return model.info.log.cutoff_hz
+    if (
+        isinstance(model, IdentifiedModel)
+        and model.info.log is not None
+        and holds_cutoff(model, logs)
+    ):
+        return model.info.log.cutoff_hz
     cut = common_cutoff(logs, recording)
     return DEFAULT_CUTOFF_HZ if cut is None else cut
+
+
+def holds_cutoff(model: TorqueModel, logs: Sequence[TorqueLog]) -> bool:
+    """Whether ``model`` holds the cut-off ``logs`` are prepared with: an identified
+    model's record, unless it was fitted unfiltered for its logs being exact to round-off
+    (``cutoff_source`` ``"exact"``) while ``logs`` are not exact."""
+    if not (isinstance(model, IdentifiedModel) and model.info.log is not None):
+        return False
+    return model.info.log.cutoff_source != "exact" or exact_to_round_off(logs)
 
 
 def validate_torques(
