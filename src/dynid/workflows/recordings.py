@@ -15,8 +15,8 @@ line naming the file, never a recording dropped silently:
   or more) or hold no motion (zeros, a constant) on joints whose positions move
   (:func:`usable_velocities`, as each route reads its logs): a warning naming it, the
   joints and the lag in samples and ms, and its velocities derived from the positions
-  instead, as ``--columns dq=none`` reads it (:func:`check_velocity_columns`, from
-  :func:`check_units`, refuses a log that still has such columns);
+  instead, as ``--columns dq=none`` reads it (:func:`usable_recorded`, after the unit
+  checks);
 * acceleration columns much noisier than the derivative of the velocities at the cut-off
   (a finite difference of noisy velocities): left out, with a note naming the file and the
   ratio; a note says whenever acceleration columns are used
@@ -107,7 +107,6 @@ __all__ = [
     "Recorded",
     "check_degrees",
     "check_derived_velocities",
-    "check_velocity_columns",
     "usable_recorded",
     "usable_velocities",
     "checked_accelerations",
@@ -384,23 +383,6 @@ def _scales(log: TorqueLog) -> tuple[float, float]:
     return rms, num / den if den > 0 else float("nan")
 
 
-def check_velocity_columns(rec: Recorded) -> None:
-    """Refuse a recording whose velocity columns lag the derivative of its positions or
-    hold no motion on joints whose positions move
-    (:func:`~dynid.identification.derivative_columns.velocity_finding`), naming it, the
-    joints and the lag [samples, ms], with the remedy ``--columns dq=none``. ``rec`` as the
-    preparation reads it (:func:`unwrapped_recorded`).
-
-    Raises
-    ------
-    DataError
-        The first such recording, named.
-    """
-    for name, log in zip(rec.names, rec.logs, strict=True):
-        if (found := velocity_finding(log)) is not None:
-            raise DataError(found, file=name)
-
-
 def usable_velocities(logs: Sequence[TorqueLog], names: Sequence[str]) -> tuple[TorqueLog, ...]:
     """The logs whose velocity columns lag the derivative of their positions or hold no
     motion where the positions move
@@ -487,21 +469,17 @@ def checked_accelerations(
 
 
 def check_units(rec: Recorded) -> None:
-    """Refuse a recording whose velocity columns lag its positions or hold no motion
-    (:func:`check_velocity_columns`); then one whose torque scale or velocity unit is a
-    power of ten away from the median of the other recordings' (several recordings only;
-    of two, the second is named). The velocity unit is compared among the recordings with
-    velocity columns only: velocities derived from the positions are their derivative by
-    construction.
-    ``rec`` as the preparation reads it (:func:`unwrapped_recorded`).
+    """Refuse a recording whose torque scale or velocity unit is a power of ten away from
+    the median of the other recordings' (several recordings only; of two, the second is
+    named). The velocity unit is compared among the recordings with velocity columns only:
+    velocities derived from the positions are their derivative by construction. ``rec`` as
+    the preparation reads it (:func:`unwrapped_recorded`).
 
     Raises
     ------
     DataError
-        Naming the recording, the ratio and the recordings it was compared with; or its
-        velocity columns' finding.
+        Naming the recording, the ratio and the recordings it was compared with.
     """
-    check_velocity_columns(rec)
     if len(rec.logs) < 2:
         return
     scales = np.array([_scales(log) for log in rec.logs])
