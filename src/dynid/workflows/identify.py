@@ -48,6 +48,7 @@ from ..feasibility.convex import (
     consistent_from_identified,
     identify_consistent,
 )
+from ..feasibility.payload_arm import model_structure
 from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
@@ -688,7 +689,7 @@ def _searched(
         model = fitted(structure, drive)
         held = _predicted_heldout(model, logs, separate)
     why = reason_to_judge_first(model, held)
-    chosen = Structure.parse(",".join(model.info.extra.get("terms", ())) or "links")
+    chosen = model_structure(model)
     first = None if why is None else gains_first(fitted, drive, logs, separate, why, chosen)
     if first is None:
         for w in said:
