@@ -98,3 +98,22 @@ def test_sigterm_while_the_workers_start_leaves_no_worker_and_no_traceback():
             break
         time.sleep(0.1)
     assert _in_session(proc.pid) == []
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forks")
+def test_a_stopped_pool_leaves_no_manager_thread_for_the_exit_hook():
+    """After the clean-up of a block that raised, the executor's manager thread has ended:
+    the interpreter's exit hook writes to the thread's wake-up pipe while the thread lives,
+    and the thread closing the pipe meanwhile printed ``OSError: [Errno 9] Bad file
+    descriptor`` as a SIGHUP run's last line (the shutdown forgets the thread, and the
+    clean-up found nothing to join)."""
+    from dynid import _parallel
+
+    with pytest.raises(KeyboardInterrupt), _parallel.process_pool(2) as ex:
+        futs = [ex.submit(time.sleep, 60) for _ in range(2)]
+        manager = ex._executor_manager_thread  # type: ignore[attr-defined]
+        assert manager is not None and manager.is_alive()
+        time.sleep(0.2)
+        raise KeyboardInterrupt
+    assert not manager.is_alive()
+    assert all(f.cancelled() or f.done() for f in futs)

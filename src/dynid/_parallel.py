@@ -141,6 +141,8 @@ def _stop(ex: ProcessPoolExecutor) -> None:
     stopping)."""
     procs: list[Any] = []
     _again(lambda: procs.extend(p for p in _workers(ex) if p not in procs))
+    # taken before the shutdown, which forgets it (``_executor_manager_thread = None``)
+    manager = getattr(ex, "_executor_manager_thread", None)
     _again(lambda: ex.shutdown(wait=False, cancel_futures=True))
     for p in procs:
         _again(p.terminate)
@@ -149,7 +151,6 @@ def _stop(ex: ProcessPoolExecutor) -> None:
     # the executor's manager thread closes its wake-up pipe when it ends; the interpreter's
     # exit hook writes to that pipe if the thread has not ended, and a close between its
     # check and its write prints a traceback (Python 3.11): let the thread end first
-    manager = getattr(ex, "_executor_manager_thread", None)
     if manager is not None:
         _again(functools.partial(manager.join, timeout=5.0))
 
