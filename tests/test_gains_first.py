@@ -376,3 +376,54 @@ def test_the_richest_structure_takes_the_chosen_friction_law():
     classical = Structure.parse("armature,viscous,coulomb,offset")
     assert richest_structure(drive) == classical
     assert richest_structure(drive, Structure.parse("links")) == classical
+
+
+#: Gear ratios of a joint-side drive whose constants a user gave at the motors.
+GEARS = np.array([100.0, 100.0, 100.0, 100.0, 50.0, 50.0, 50.0])
+
+
+def test_constants_given_at_the_motors_are_read_times_the_gear_ratios(panda, current_log):
+    """A joint-side current log through a drive of gear ratios 100 and 50 whose
+    torque_constant holds the motors' constants (the true joint torque per A over the gear
+    ratio, a datasheet's): the gains follow the gear ratios, the note says the constants
+    look given at the motors, and the model reads the currents through the true
+    constants (torque_constant x gear_ratio, every joint's, the wrist's too) with its
+    held-out verdict at the noise floor, naming no factor."""
+    K = np.diag(GEARS)
+    drive = dataclasses.replace(
+        Drive.identity(7), transmission=K, effort="current", torque_constant=KT / GEARS
+    )
+    got = _identified(panda, current_log, drive)
+    assert got.model.drive is not None and got.model.drive.torque_constant is not None
+    np.testing.assert_allclose(got.model.drive.torque_constant, KT, rtol=1e-12)
+    note = got.model.info.extra["gains_first"]
+    assert "torque_constant looks given at the motors" in note, note
+    assert "torque_constant x gear_ratio" in note
+    held = got.heldout
+    assert held is not None and held.verdict.ratio is not None and held.verdict.ratio < 1.5
+    assert held.gains is None or not held.gains.named, held.gains
+
+
+@pytest.mark.parametrize(
+    "factor, found",
+    [
+        (GEARS * 0.8, True),  # the description's masses 20 % off: still the gear ratios
+        (GEARS * np.array([0.8, 0.8, 0.8, 0.8, 1.0, 1.0, 1.0]), False),  # 25 % apart
+        (1 / GUESS, False),  # two constants guessed off, near 1
+        (GEARS * 5.0, False),  # a common factor beyond the masses' error
+    ],
+)
+def test_the_gear_ratio_pattern_needs_gains_that_follow_the_gear_ratios(factor, found):
+    """Gains per joint (determined, 0.1 % std) that are the gear ratios times one factor
+    within 15 % and between 1/3 and 3 are the pattern of constants given at the motors;
+    others are not."""
+    from dynid.identification.drive_gains import DriveGains
+    from dynid.identification.motor_constants import gear_ratio_pattern
+
+    cov = np.diag((1e-3 * factor) ** 2)
+    gains = DriveGains(factor, cov, True, 10.0, 1.0, effort="current", per="motor")
+    drive = dataclasses.replace(
+        Drive.identity(7), transmission=np.diag(GEARS), effort="current", torque_constant=KT
+    )
+    assert (gear_ratio_pattern(gains, drive) is not None) is found
+    assert gear_ratio_pattern(gains, dataclasses.replace(drive, side="motor")) is None

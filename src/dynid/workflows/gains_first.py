@@ -41,6 +41,7 @@ from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.drive_gains import DriveGains
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
+from ..identification.motor_constants import GearRatioPattern, gear_ratio_pattern
 from ..identification.rotor_sign import negative_rotor_inertias, per_joint
 from ..identification.structure import Structure
 from ..model.drive import Drive
@@ -87,6 +88,10 @@ class CorrectedSearch:
         The search's warnings (of the model kept), for the caller to say.
     rich : Structure
         The structure the factors were judged with (:func:`richest_structure`).
+    pattern : GearRatioPattern, optional
+        The gains follow the gear ratios (constants given at the motors on a joint-side
+        log): the drive's constants are corrected by the gear ratios, every motor's, not
+        by the factors.
     """
 
     gains: DriveGains
@@ -95,6 +100,7 @@ class CorrectedSearch:
     why: str = ""
     said: tuple[warnings.WarningMessage, ...] = ()
     rich: Structure = dataclasses.field(default_factory=Structure)
+    pattern: GearRatioPattern | None = None
 
     @property
     def structure(self) -> Structure:
@@ -104,6 +110,9 @@ class CorrectedSearch:
     def factors(self) -> str:
         """The factors named, in words: ``joint 2's by 0.713, joint 4's by 1.42``."""
         g = self.gains
+        if self.pattern is not None:
+            ratios = ", ".join(f"{r:.4g}" for r in self.pattern.gear_ratio)
+            return f"every motor's by its gear ratio ({ratios})"
         return ", ".join(f"{g.per} {k + 1}'s by {g.factor[k]:.3g}" for k in g.named)
 
     def note(self) -> str:
@@ -111,9 +120,18 @@ class CorrectedSearch:
         were judged first and the factors the search's efforts were corrected by."""
         said = self.factors()
         why = f" ({self.why})" if self.why else ""
-        return (
+        judged = (
             f"the torque constants were judged first{why} with the richest structure "
-            f"({','.join(self.rich.terms)}) and the structure was chosen "
+            f"({','.join(self.rich.terms)})"
+        )
+        if self.pattern is not None:
+            return (
+                f"{judged}: {self.pattern.sentence()}; the structure was chosen on them and "
+                "the model is fitted to them (identification.json's drive holds "
+                "torque_constant x gear_ratio: put it in the drive file)"
+            )
+        return (
+            f"{judged} and the structure was chosen "
             f"on efforts corrected by their factors: {said}; the model is fitted to them (its "
             "drive's torque_constant times the factors)"
         )
@@ -228,11 +246,14 @@ def gains_first(
     gains = None if held is None else held.gains
     if gains is None or not gains.named:
         return None
+    pattern = gear_ratio_pattern(gains, drive)
     factor = np.ones(drive.n)
     named = list(gains.named)
     factor[named] = gains.factor[named]
+    if pattern is not None:  # the constants were right, at the motors: every one
+        factor = pattern.gear_ratio
     corrected = dataclasses.replace(drive, torque_constant=drive.torque_constant * factor)
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         searched = fit("auto", corrected)
-    return CorrectedSearch(gains, corrected, searched, why, tuple(said), richest)
+    return CorrectedSearch(gains, corrected, searched, why, tuple(said), richest, pattern)

@@ -704,7 +704,7 @@ def _searched(
     )
     model = dataclasses.replace(model, info=info)
     held = _predicted_heldout(model, logs, separate)
-    if held is not None:  # one judgement of the efforts' scale
+    if held is not None and first.pattern is None:  # one judgement of the efforts' scale
         gains = None if first.gains is None else dataclasses.replace(first.gains, applied=True)
         held = dataclasses.replace(held, gains=gains, springs=None, tilt=None)
     return model, held, first

@@ -1,0 +1,108 @@
+"""Torque constants given at the motors where a joint-side log's drive wants them at the
+joints.
+
+On a joint-side log of currents (``side = "joint"``, ``effort = "current"``) a drive's
+``torque_constant`` is each joint's torque per ampere: the motor's constant times its gear
+ratio. A datasheet's constant, per ampere at the motor, reads every joint's torques its
+gear ratio times too small; the gains per motor (:mod:`~dynid.identification.drive_gains`)
+then come out as the gear ratios times one common factor, the description's masses'
+error (a 6-axis arm of gear ratios 30, 30, 30, 20, 20, 20 whose description lacked a
+0.28 kg gripper and had masses 15 % off: factors 24.3, 24.4, 24.4, 16.3, 16.0, their ratios
+to the gear ratios 0.80 to 0.82, the wrist motor's gain not determined). Corrected by those
+factors the model is off by the masses' error, 19 %, and the undetermined motor by its gear
+ratio; corrected by the gear ratios, by neither: the constants were right, at the motor.
+:func:`gear_ratio_pattern` tells the pattern; :meth:`GearRatioPattern.sentence` says it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.drive import Drive
+from .drive_gains import DriveGains
+
+__all__ = ["SPREAD", "GearRatioPattern", "gear_ratio_pattern"]
+
+#: Largest spread (largest over smallest, less one) of the determined motors' gains over
+#: their gear ratios for the gains to follow the gear ratios.
+SPREAD = 0.15
+#: Range of the common factor (gain over gear ratio): the description's masses are that
+#: far off at most.
+_COMMON = (1.0 / 3.0, 3.0)
+#: Smallest ratio between the largest and smallest gear ratio of the determined motors:
+#: gains uniform over equal gear ratios are one common factor, not this pattern's.
+_DISTINCT = 1.2
+
+
+@dataclass(frozen=True, slots=True)
+class GearRatioPattern:
+    """Gains per motor that follow the drive's gear ratios.
+
+    Attributes
+    ----------
+    gear_ratio : ndarray, shape (n,)
+        Each joint's gear ratio [-] (the transmission's diagonal, its magnitude).
+    common : ndarray, shape (k,)
+        The determined motors' gains over their gear ratios [-].
+    motors : tuple of int
+        The determined motors (from 0).
+    """
+
+    gear_ratio: NDArray[np.float64]
+    common: NDArray[np.float64]
+    motors: tuple[int, ...]
+
+    def sentence(self) -> str:
+        """The finding in words (``torque_constant looks given at the motors: ...``)."""
+        lo, hi = float(self.common.min()), float(self.common.max())
+        span = f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g} to {hi:.3g}"
+        which = ", ".join(str(k + 1) for k in self.motors)
+        return (
+            "torque_constant looks given at the motors: the currents' gains follow the gear "
+            f"ratios (gain / gear ratio {span} on motor(s) {which}, the rest the "
+            "description's masses' error); on a joint-side log (side = \"joint\") "
+            "torque_constant is each joint's torque per A, the motor's constant times its "
+            "gear ratio: the currents are read through torque_constant x gear_ratio"
+        )
+
+
+def gear_ratio_pattern(gains: DriveGains, drive: Drive) -> GearRatioPattern | None:
+    """The pattern of constants given at the motors (module docstring), or None.
+
+    Parameters
+    ----------
+    gains : DriveGains
+        The gains per joint of a joint-side current log (:attr:`DriveGains.factor` at the
+        description's scale, :attr:`DriveGains.scaled`).
+    drive : Drive
+        The drive the log was read through: joint side, currents, a diagonal transmission
+        (no coupling) of gear ratios not all equal.
+
+    Returns
+    -------
+    GearRatioPattern or None
+        The pattern when at least two determined motors of gear ratios at least
+        :data:`_DISTINCT` apart have gains over their gear ratios within :data:`SPREAD` of
+        each other and within :data:`_COMMON` of one.
+    """
+    if drive.side != "joint" or drive.effort != "current" or not gains.scaled:
+        return None
+    K = np.asarray(drive.transmission, dtype=np.float64)
+    ratio = np.abs(np.diag(K))
+    if np.count_nonzero(K - np.diag(np.diag(K))) or gains.factor.shape != ratio.shape:
+        return None
+    motors = np.flatnonzero(gains.determined)
+    if motors.size < 2 or ratio[motors].max() < _DISTINCT * ratio[motors].min():
+        return None
+    common = gains.factor[motors] / ratio[motors]
+    if not np.all(np.isfinite(common)) or common.min() <= 0:
+        return None
+    if common.max() > (1.0 + SPREAD) * common.min():
+        return None
+    mid = float(np.exp(np.mean(np.log(common))))
+    if not _COMMON[0] <= mid <= _COMMON[1]:
+        return None
+    return GearRatioPattern(ratio, common, tuple(int(k) for k in motors))
