@@ -55,3 +55,20 @@ def test_masses_off_joint_by_joint_or_a_factor_near_one_say_nothing(q):
     near = exact_model(robot, robot.with_params(0.95 * robot.phi))
     assert gravity_scale_finding(robot, near, [q]) is None
     assert gravity_scale_finding(robot, exact_model(robot, robot), [q]) is None
+
+
+def test_one_factor_near_a_shared_gear_ratio_names_constants_given_at_the_motors(q):
+    """A joint-side drive of gear ratio 100 on every joint whose model came out 1/90 of
+    the description (constants given at the motors, the masses 10 % off): the finding says
+    the constants look given at the motors and what a joint-side log wants; with gear
+    ratio 1, or a factor far from the gear ratio, it does not."""
+    robot = dynid.panda()
+    model = exact_model(robot, robot.with_params(robot.phi / 90.0))
+    geared = Drive(100.0 * np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
+    said = gravity_scale_finding(robot, model, [q], geared)
+    assert said is not None and "multiply it by 90" in said
+    assert "near the gear ratio, 100: torque_constant looks given at the motors" in said
+    plain = Drive(np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
+    assert "given at the motors" not in (gravity_scale_finding(robot, model, [q], plain) or "")
+    far = exact_model(robot, robot.with_params(robot.phi / 2.0))
+    assert "given at the motors" not in (gravity_scale_finding(robot, far, [q], geared) or "x")

@@ -93,6 +93,7 @@ def gravity_scale_finding(
         return (
             f"{said}; if the description's masses are right, the drive file's torque_constant "
             f"is {mean:.3g} times the true one: multiply it by {1 / mean:.3g}"
+            f"{_at_the_motors(drive, 1 / mean)}"
         )
     currents = (
         '; or the log holds motor currents: a drive file with effort = "current" and each '
@@ -103,4 +104,21 @@ def gravity_scale_finding(
     return (
         f"{said}; if the description's masses are right, the torques are {1 / mean:.3g} "
         f"times too small (a sensor scale: --units tau={1 / mean:.3g}){currents}"
+    )
+
+
+def _at_the_motors(drive: Drive, factor: float) -> str:
+    """A clause when ``factor``, the torque constants' correction, is near the gear ratio
+    every joint of a joint-side ``drive`` shares (within 1/3 to 3 times): constants given
+    at the motors, where ``side = "joint"`` wants each joint's torque per A."""
+    K = np.asarray(drive.transmission, dtype=np.float64)
+    ratio = np.abs(np.diag(K))
+    if drive.side != "joint" or np.count_nonzero(K - np.diag(np.diag(K))):
+        return ""
+    if not np.allclose(ratio, ratio[0]) or ratio[0] == 1 or not 1 / 3 <= factor / ratio[0] <= 3:
+        return ""
+    return (
+        f" (near the gear ratio, {ratio[0]:.4g}: torque_constant looks given at the motors; on "
+        "a joint-side log, side = \"joint\", it is each joint's torque per A, the motor's "
+        "constant times its gear ratio)"
     )
