@@ -70,8 +70,9 @@ def test_urdf_and_mjcf_hold_motor_friction_reflected_through_the_gears(tmp_path)
     """Regression: a smooth law at the motors was fitted over the joints' velocity range
     (10 rad/s for motors turning 3450 rad/s), so the SO-101's shoulder read damping 1.80
     and friction 0.051 instead of 0.208 and 0.084 (345^2 fv, 345 fc). Now the URDF and
-    MuJoCo's compiled MJCF hold the law's reflection, the NNLS fit of the joint torque over
-    the joint's range, within 1 % of G^2 fv and G fc."""
+    the URDF holds the law's reflection, the NNLS fit of the joint torque over the joint's
+    range, within 1 % of G^2 fv and G fc; MuJoCo's compiled MJCF, whose dry friction is a
+    ramp that holds the rounding, exactly G^2 fv and G fc."""
     law = _motor_law()
     damping, friction, _ = _joint_fit(VS_M)
     path, lines = _warnings(export_urdf, tmp_path / "r.urdf", _arm(), ExportOptions(friction=law))
@@ -83,8 +84,8 @@ def test_urdf_and_mjcf_hold_motor_friction_reflected_through_the_gears(tmp_path)
     assert len(lines) == 1 and "friction at the motors" in lines[0], lines
     (text, _), mj_lines = _warnings(mjcf_from_robot, _arm(), friction=law)
     model = mujoco.MjModel.from_xml_string(text)
-    np.testing.assert_allclose(model.dof_damping, damping, rtol=1e-9)
-    np.testing.assert_allclose(model.dof_frictionloss, friction, rtol=1e-9)
+    np.testing.assert_allclose(model.dof_damping, G**2 * FV_M, rtol=1e-9)
+    np.testing.assert_allclose(model.dof_frictionloss, G * FC_M, rtol=1e-9)
     assert len(mj_lines) == 1 and "friction at the motors" in mj_lines[0], mj_lines
 
 

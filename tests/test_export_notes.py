@@ -119,10 +119,14 @@ def test_a_friction_urdf_cannot_hold_is_said_in_one_sentence(tmp_path):
         )[1]
     said = [x for x in lines if "smooth_stribeck" in x]
     assert len(said) == 2, lines
-    for line in said:
+    for line, written in zip(
+        said,
+        ("as the nonnegative viscous and Coulomb friction closest", "with its rounding"),
+        strict=True,
+    ):
         assert line.count("smooth_stribeck friction") == 1, line
         assert "friction without smooth_stribeck" not in line and "; not written:" not in line
-        assert ", written as the nonnegative viscous and Coulomb friction closest" in line
+        assert f", written {written}" in line
         assert ", without the Stribeck peak fs - fc at low speed (no per-joint term)" in line
         assert " and the offsets fo (up to +0.8 N m at joint 7); feasible.json holds it " in line
         assert line.endswith(

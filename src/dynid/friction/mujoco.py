@@ -247,7 +247,7 @@ def _coupled_coulomb_note(K: NDArray[np.float64], left: NDArray[np.float64]) -> 
 
 
 def joint_coulomb_viscous(
-    friction: FrictionModel | FrictionSum, dq_max: ArrayLike | None = None
+    friction: FrictionModel | FrictionSum, dq_max: ArrayLike | None = None, *, sharp: bool = True
 ) -> DriveJointTerms:
     """Per-joint Coulomb (``frictionloss``, URDF ``friction``) and viscous (``damping``)
     coefficients of a friction model, at the joints or reflected from the motors of a drive
@@ -265,6 +265,12 @@ def joint_coulomb_viscous(
     friction : FrictionModel
     dq_max : array_like, shape (n,), optional
         Velocity range of the joints [rad/s] (default 2 rad/s).
+    sharp : bool
+        True (URDF): the Coulomb term is a sharp ``sign(dq)``, and a smooth law's
+        ``fc tanh(dq / width)`` is refitted as viscous and sharp Coulomb friction. False
+        (MJCF, whose ``frictionloss`` is a ramp of a slope the file sets,
+        :mod:`dynid.friction.mujoco_soft`): the smooth law's ``fv`` and ``fc`` as they are;
+        only negative terms are refitted.
 
     Returns
     -------
@@ -273,7 +279,7 @@ def joint_coulomb_viscous(
         reflected from where it acts).
     """
     if isinstance(friction, FrictionSum):
-        each = [joint_coulomb_viscous(p, dq_max) for p in friction.parts]
+        each = [joint_coulomb_viscous(p, dq_max, sharp=sharp) for p in friction.parts]
         z = np.zeros(friction.n)
         return DriveJointTerms(
             np.sum([t.armature for t in each], axis=0),
@@ -289,7 +295,7 @@ def joint_coulomb_viscous(
     notes = (f"{friction.kind} friction: {terms.dropped} has no per-joint term",) * bool(
         terms.dropped
     )
-    terms, negative, refit = _dissipative(friction, terms, vlaw)
+    terms, negative, refit = _dissipative(friction, terms, vlaw, sharp)
     z = np.zeros(n)
     jt = DriveJointTerms(z, terms.damping, terms.frictionloss, (), terms.offset)
     if friction.drive is not None:
@@ -352,14 +358,15 @@ ROUND_OFF_NM = 1e-6
 
 
 def _dissipative(
-    friction: FrictionModel, terms: MjcfTerms, vlaw: NDArray[np.float64]
+    friction: FrictionModel, terms: MjcfTerms, vlaw: NDArray[np.float64], sharp: bool = True
 ) -> tuple[MjcfTerms, NDArray[np.intp], NDArray[np.intp]]:
     """``terms`` with every motor (joint) whose ``damping`` or ``frictionloss`` came out
     negative (a law identified with the links whose viscous part is negative beside a
     larger smooth Coulomb part: dissipative as a whole, not term by term), and every one of
     a smooth-sign law, replaced by the nonnegative ``fv dq + fc sign(dq)`` closest to the
     law's odd part over ``(0, vlaw]``, the velocities where the law acts
-    (:func:`~dynid.friction.laws.base.odd_coulomb_viscous`); with the motors (joints)
+    (:func:`~dynid.friction.laws.base.odd_coulomb_viscous`; the smooth-sign laws only when
+    ``sharp``, the Coulomb term written as a sharp sign); with the motors (joints)
     negative and those replaced. MuJoCo and URDF readers take a negative damping as a
     joint that pushes."""
     negative = (terms.damping < 0) | (terms.frictionloss < 0)
@@ -368,7 +375,7 @@ def _dissipative(
     P = friction.as_array()
     band = np.asarray(friction.band, dtype=np.float64)
     band = band if band.size == P.shape[0] else np.zeros(P.shape[0])
-    smooth = (band > 0) & (friction.kind in ("smooth", "smooth_stribeck"))
+    smooth = (band > 0) & (friction.kind in ("smooth", "smooth_stribeck")) & sharp
     bad = np.flatnonzero(negative | smooth)
     damping, loss = terms.damping.copy(), terms.frictionloss.copy()
     for m in bad:
@@ -425,6 +432,8 @@ def unheld_friction(
     friction: FrictionModel | FrictionSum,
     dq_max: ArrayLike | None = None,
     offset_held: NDArray[np.bool_] | None = None,
+    *,
+    sharp: bool = True,
 ) -> tuple[str, ...]:
     """What per-joint viscous and sharp Coulomb friction (MJCF ``damping`` and
     ``frictionloss``, URDF ``<dynamics damping friction>``) cannot hold of a friction
@@ -433,7 +442,9 @@ def unheld_friction(
     offsets ``fo`` [N m], and that the friction acts at the motors (written reflected to
     the joints). Empty when the coefficients hold the model exactly. ``offset_held`` (n,):
     the joints whose offset the file holds otherwise (a joint spring's reference, MJCF's
-    ``springref``), left out of the offsets' line.
+    ``springref``), left out of the offsets' line. ``sharp=False``: the file holds the
+    smooth law's rounding as its dry friction's slope (MJCF,
+    :mod:`dynid.friction.mujoco_soft`), not named here.
     """
     notes: list[str] = []
     for p in friction_parts(friction):
@@ -445,11 +456,12 @@ def unheld_friction(
         if np.any(band > 0):
             j = int(np.argmax(band))
             if p.kind in ("smooth", "smooth_stribeck"):
-                notes.append(
-                    f"the {p.kind} law's rounding fc tanh(dq / width){where} (the smooth "
-                    f"sign's width up to {band[j]:.3g} rad/s at {what} {j + 1}; written as "
-                    "plain Coulomb friction)"
-                )
+                if sharp:
+                    notes.append(
+                        f"the {p.kind} law's rounding fc tanh(dq / width){where} (the smooth "
+                        f"sign's width up to {band[j]:.3g} rad/s at {what} {j + 1}; written "
+                        "as plain Coulomb friction)"
+                    )
             else:
                 notes.append(
                     f"the standstill band{where} (no Coulomb friction for |dq| up to "

@@ -18,7 +18,8 @@ keeping the robot's link and joint names:
   (``boundmass``, ``boundinertia``): massless links weigh 1e-10 kg, real links are
   unchanged;
 * every named frame that is not a link (``flange``, tools) becomes a ``<site>``;
-* ``<option gravity>`` is the robot's gravity [m/s^2]; one ``<motor>`` per joint with
+* ``<option timestep>`` is MuJoCo's default, 0.002 s (:data:`MJCF_TIMESTEP`), and
+  ``gravity`` the robot's [m/s^2]; one ``<motor>`` per joint with
   ``ctrlrange`` = the torque limit when it is finite (gear 1, so ``ctrl`` is the joint
   torque [N m]);
 * friction (``friction=True`` and a sigmoid on the robot): the sigmoid's odd part fitted
@@ -28,11 +29,16 @@ keeping the robot's link and joint names:
   :class:`~dynid.friction.model.Friction` of any law of the registry
   (:mod:`dynid.friction.laws`) is written as its law maps itself
   (:attr:`~dynid.friction.laws.base.FrictionLaw.mjcf`: the classical law's ``fc`` and
-  ``fv`` as they are, the asymmetric law's means, the Stribeck law's ``fv`` and ``fc``),
-  what MJCF cannot hold (the offsets, a smooth law's rounding, a standstill band, an
+  ``fv`` as they are, the smooth law's too, the asymmetric law's means, the Stribeck law's
+  ``fv`` and ``fc``). MuJoCo's ``frictionloss`` is a soft constraint, a ramp of the
+  velocity saturating at ``frictionloss``: each joint's ``solreffriction`` and
+  ``solimpfriction`` set its slope at rest (:mod:`dynid.friction.mujoco_soft`, from the
+  file's own inverse weights, :func:`invweight0`), a smooth law's rounding
+  ``fc tanh(dq / width)`` as the closest ramp (about ``0.8 fc / width``), a sharp law's
+  as the steepest MuJoCo holds. What MJCF cannot hold (the offsets, a standstill band, an
   asymmetry, a Stribeck peak, a quadratic term, friction at the motors, coupled terms;
-  :func:`dynid.friction.mujoco.unheld_friction`) named in one warning line with the files
-  that hold it.
+  :func:`dynid.friction.mujoco.unheld_friction`) is named in one warning line with the
+  files that hold it, with how a smooth law's rounding was written.
   With ``friction=False`` the joints are frictionless, and ``mj_inverse`` equals
   :func:`dynid.rnea`;
 * a joint spring (:attr:`~dynid.model.robot.Robot.spring`, the motors' torque
@@ -56,15 +62,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import __version__
+from ...dynamics.terms import mass_matrix
 from ...exceptions import DynidWarning, ModelError, ShapeError
 from ...friction.model import FrictionModel, FrictionSum, robot_friction, sigmoid_parameters
 from ...friction.mujoco import (
+    ROUND_OFF_NM,
     CoulombViscous,
     coulomb_viscous_from_sigmoid,
     drive_joint_terms,
     joint_coulomb_viscous,
     unheld_friction,
 )
+from ...friction.mujoco_soft import SoftFrictionLoss, soft_frictionloss
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
@@ -77,7 +86,18 @@ from .export_options import (
     xml_comment,
 )
 
-__all__ = ["export_mjcf", "mjcf_from_robot", "save_mjcf", "spring_held_offsets"]
+__all__ = [
+    "MJCF_TIMESTEP",
+    "export_mjcf",
+    "invweight0",
+    "mjcf_from_robot",
+    "save_mjcf",
+    "spring_held_offsets",
+]
+
+#: The timestep [s] the file writes (MuJoCo's default): the dry friction's time constant
+#: is two of it (:mod:`dynid.friction.mujoco_soft`).
+MJCF_TIMESTEP = 0.002
 
 
 def _f(x: float) -> str:
@@ -114,22 +134,74 @@ def spring_held_offsets(
     return out
 
 
+def invweight0(robot: Robot, armature: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """MuJoCo's ``dof_invweight0`` (n,) [1/(kg m^2), m/kg for a prismatic joint] of the
+    file: the diagonal of ``(M(0) + diag(armature))^{-1}``, the inverse mass matrix at the
+    joints' zero (MuJoCo's ``qpos0``) with the rotors' ``armature`` [kg m^2] (n,)."""
+    n = robot.n
+    M = mass_matrix(robot, np.zeros(n)) + np.diag(np.zeros(n) if armature is None else armature)
+    L = np.linalg.cholesky(M)
+    Linv = np.linalg.solve(L, np.eye(n))  # M^-1 = L^-T L^-1: its diagonal, column sums
+    return np.asarray(np.sum(Linv**2, axis=0), dtype=np.float64)
+
+
+def _velocity_range(robot: Robot) -> NDArray[np.float64]:
+    """The joints' velocity limits [rad/s], 2 rad/s where none is given."""
+    return np.where(np.isfinite(robot.dq_max), robot.dq_max, 2.0)
+
+
+def _soft(
+    model: FrictionModel | FrictionSum,
+    approx: CoulombViscous,
+    robot: Robot,
+    armature: NDArray[np.float64] | None,
+) -> tuple[SoftFrictionLoss, tuple[str, ...]]:
+    """The dry friction's slope at rest per joint (:mod:`dynid.friction.mujoco_soft`) and
+    the line saying how it holds a smooth law's rounding (none below round-off)."""
+    soft = soft_frictionloss(
+        model,
+        approx.viscous,
+        approx.coulomb,
+        _velocity_range(robot),
+        invweight0(robot, armature),
+        MJCF_TIMESTEP,
+    )
+    smooth = any(
+        p.kind in ("smooth", "smooth_stribeck") and np.any(np.asarray(p.band) > 0)
+        for p in (model.parts if isinstance(model, FrictionSum) else (model,))
+    )
+    if not smooth or np.max(soft.rms_error) < ROUND_OFF_NM:
+        return soft, ()
+    j = int(np.argmax(soft.rms_error))
+    return soft, (
+        f"{model.kind} friction: written with its rounding fc tanh(dq / width) as the "
+        "slope at rest of MuJoCo's soft frictionloss (solreffriction, solimpfriction; RMS "
+        f"difference at the joints up to {soft.rms_error[j]:.3g} N m, at joint {j + 1} "
+        "moving alone)",
+    )
+
+
 def _law_terms(
-    friction: FrictionModel | FrictionSum, robot: Robot, kept: str
-) -> tuple[CoulombViscous, tuple[str, ...], NDArray[np.bool_]]:
-    """A friction model as MuJoCo holds it, what it drops (one line each, ending with
-    ``kept``: the files that hold it, :func:`~dynid.io.robot.export_options.kept_elsewhere`),
-    and the joints whose offset the robot's spring holds (:func:`spring_held_offsets`),
-    which are not dropped."""
-    dq_max = robot.dq_max
-    vmax = np.where(np.isfinite(dq_max), dq_max, 2.0)
-    jt = joint_coulomb_viscous(friction, vmax)
+    friction: FrictionModel | FrictionSum,
+    robot: Robot,
+    kept: str,
+    armature: NDArray[np.float64] | None,
+) -> tuple[CoulombViscous, SoftFrictionLoss, tuple[str, ...], NDArray[np.bool_]]:
+    """A friction model as MuJoCo holds it (the smooth laws' ``fv`` and ``fc`` as they
+    are, their rounding as the dry friction's slope, :func:`_soft`), what it drops (one
+    line each, ending with ``kept``: the files that hold it,
+    :func:`~dynid.io.robot.export_options.kept_elsewhere`), and the joints whose offset the
+    robot's spring holds (:func:`spring_held_offsets`), which are not dropped."""
+    vmax = _velocity_range(robot)
+    jt = joint_coulomb_viscous(friction, vmax, sharp=False)
     z = np.zeros(friction.n)
     offset = z if jt.offset is None else jt.offset
     held = spring_held_offsets(robot, offset, friction.at_motors)
-    lost = jt.notes + unheld_friction(friction, vmax, held)
+    approx = CoulombViscous(jt.frictionloss, jt.damping, offset, z, z)
+    soft, rounding = _soft(friction, approx, robot, armature)
+    lost = rounding + jt.notes + unheld_friction(friction, vmax, held, sharp=False)
     if not lost:
-        return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (), held
+        return approx, soft, (), held
     written, left = friction_losses(friction.kind, lost)
     note = (
         f"the joints' frictionloss and damping (Coulomb and viscous friction at the joints) "
@@ -138,21 +210,31 @@ def _law_terms(
         + (f", without {left}" if left else "")
         + (f"; {kept}" if kept else "")
     )
-    return CoulombViscous(jt.frictionloss, jt.damping, offset, z, z), (note,), held
+    return approx, soft, (note,), held
+
+
+_Terms = tuple[
+    CoulombViscous | None,
+    SoftFrictionLoss | None,
+    NDArray[np.float64] | None,
+    tuple[str, ...],
+    NDArray[np.bool_],
+]
 
 
 def _joint_terms(
     robot: Robot, friction: bool | FrictionModel | FrictionSum, drive: Drive | None, kept: str
-) -> tuple[CoulombViscous | None, NDArray[np.float64] | None, tuple[str, ...], NDArray[np.bool_]]:
+) -> _Terms:
     """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
 
-    Returns ``(approximation, armature, notes, held)``: the Coulomb and viscous terms per
-    joint (None: frictionless), the armature (n,) [kg m^2] (None: no drive with rotor
-    inertias), one note per thing dropped (:func:`dynid.friction.mujoco.drive_joint_terms`,
-    :func:`_law_terms`) and the joints (n,) whose friction offset the spring's reference
-    holds (:func:`spring_held_offsets`). ``friction=True`` is the robot's own friction: its sigmoid
-    (``Robot.friction``) by the fit of its odd part up to ``dq_max``, another law as that
-    law maps itself.
+    Returns ``(approximation, soft, armature, notes, held)``: the Coulomb and viscous terms
+    per joint (None: frictionless), the dry friction's slope at rest
+    (:mod:`dynid.friction.mujoco_soft`; None: frictionless), the armature (n,) [kg m^2]
+    (None: no drive with rotor inertias), one note per thing dropped
+    (:func:`dynid.friction.mujoco.drive_joint_terms`, :func:`_law_terms`) and the joints
+    (n,) whose friction offset the spring's reference holds (:func:`spring_held_offsets`).
+    ``friction=True`` is the robot's own friction: its sigmoid (``Robot.friction``) by the
+    fit of its odd part up to ``dq_max``, another law as that law maps itself.
     """
     n = robot.n
     model = robot_friction(robot) if friction is True else friction or None
@@ -176,11 +258,13 @@ def _joint_terms(
     sigmoid = sigmoid_parameters(model) if friction is True else None
     if model is not None and sigmoid is not None:  # the description's sigmoid
         fit = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
-        return fit, armature, notes, spring_held_offsets(robot, fit.offset, model.at_motors)
+        soft, _ = _soft(model, fit, robot, armature)
+        held = spring_held_offsets(robot, fit.offset, model.at_motors)
+        return fit, soft, armature, notes, held
     if model is None:
-        return None, armature, notes, np.zeros(n, dtype=bool)
-    approx, more, held = _law_terms(model, robot, kept)
-    return approx, armature, notes + more, held
+        return None, None, armature, notes, np.zeros(n, dtype=bool)
+    approx, soft, more, held = _law_terms(model, robot, kept, armature)
+    return approx, soft, armature, notes + more, held
 
 
 def _comment(
@@ -195,7 +279,10 @@ def _comment(
     if approx is None:
         text += "; frictionless joints"
     else:
-        text += "; friction: Coulomb as frictionloss, viscous as damping"
+        text += (
+            "; friction: Coulomb as frictionloss (MuJoCo's soft dry friction, its slope at "
+            "rest set per joint by solreffriction and solimpfriction), viscous as damping"
+        )
         if isinstance(friction, bool):
             text += " (fit of the sigmoid)"
         elif friction.at_motors:
@@ -207,9 +294,20 @@ def _comment(
     return text + "".join(f"; {note}" for note in notes)
 
 
+def _friction_attrs(approx: CoulombViscous, soft: SoftFrictionLoss | None, i: int) -> str:
+    """Joint ``i``'s ``frictionloss`` and ``damping``, with the dry friction's
+    ``solreffriction`` and ``solimpfriction`` (:mod:`dynid.friction.mujoco_soft`)."""
+    attrs = f' frictionloss="{_f(approx.coulomb[i])}" damping="{_f(approx.viscous[i])}"'
+    if soft is not None and approx.coulomb[i] > 0:
+        d = _f(soft.impedance[i])
+        attrs += f' solreffriction="{_f(soft.timeconst[i])} 1" solimpfriction="{d} {d} 0.001"'
+    return attrs
+
+
 def _bodies(
     robot: Robot,
     approx: CoulombViscous | None,
+    soft: SoftFrictionLoss | None,
     armature: NDArray[np.float64] | None,
     held: NDArray[np.bool_],
 ) -> list[str]:
@@ -242,7 +340,7 @@ def _bodies(
         if np.isfinite(lo) and np.isfinite(hi):
             attrs += f' range="{_f(lo)} {_f(hi)}"'
         if approx is not None:
-            attrs += f' frictionloss="{_f(approx.coulomb[i])}" damping="{_f(approx.viscous[i])}"'
+            attrs += _friction_attrs(approx, soft, i)
         if armature is not None:
             attrs += f' armature="{_f(armature[i])}"'
         if robot.spring is not None:  # MuJoCo's own torque -k (q - q0): dynid's tau_s held
@@ -321,7 +419,7 @@ def mjcf_from_robot(
     ModelError
         A link other than the base is named ``world`` (MuJoCo's world body).
     """
-    approx, armature, notes, held = _joint_terms(robot, friction, drive, kept)
+    approx, soft, armature, notes, held = _joint_terms(robot, friction, drive, kept)
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     text = comment or _comment(robot, friction, approx, armature, notes)
@@ -330,9 +428,9 @@ def mjcf_from_robot(
         xml_comment(text),
         f"<mujoco model={quoteattr(robot.name)}>",
         '  <compiler angle="radian" autolimits="true" boundmass="1e-10" boundinertia="1e-14"/>',
-        f'  <option gravity="{_v(robot.gravity)}"/>',
+        f'  <option timestep="{_f(MJCF_TIMESTEP)}" gravity="{_v(robot.gravity)}"/>',
         "  <worldbody>",
-        *_bodies(robot, approx, armature, held),
+        *_bodies(robot, approx, soft, armature, held),
         "  </worldbody>",
         "  <actuator>",
         *_actuators(robot),
