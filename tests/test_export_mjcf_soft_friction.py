@@ -135,3 +135,21 @@ def test_a_sharp_law_gets_the_steepest_slope():
         mujoco.mj_step(model, data)
         speeds.append(np.abs(data.qvel).max())
     assert max(speeds[50:]) < 1e-6
+
+
+def test_only_negative_terms_are_refitted_for_mjcf():
+    """joint_coulomb_viscous(sharp=False), MJCF's: a smooth law's fv and fc as they are
+    (its rounding held by the slope); a negative fv beside a larger smooth Coulomb term
+    still refitted nonnegative (scipy's NNLS of the odd part, as for URDF)."""
+    from scipy.optimize import nnls
+
+    from dynid.friction.mujoco import joint_coulomb_viscous
+
+    P = np.array([[-0.1, 1.0, 0.0], [0.3, 0.5, 0.0]])
+    terms = joint_coulomb_viscous(
+        law_named("smooth").model(P, np.full(2, 0.3)), np.full(2, 2.0), sharp=False
+    )
+    np.testing.assert_allclose([terms.damping[1], terms.frictionloss[1]], [0.3, 0.5])
+    v = np.linspace(0.0, 2.0, 201)[1:]
+    x, _ = nnls(np.column_stack([v, np.ones_like(v)]), -0.1 * v + np.tanh(v / 0.3))
+    np.testing.assert_allclose([terms.damping[0], terms.frictionloss[0]], x, atol=1e-9)

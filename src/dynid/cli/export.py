@@ -20,14 +20,17 @@ link gets the whole body and they lose their inertials (--merged move).
 MJCF (MuJoCo): bodies, hinge/slide joints with ranges, full inertials, gravity, motors, and
 the friction as frictionloss + damping: the linear friction a consistent identification
 stored in feasible.json, else the sigmoid approximated (its odd part fitted over the
-velocity range); --no-friction for frictionless joints. A drive (feasible.json's, a robot
-TOML's [drive] table, or --drive) adds its rotor inertias as armature and reflects friction
-at the motors to the joints; what MJCF cannot hold (a coupled rotor's off-diagonal inertia)
-is named in a warning. TOML keeps the drive as a [drive] table and the identified friction
-as a [friction] table (exactly, as feasible.json does). URDF holds per joint damping and
-sharp Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they cannot
-hold of the friction (a smooth law's rounding, a standstill band, the offsets, a Stribeck
-peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
+velocity range); --no-friction for frictionless joints. MuJoCo's frictionloss is a soft
+constraint, a ramp of the velocity up to frictionloss: each joint's solreffriction and
+solimpfriction set its slope at rest, a smooth law's fc tanh(dq / width) as the closest ramp
+(fv and fc written as identified), a sharp law as the steepest. A drive (feasible.json's, a
+robot TOML's [drive] table, or --drive) adds its rotor inertias as armature and reflects
+friction at the motors to the joints; what MJCF cannot hold (a coupled rotor's off-diagonal
+inertia) is named in a warning. TOML keeps the drive as a [drive] table and the identified
+friction as a [friction] table (exactly, as feasible.json does). URDF holds per joint
+damping and sharp Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they
+cannot hold of the friction (URDF: a smooth law's rounding; a standstill band, the offsets,
+a Stribeck peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
 off-diagonal terms: its motors' Coulomb friction, which follows the motors' velocities, is
 left out up to the N m named at each joint it acts on) and of the drive (MJCF: a coupled
 rotor's off-diagonal inertia); URDF names the rotor inertias it drops, by joint, in a

@@ -15,7 +15,9 @@ command applies, so that the Python API behaves as the command does.
   top of the file (:func:`~dynid.io.feasible.rejection_caveat`).
 * MJCF holds friction as ``frictionloss`` and ``damping``: the robot's sigmoid is
   approximated and the fit is part of the result
-  (:func:`~dynid.friction.mujoco.coulomb_viscous_from_sigmoid`).
+  (:func:`~dynid.friction.mujoco.coulomb_viscous_from_sigmoid`); ``frictionloss`` is
+  MuJoCo's soft dry friction, its slope at rest set per joint
+  (:mod:`dynid.friction.mujoco_soft`).
 """
 
 from __future__ import annotations
