@@ -153,3 +153,23 @@ def test_only_negative_terms_are_refitted_for_mjcf():
     v = np.linspace(0.0, 2.0, 201)[1:]
     x, _ = nnls(np.column_stack([v, np.ones_like(v)]), -0.1 * v + np.tanh(v / 0.3))
     np.testing.assert_allclose([terms.damping[0], terms.frictionloss[0]], x, atol=1e-9)
+
+
+@pytest.mark.parametrize("which", ["sigmoid", "classical with a band"])
+def test_other_laws_get_the_slope_closest_to_them(which):
+    """The Panda's own sigmoid (friction=True) and a classical law with a standstill band
+    of 0.01 rad/s: each joint's ramp fitted to the law, mj_inverse against dynid's torques
+    at random states half near rest 1.30 % -> 0.32 % and 3.67 % -> 1.10 % (MuJoCo's
+    default slope before)."""
+    robot = dynid.panda()
+    if which == "sigmoid":
+        law, arg, bound = robot.friction, True, 0.006
+    else:
+        P = np.column_stack([FV, FC, 0 * FV])
+        law = law_named("classical").model(P, np.full(7, 0.01))
+        arg, bound = law, 0.02
+    model, _ = _model(arg)
+    q, dq, ddq = _states(robot, 300, seed=3)
+    tau = dynid.rnea(robot, q, dq, ddq) + law.torques(dq)
+    err = _mj_inverse(model, q, dq, ddq) - tau
+    assert np.sqrt(np.sum(err**2) / np.sum(tau**2)) < bound

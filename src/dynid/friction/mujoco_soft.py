@@ -20,11 +20,12 @@ armature). At rest the torque rises with the velocity at the slope
 ramp of slope ``fc / w`` saturating at ``fc``: per joint ``solreffriction`` (``tau_c``
 two timesteps, the shortest MuJoCo keeps, the fastest stable response) and
 ``solimpfriction`` (``d``) set the slope closest to the law, with ``frictionloss = fc``
-and ``damping = fv`` as identified; a sharp law gets the steepest slope MuJoCo holds
-(``d = 0.9999``). The acceleration term shifts the ramp by ``-ddq d tau_c / 2`` in
-velocity (2 mrad/s per rad/s^2 at MuJoCo's default timestep, 0.002 s): a longer time
-constant would move it further, a shorter one (solref's direct form) would hold it closer
-in ``mj_inverse`` but makes the forward step chatter at rest.
+and ``damping = fv`` as identified; any other law the ramp closest to it, a sharp law
+without a band the steepest slope MuJoCo holds (``d = 0.9999``). The acceleration term
+shifts the ramp by ``-ddq d tau_c / 2`` in velocity (2 mrad/s per rad/s^2 at MuJoCo's
+default timestep, 0.002 s): a longer time constant would move it further, a shorter one
+(solref's direct form) would hold it closer in ``mj_inverse`` but makes the forward step
+chatter at rest.
 """
 
 from __future__ import annotations

@@ -34,8 +34,9 @@ keeping the robot's link and joint names:
   velocity saturating at ``frictionloss``: each joint's ``solreffriction`` and
   ``solimpfriction`` set its slope at rest (:mod:`dynid.friction.mujoco_soft`, from the
   file's own inverse weights, :func:`invweight0`), a smooth law's rounding
-  ``fc tanh(dq / width)`` as the closest ramp (about ``0.8 fc / width``), a sharp law's
-  as the steepest MuJoCo holds. What MJCF cannot hold (the offsets, a standstill band, an
+  ``fc tanh(dq / width)`` as the closest ramp (about ``0.8 fc / width``), any other
+  law's as the ramp closest to it, a sharp law's without a band as the steepest MuJoCo
+  holds. What MJCF cannot hold (the offsets, a standstill band, an
   asymmetry, a Stribeck peak, a quadratic term, friction at the motors, coupled terms;
   :func:`dynid.friction.mujoco.unheld_friction`) is named in one warning line with the
   files that hold it, with how a smooth law's rounding was written.
