@@ -465,10 +465,11 @@ def _recorded_delay(model: IdentifiedModel | Robot | None) -> float:
     return 0.0 if own is None else float(own.torque_delay_s)
 
 
-def identification_beside(feasible: str | Path, robot: Robot) -> Path | None:
-    """The ``identification.json`` in the folder of ``feasible`` (``identify
-    --consistent`` writes both) whose robot has ``robot``'s joints, or None: the record of
-    how the data the consistent parameters were fitted to were read and prepared."""
+def identification_beside(feasible: str | Path, robot: Robot) -> IdentifiedModel | None:
+    """The model of the ``identification.json`` in the folder of ``feasible`` (``identify
+    --consistent`` writes both) whose robot has ``robot``'s joints, or None (none there,
+    not readable, another arm): the record of how the data the consistent parameters were
+    fitted to were read and prepared."""
     path = Path(feasible).with_name("identification.json")
     if path == Path(feasible) or not path.is_file():
         return None
@@ -476,7 +477,7 @@ def identification_beside(feasible: str | Path, robot: Robot) -> Path | None:
         mine = load_model_json(path)
     except DataError:
         return None
-    return path if mine.robot.joint_names == robot.joint_names else None
+    return mine if mine.robot.joint_names == robot.joint_names else None
 
 
 def _own_record(
@@ -498,18 +499,16 @@ def _own_record(
                 other,
             )
         return model
-    path = None if feasible is None else identification_beside(feasible, model)
-    if path is None:
-        return None
-    _log.log(
-        NOTE,
-        "%s: the data read and prepared as %s beside it records (its --columns/--units, "
-        "cut-off, gap rule and torque delay), as --model reads them; each given replaces "
-        "its part",
-        Path(str(feasible)).name,
-        path.name,
-    )
-    return load_model_json(path)
+    own = None if feasible is None else identification_beside(feasible, model)
+    if own is not None:
+        _log.log(
+            NOTE,
+            "%s: the data read and prepared as identification.json beside it records (its "
+            "--columns/--units, cut-off, gap rule and torque delay), as --model reads them; "
+            "each given replaces its part",
+            Path(str(feasible)).name,
+        )
+    return own
 
 
 def _prepared_as(
