@@ -4,7 +4,10 @@ The model's torques M ddq + c + g, without and with friction, are compared with 
 measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
 
   --model identification.json   an identified model (its classical friction, if it has
-                                one, is used unless --friction or --no-friction)
+                                one, is used unless --friction or --no-friction); of a
+                                folder identify --consistent wrote, the least-squares
+                                model (a note says so, and that --params feasible.json
+                                validates the consistent one)
   --robot ROBOT                 a robot's own link parameters and friction ('panda': the
                                 published feasible parameters and sigmoid friction)
   --params feasible.json        retrieved feasible link parameters (dynid retrieve), with
@@ -12,7 +15,10 @@ measured ones, per joint (RMS, MSE) and overall (relative error). Model sources:
                                 links, or a sigmoid): Newton-Euler torques (RNEA) with
                                 those parameters (the paper's Fig. 5); a robot
                                 .urdf, .toml or .xml (MJCF) given here is read
-                                as --robot reads it
+                                as --robot reads it; the data are read and
+                                prepared as the identification.json beside it
+                                records (identify --consistent writes both), as
+                                --model reads them
 
 --friction friction.json replaces the model's own friction. A Coulomb step whose
 standstill band lies well inside the noise of the velocities it is evaluated at (none at
@@ -171,7 +177,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
         drive=load_drive_arg(args, robot.n, robot_rotors=not isinstance(model, IdentifiedModel)),
         q_start=args.q_start,
     )
-    result = validate_files(model, args.data, options, feasible=args.params, label=label)
+    result = validate_files(
+        model, args.data, options, feasible=args.params, label=label, source=args.model
+    )
     path = save_validation_json(
         args.out / "validation.json", result.validation, **result.metadata()
     )

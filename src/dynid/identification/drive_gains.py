@@ -518,7 +518,8 @@ class _Eigen:
         c = float(np.linalg.norm(B[:, active] @ np.ones(int(active.sum()))))
         c /= max(float(np.linalg.norm(B[:, active] @ g)), 1e-300)
         g = g * c
-        fitted = float(g @ S @ g) / max(dof, 1)
+        # a sum of squares: below zero only by round-off (a log exact to round-off)
+        fitted = max(float(g @ S @ g), 0.0) / max(dof, 1)
         full = np.full(m, np.nan)
         full[active] = g
         factor, scaled = _common_scale(full, W, B, A, gravity_columns, gravity)

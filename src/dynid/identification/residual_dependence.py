@@ -65,6 +65,9 @@ __all__ = [
     "with_dependence_hint",
 ]
 
+#: The ``--terms`` name of a model term's kind (:attr:`~dynid.regressors.terms.ModelTerm.kind`)
+#: where it differs from the term's own name: the rotor inertias are the ``armature``.
+_TERM_WORDS = {"rotor_inertia": "armature"}
 #: Bins of equal counts over a joint's position or velocity.
 BINS = 20
 #: Joints the hint describes at most, the farthest above their noise first.
@@ -337,15 +340,11 @@ def _remedy(terms: Collection[str]) -> str:
     return "beyond the model's linear spring: a spring that is not linear, a cable"
 
 
-def _inertia_remedy(terms: Collection[str]) -> str:
-    """What to add to the model for a residual that follows a joint's acceleration, given
-    the model's ``terms``."""
-    if "armature" in terms:
-        return "beyond the model's armature: an inertia the rigid bodies and rotors miss"
-    return (
-        "add armature to --terms of dynid identify, or give a drive file with rotor_inertia "
-        "(--drive)"
-    )
+#: What to add to a model without the armature for a residual that follows a joint's
+#: acceleration (a model that holds it is told its inertia is off: :func:`_sentence`).
+_INERTIA_REMEDY = (
+    "add armature to --terms of dynid identify, or give a drive file with rotor_inertia (--drive)"
+)
 
 
 def _constant(d: Dependence, head: str, offset: tuple[str, bool] | None) -> str:
@@ -385,7 +384,8 @@ def _sentence(
     the holding torque at rest, its why said once, ``still_as`` the joint it was said
     at; then a residual that follows the acceleration:
     an inertia the model lacks, with ``inertia`` the remedy where the caller knows it,
-    else :func:`_inertia_remedy`); ``terms`` the model's term names (:func:`held_terms`),
+    else :data:`_INERTIA_REMEDY`; a model that holds the armature, its
+    inertia off the model's); ``terms`` the model's term names (:func:`held_terms`),
     so that the remedy names what the model lacks, not what it holds; ``springs`` the
     stiffness per joint fitted with the model (its named joints' said with their
     stiffness, a position dependence no spring explains said so); ``offsets`` the model's
@@ -409,10 +409,19 @@ def _sentence(
             "samples, or record without rests)"
         )
     if acceleration_led(d):
+        said = (
+            f"{head}{d.acceleration:.2g} of {d.rms:.2g} N m RMS residual follows its acceleration"
+        )
+        if inertia is None and "armature" in terms:
+            return (
+                f"{said}: the joint's inertia is off the model's, which holds the armature "
+                "(a base parameter that groups it with the link inertias counts: the sum "
+                "fitted off, its standard deviation says by how much the data allow, or an "
+                "inertia beyond the links and rotors)"
+            )
         return (
-            f"{head}{d.acceleration:.2g} of {d.rms:.2g} N m RMS residual follows its "
-            "acceleration: an inertia the model lacks at the joint, most likely a rotor's "
-            f"(armature) ({inertia or _inertia_remedy(terms)})"
+            f"{said}: an inertia the model lacks at the joint, most likely a rotor's "
+            f"(armature) ({inertia or _INERTIA_REMEDY})"
         )
     named = springs is not None and d.joint in springs.named  # judged_springs judged it
     follows = f"{head}{d.position:.2g} of {d.rms:.2g} N m RMS residual follows its position"
@@ -459,13 +468,17 @@ def _sentence(
 
 def held_terms(model: IdentifiedModel | Robot) -> frozenset[str]:
     """The names of the terms ``model`` holds beside the rigid bodies, as ``--terms`` names
-    them: an identified model's terms (``spring``, ``armature``) and its friction's parts
-    (``viscous``, ``coulomb``, ``offset``, ...); a robot's ``spring`` when it has one."""
+    them: an identified model's terms (``spring``, ``armature``: its rotor inertias, also
+    where a base parameter groups one with the link inertias, ``J1zz + ... + Ia1``) and
+    its friction's parts (``viscous``, ``coulomb``, ``offset``, ...); a robot's ``spring``
+    when it has one."""
     if isinstance(model, Robot):
         return frozenset({"spring"} if model.spring is not None else ())
     out = set(model.terms)
     for t in model.terms.values():
         out.update(getattr(t.term, "parts", ()) or ())
+        if t.term.kind in _TERM_WORDS:  # its --terms name; held even where a base
+            out.add(_TERM_WORDS[t.term.kind])  # parameter groups it with the links
     return frozenset(out)
 
 

@@ -54,7 +54,7 @@ from ..friction.heldout_torques import residual_gains, residual_springs, residua
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.pooled import joined_validation
 from ..friction.recordings import RecordingsValidation, validate_recordings
-from ..friction.validation import RECORDED, own_friction
+from ..friction.validation import RECORDED, own_friction, recorded_cutoff
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains
 from ..identification.floor_verdict import (
@@ -83,6 +83,7 @@ from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_del
 from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
+from ..io.model_json import load_model_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
@@ -98,7 +99,7 @@ from .recordings import (
     warn_signs,
 )
 
-__all__ = ["ValidateOptions", "ValidateResult", "validate_files"]
+__all__ = ["ValidateOptions", "ValidateResult", "identification_beside", "validate_files"]
 
 _log = logging.getLogger(__name__)
 
@@ -336,8 +337,13 @@ def validate_files(
     feasible: str | Path | None = None,
     label: str | None = None,
     recorded: Recorded | None = None,
+    source: str | Path | None = None,
 ) -> ValidateResult:
     """Compare ``model``'s torques, without and with friction, with the recordings ``data``.
+
+    The data are read and prepared as an identified model records (column map, cut-off, gap
+    rule, torque delay; an option given replaces its part): ``model``, or the one beside a
+    ``feasible`` file (:func:`identification_beside`), with a note (:func:`_own_record`).
 
     Parameters
     ----------
@@ -348,12 +354,16 @@ def validate_files(
     options : ValidateOptions, optional
     feasible : str or Path, optional
         The ``feasible.json`` the robot ``model`` was read from: the friction and the drive
-        stored in it are the model's own.
+        stored in it are the model's own, the record of the identification beside it the
+        data's reading and preparation.
     label : str, optional
         What the model is, for the record (default: its robot's name).
     recorded : Recorded, optional
         The recordings ``data`` already read and checked for this model (``dynid observe
         --calibrate`` judging its model on its logs): not read again.
+    source : str or Path, optional
+        The ``identification.json`` an identified ``model`` was read from: a note names a
+        consistent model's ``feasible.json`` beside it (``identify --consistent``).
 
     Returns
     -------
@@ -369,41 +379,26 @@ def validate_files(
     """
     opt = options or ValidateOptions()
     robot = model.robot if isinstance(model, IdentifiedModel) else model
-    drive = opt.drive
-    if feasible is not None:  # the file's drive holds the rotor inertias identified
-        held = load_feasible_drive(feasible)
-        drive = same_drive(drive, held, Path(feasible).name, f"the one {Path(feasible).name} holds")
-    placed = model.drive if drive is None and isinstance(model, IdentifiedModel) else drive
+    own = _own_record(model, feasible, source)  # whose record reads and prepares the data
+    drive, placed = _drives(model, opt.drive, feasible)
     rec = recorded or read_recordings(
-        data,
-        robot,
-        recorded=model.info.column_map if isinstance(model, IdentifiedModel) else None,
-        columns=opt.columns,
-        drop_invalid=opt.drop_invalid,
-        cutoff_hz=velocity_cutoff(opt.cutoff_hz),
-        owner=f"the model ({label or robot.name})",
-        drive=placed,
-        q_start=opt.q_start,
-        max_gap_s=opt.max_gap_s,
-        reference=_reference(model),
-    )
+        data, robot, recorded=None if own is None else own.info.column_map, columns=opt.columns,
+        drop_invalid=opt.drop_invalid, cutoff_hz=velocity_cutoff(opt.cutoff_hz),
+        owner=f"the model ({label or robot.name})", drive=placed, q_start=opt.q_start,
+        max_gap_s=opt.max_gap_s, reference=_reference(model),
+    )  # fmt: skip
     checked = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
-    sign_map, opposite = _said_signs(checked, model, opt)  # before the verdict, naming joints
-    _say_training_data(model, rec.names)
+    sign_map, opposite = _said_signs(checked, model, opt, own)  # before the verdict
+    _say_training_data(model if own is None else own, rec.names)
     rec, spikes = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_JUDGING)
-    friction, source = _friction(model, opt.friction, feasible, placed)
+    friction, fr_source = _friction(model, opt.friction, feasible, placed)
+    cut, gap, lag = _prepared_as(opt, model, own, rec.logs)
 
     def run(fr: FrictionModel | FrictionSum | None) -> RecordingsValidation:
         return validate_recordings(
-            model,
-            rec.logs,
-            rec.names,
-            friction=fr,
-            cutoff_hz=library_cutoff(opt.cutoff_hz, RECORDED),
-            max_gap_s=opt.max_gap_s,
-            drive=drive,
-            torque_delay_s=opt.torque_delay_s,
-        )
+            model, rec.logs, rec.names, friction=fr, cutoff_hz=cut, max_gap_s=gap, drive=drive,
+            torque_delay_s=lag,
+        )  # fmt: skip
 
     val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
     val = _banded(run, friction) if val is None else val  # friction as observe evaluates it
@@ -411,7 +406,7 @@ def validate_files(
     inputs = _input_noise(model, val.friction, val)
     verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
     verdict = _worst_recording(val, verdict, rec.names, names, inputs)
-    speeds = _identified_speeds(model)
+    speeds = _identified_speeds(model if own is None else own)
     dq = [v.log.dq for v in val.parts]
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
@@ -424,14 +419,14 @@ def validate_files(
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     named = gains is not None and bool(gains.named)  # a scale off leaves no lag to name
-    verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s, named)
+    verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s, named, own)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
     verdict = _signs_first(verdict, opposite, sign_map)
     return ValidateResult(
         validation=val,
         model=label or f"robot {robot.name}",
-        friction_source=source,
+        friction_source=fr_source,
         files=rec.names,
         cutoff_hz=val.pieces.cutoff_hz,
         verdict=verdict,
@@ -450,10 +445,89 @@ def validate_files(
     )  # fmt: skip
 
 
-def _recorded_delay(model: IdentifiedModel | Robot) -> float:
+def _drives(
+    model: IdentifiedModel | Robot, given: Drive | None, feasible: str | Path | None
+) -> tuple[Drive | None, Drive | None]:
+    """The drive the recordings were recorded through (``given``, or a ``feasible`` file's,
+    which holds the rotor inertias identified; refused where they differ) and the one the
+    model's friction is placed by (an identified model's own without either)."""
+    drive = given
+    if feasible is not None:
+        held = load_feasible_drive(feasible)
+        drive = same_drive(drive, held, Path(feasible).name, f"the one {Path(feasible).name} holds")
+    placed = model.drive if drive is None and isinstance(model, IdentifiedModel) else drive
+    return drive, placed
+
+
+def _recorded_delay(model: IdentifiedModel | Robot | None) -> float:
     """The delay [s] an identified model was identified with (0: a robot, static data)."""
     own = model.info.log if isinstance(model, IdentifiedModel) else None
     return 0.0 if own is None else float(own.torque_delay_s)
+
+
+def identification_beside(feasible: str | Path, robot: Robot) -> IdentifiedModel | None:
+    """The model of the ``identification.json`` in the folder of ``feasible`` (``identify
+    --consistent`` writes both) whose robot has ``robot``'s joints, or None (none there,
+    not readable, another arm): the record of how the data the consistent parameters were
+    fitted to were read and prepared."""
+    path = Path(feasible).with_name("identification.json")
+    if path == Path(feasible) or not path.is_file():
+        return None
+    try:
+        mine = load_model_json(path)
+    except DataError:
+        return None
+    return mine if mine.robot.joint_names == robot.joint_names else None
+
+
+def _own_record(
+    model: IdentifiedModel | Robot, feasible: str | Path | None, source: str | Path | None
+) -> IdentifiedModel | None:
+    """The identified model whose record the data are read and prepared by: ``model``
+    itself (with a note where a ``feasible.json`` beside its ``source`` holds the
+    consistent model of the same run), the one beside a ``feasible`` file (a note names
+    it), or None."""
+    if isinstance(model, IdentifiedModel):
+        read = None if source is None else Path(source)
+        other = None if read is None else read.with_name("feasible.json")
+        if read is not None and other is not None and other != read and other.is_file():
+            _log.log(
+                NOTE,
+                "%s holds the least-squares model, which is validated here; the physically "
+                "consistent model beside it is validated with --params %s",
+                read.name,
+                other,
+            )
+        return model
+    own = None if feasible is None else identification_beside(feasible, model)
+    if own is not None:
+        _log.log(
+            NOTE,
+            "%s: the data read and prepared as identification.json beside it records (its "
+            "--columns/--units, cut-off, gap rule and torque delay), as --model reads them; "
+            "each given replaces its part",
+            Path(str(feasible)).name,
+        )
+    return own
+
+
+def _prepared_as(
+    opt: ValidateOptions,
+    model: IdentifiedModel | Robot,
+    own: IdentifiedModel | None,
+    logs: Sequence[TorqueLog],
+) -> tuple[Any, float | None, float | None]:
+    """The cut-off [Hz] (or ``"recorded"``, None: no filter), the longest gap bridged [s]
+    and the torque delay [s] the recordings ``logs`` are prepared with: each option given,
+    else the record of ``own`` (:func:`_own_record`); ``model``'s own where it is
+    ``own``."""
+    cut = library_cutoff(opt.cutoff_hz, RECORDED)
+    if own is None or own is model or own.info.log is None:
+        return cut, opt.max_gap_s, opt.torque_delay_s
+    log = own.info.log
+    gap = log.preprocessing.max_gap_s if opt.max_gap_s is None else opt.max_gap_s
+    lag = float(log.torque_delay_s) if opt.torque_delay_s is None else opt.torque_delay_s
+    return (recorded_cutoff(own, logs) if cut == RECORDED else cut), gap, lag
 
 
 def _with_delay(
@@ -462,16 +536,17 @@ def _with_delay(
     val: RecordingsValidation,
     given_s: float | None,
     gains_named: bool = False,
+    own: IdentifiedModel | None = None,
 ) -> tuple[Verdict, TorqueDelay | None, AppliedDelay | None]:
     """``verdict`` with the torques' lag behind the positions the residual points to
     (:func:`~dynid.friction.delay_check.validations_delay`) appended when it is named, the
-    delay, and the one the recordings were prepared with (``given_s`` [s], else the
-    model's). Of an identified model the hint is to identify it again with the whole
-    delay (the one applied and the residual's): its coefficients were fitted to the
-    lagging torques. Where the verdict names a gain per motor (``gains_named``), no delay
-    is said: efforts read through a torque constant 1.3 times off left a residual that
+    delay, and the one the recordings were prepared with (``given_s`` [s], else the model's,
+    ``own``'s: :func:`_own_record`). Of an identified model the hint is to identify it again
+    with the whole delay (the one applied and the residual's): its coefficients were fitted
+    to the lagging torques. Where the verdict names a gain per motor (``gains_named``), no
+    delay is said: efforts read through a torque constant 1.3 times off left a residual that
     read as the torques leading by 3.0 ms (std 0.9) on a log without any lag."""
-    applied = applied_delay(given_s, _recorded_delay(model))
+    applied = applied_delay(given_s, _recorded_delay(model if own is None else own))
     delay = None if gains_named else validations_delay(model, val.parts)
     if delay is not None and delay.named:
         before = 0.0 if applied is None else applied.delay_s
@@ -658,7 +733,7 @@ def _worst_recording(
 
 
 def _said_signs(
-    rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions
+    rec: Recorded, model: IdentifiedModel | Robot, opt: ValidateOptions, own: IdentifiedModel | None
 ) -> tuple[str | None, tuple[SignFinding, ...]]:
     """Warn of the recordings whose torques look of the opposite sign: first those for
     which the model's recorded sign map looks wrong
@@ -675,7 +750,7 @@ def _said_signs(
         check_below_nyquist(list(rec.logs), float(given))
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     ref = _reference(model) or robot
-    recorded = model.info.column_map if isinstance(model, IdentifiedModel) else None
+    recorded = None if own is None else own.info.column_map  # the record the data are read by
     units = None if opt.columns is None else opt.columns[1]
     found = recorded_sign_map_findings(rec, ref, recorded, units)
     for text in found.values():
