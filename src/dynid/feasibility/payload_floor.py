@@ -89,7 +89,7 @@ def floor_ratio(
     residual: Sequence[NDArray[np.float64]],
     sensor_var: Sequence[NDArray[np.float64] | None],
     states_var: Sequence[NDArray[np.float64]],
-) -> tuple[float | None, float]:
+) -> tuple[float | None, float | None]:
     """The residual over the noise floor of pieces, each sample weighed against its own
     noise, and the RMS [N m] of the states' noise through the model over every sample and
     joint.
