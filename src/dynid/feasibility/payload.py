@@ -116,6 +116,7 @@ from .payload_arm import (
     arm_model,
     holds_the_load,
     model_structure,
+    parameter_spread,
     unloaded_arm,
 )
 from .payload_difference import (
@@ -192,6 +193,13 @@ _Unloaded = tuple[
 _Floor = tuple[
     list[NDArray[np.float64]], list[NDArray[np.float64] | None], list[NDArray[np.float64]]
 ]
+
+
+#: What a torque log's load fit is judged and widened by: the arm's residual without the
+#: load (:data:`_Unloaded`), the noise floor (:data:`_Floor`) and the covariance the
+#: identified arm's base parameters put into the load's parameters (p, p), each None
+#: when not known.
+_Judging = tuple[_Unloaded | None, _Floor | None, NDArray[np.float64] | None]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -445,8 +453,7 @@ def identify_payload(
     A, cols = link_params_from_frame(f.T_link_frame), slice(10 * (k - 1), 10 * k)
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
-    against: _Unloaded | None = None  # the arm's residual without the load (logs)
-    floor: _Floor | None = None  # the noises the residual is judged against (logs)
+    judging: _Judging = (None, None, None)  # torque logs: what judges the load's fit
     described = _description(arm, d, friction)
     if isinstance(data, StaticDataset):
         empty = None if base is None else cast(StaticDataset, base[0])
@@ -458,13 +465,13 @@ def identify_payload(
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol, terms=terms)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
-        W, yv, route, kept, record, differenced, scale, against, floor = _log_route(
+        W, yv, route, kept, record, differenced, scale, judging = _log_route(
             arm, logs, names, without, unloaded_names, cols, A, notes, opt, described
         )
     fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
     scaled = None if described is None else scale
-    return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, against, floor)
+    return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, *judging)
 
 
 #: One data set: static data or one recording.
@@ -557,6 +564,7 @@ def _estimate(
     drive: Drive | None,
     against: _Unloaded | None = None,
     floor: _Floor | None = None,
+    spread: NDArray[np.float64] | None = None,
 ) -> PayloadEstimate:
     """The load's estimate from its rows: least squares, consistency, doubts (warned);
     ``difference``: the arm was identified from unloaded data (its hint differs);
@@ -564,7 +572,8 @@ def _estimate(
     no description, or one identified from these sensors), ``drive`` for its hint;
     ``against``: the arm's residual on recordings without the load, the misfit then
     judged on the difference at matched states (:func:`_judged`); ``floor``: the noises
-    the residual is judged against (None: the torque noise alone)."""
+    the residual is judged against (None: the torque noise alone); ``spread``: the
+    covariance the identified arm's parameters put into the load's, added (None: none)."""
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
@@ -577,6 +586,8 @@ def _estimate(
     cov, per_period = _serial_widening(np.asarray(fit.covariance)[:p, :p], resid, n, prep, notes)
     if not static:  # static configurations are exchangeable: their blocks spread alike
         cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
+    if spread is not None:  # the arm's own error: the same all along the recordings
+        cov = _with_arm_spread(cov, spread, notes)
     sm_noise = float(np.sqrt(cov[0, 0]))  # whether there is a load: the misfit says its own
     floor_rms = loaded_floor_rms(noise, judged)  # the torques' scale's fit holds it too
     if misfit and judged is not None and judged.floor_rms:  # the residual does not see them
@@ -717,6 +728,24 @@ def _serial_widening(
     return cov * factor, per_period
 
 
+def _with_arm_spread(
+    cov: NDArray[np.float64], spread: NDArray[np.float64], notes: list[str]
+) -> NDArray[np.float64]:
+    """``cov`` (the load's ``p`` parameters) plus ``spread`` (p, p), the covariance the
+    identified arm's base parameters put into them
+    (:func:`~dynid.feasibility.payload_arm.parameter_spread`), with a note of the mass's
+    widening."""
+    out = cov + spread
+    widen = np.sqrt(out[0, 0] / cov[0, 0]) if cov[0, 0] > 0 else 1.0
+    notes.append(
+        f"standard deviations include the identified arm's base parameters' uncertainty "
+        f"(their covariance carried through the load's fit: the mass's x{widen:.3g}), an "
+        "error the same all along the recordings that no residual shows; the friction's "
+        "own uncertainty is not saved with the model and not included"
+    )
+    return out
+
+
 def _misfit_spread(
     cov: NDArray[np.float64],
     W: NDArray[np.float64],
@@ -792,17 +821,18 @@ def _log_route(
     dict[str, Any],
     bool,
     _ScaleRows,
-    _Unloaded | None,
-    _Floor | None,
+    _Judging,
 ]:
     """The rows of recordings (:func:`~dynid.feasibility.payload_rows.log_rows`) with the
-    arm given or identified from ``base``; the preprocessing, recordings and pieces left
-    out, for the record (:class:`PayloadEstimate`'s fields); whether the arm identified
-    from ``base`` differs from the one given (the difference method changed it); the rows
-    of the torques' scale against the arm's ``described`` model (on ``base`` when given:
-    :func:`_base_scale`); the arm's residual on ``base`` (:func:`_arm_on_base`, None
-    without it); the noise floor of the loaded recordings (:data:`_Floor`, None when the
-    states' noise is not known). ``opt``: the options of :func:`identify_payload`."""
+    arm given or identified from ``base``; the preprocessing, recordings and pieces left out, for
+    the record (:class:`PayloadEstimate`'s fields); whether the arm identified from ``base`` differs
+    from the one given (the difference method changed it); the rows of the torques' scale against
+    the arm's ``described`` model (on ``base`` when given: :func:`_base_scale`); what judges and
+    widens the fit (:data:`_Judging`): the arm's residual on ``base`` (:func:`_arm_on_base`, None
+    without it), the noise floor of the loaded recordings (:data:`_Floor`, None when the states'
+    noise is not known); the covariance the identified arm's base parameters put into the load's
+    (:func:`~dynid.feasibility.payload_arm.parameter_spread`, None for a robot description).
+    ``opt``: the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
     d = opt["drive"]
@@ -849,7 +879,8 @@ def _log_route(
     name = CLASSICAL_NAME if fr is None else fr.name.removeprefix("links + ")
     record |= {"friction_terms": name, "friction_labels": friction_term(fr, rec, kin.n).labels}
     record |= {"skipped": rec.skipped, "noise_rms": filtered_noise_rms(rec)}
-    return W, yv, route, kept, record, differenced, scale, against, floor
+    spread = parameter_spread(the_arm, [p.log for p in rec.pieces], still, W[:, kept], 10)
+    return W, yv, route, kept, record, differenced, scale, (against, floor, spread)
 
 
 def _floor_of(rec: Recordings, states: list[NDArray[np.float64]]) -> _Floor:
