@@ -235,7 +235,7 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
     if (judged := judged_line(est)) is not None:
         console.print(f"  {judged}")
     if est.torque_scale is not None:
-        console.print(f"  {scale_line(est.torque_scale, est.mass, est.noise_rms)}")
+        console.print(f"  {scale_line(est.torque_scale, est.mass, est.floor_rms)}")
     if result.recordings:
         console.print(result.describe())
     prep = est.preprocessing
@@ -289,23 +289,28 @@ def scale_line(t: TorqueScale, mass: float, noise_rms: float | None = None) -> s
 
 def residual_line(est: PayloadEstimate) -> str:
     """``residual RMS 0.0067 N m, 1.5 x the torque noise (0.0044 N m after the low-pass)``
-    for torque logs (over :data:`~dynid.identification.verdict.FLOOR_FAIR` x, what it
-    means: :func:`~dynid.feasibility.payload_doubts.misfit_doubts`); the static rows'
-    residual without a unit of its own."""
+    for torque logs, with the states' noise through the arm's model when known (``1.29 x
+    the noise (the torques' 0.0073 N m after the low-pass and the states' through the
+    arm's model 0.06 N m)``, the ratio the fit's judged one,
+    :mod:`~dynid.feasibility.payload_floor`; over
+    :data:`~dynid.identification.verdict.FLOOR_FAIR` x, what it means:
+    :func:`~dynid.feasibility.payload_doubts.misfit_doubts`); the static rows' residual
+    without a unit of its own."""
     if not est.noise_rms:  # static data, or no noise read from the logs
         mixed = est.route.startswith("static M")
         unit = " (rows of M [kg m^2] and g [N m])" if mixed else " N m"
         return f"residual RMS {est.residual_rms:.2g}{unit}"
+    j = est.judged
+    fit = j is None or j.kind == "fit"
     ratio = est.residual_rms / est.noise_rms
-    fit = est.judged is None or est.judged.kind == "fit"
-    return (
-        f"residual RMS {est.residual_rms:.2g} N m, {ratio:.3g} x the torque noise "
-        f"({est.noise_rms:.2g} N m after the low-pass)"
-        + (
-            f": over {FLOOR_FAIR:g} x, torques the arm's model leaves, which the load took"
-            if ratio > FLOOR_FAIR and fit
-            else ""
-        )
+    noise = f"the torque noise ({est.noise_rms:.2g} N m after the low-pass)"
+    if j is not None and j.states_rms is not None and fit and j.ratio is not None:
+        ratio = j.ratio
+        noise += f" and the states' noise through the arm's model ({j.states_rms:.2g} N m)"
+    return f"residual RMS {est.residual_rms:.2g} N m, {ratio:.3g} x {noise}" + (
+        f": over {FLOOR_FAIR:g} x, torques the arm's model leaves, which the load took"
+        if ratio > FLOOR_FAIR and fit
+        else ""
     )
 
 
@@ -324,13 +329,16 @@ def judged_line(est: PayloadEstimate) -> str | None:
         what = "the fit's residual"
         if j.matched or est.route.endswith("difference"):
             what += f" (the motions do not match: {100 * j.matched:.0f} % of the samples)"
-        return f"judged   {what}: {ratio:.3g} x the torque noise; " + (
+        noise = "" if j.states_rms is None else " and the states' through the arm's model"
+        return f"judged   {what}: {ratio:.3g} x the torque noise{noise}; " + (
             f"over {FLOOR_FAIR:g} x: the load in doubt" if over else f"within {FLOOR_FAIR:g} x"
         )
     return (
         "judged   the difference from the unloaded arm's residual at matched states "
         f"({100 * j.matched:.0f} % of the samples): {j.residual_rms:.2g} N m, {ratio:.3g} x "
-        f"the noise of both recordings ({j.noise_rms:.2g} N m); "
+        f"the noise of both recordings ({j.noise_rms:.2g} N m"
+        + ("" if j.states_rms is None else f", the states' {j.states_rms:.2g} N m")
+        + "); "
         + (
             f"over {FLOOR_FAIR:g} x: the load does not explain what changed between them"
             if over

@@ -66,8 +66,11 @@ least-squares mass is not positive). A doubtful estimate is not a load to hand t
 controller. An inertia whose elements the data do not determine
 (:attr:`PayloadEstimate.undetermined`, :mod:`dynid.feasibility.payload_doubts`) is doubted
 on its own (:attr:`PayloadEstimate.inertia_doubts`): the mass and CoM are handed on, the
-inertia is not. The fit's residual is compared with the torque noise left after the
-low-pass (:attr:`PayloadEstimate.noise_rms`): above
+inertia is not. The fit's residual is compared with its noise floor, the torque noise
+left after the low-pass (:attr:`PayloadEstimate.noise_rms`) and the states' noise through
+the arm's model (:mod:`dynid.feasibility.payload_floor`: recorded velocities' noise
+through a steep friction law), each sample against its own noise as ``validate`` and
+``identify`` weigh it (:attr:`PayloadEstimate.floor_rms`): above
 :data:`~dynid.identification.verdict.FLOOR_FAIR` times it, the torques the arm's model
 leaves go into the mass and CoM too (an unmodelled spring at 74 x the noise read a 1.5 kg
 load as 1.04 kg), so the whole load is a doubt
@@ -84,7 +87,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal, cast
 
 import numpy as np
@@ -113,9 +116,16 @@ from .payload_arm import (
     arm_model,
     holds_the_load,
     model_structure,
+    parameter_spread,
     unloaded_arm,
 )
-from .payload_difference import JudgedResidual, arm_residual, judged_residual, piece_states
+from .payload_difference import (
+    JudgedResidual,
+    arm_residual,
+    judged_residual,
+    loaded_floor_rms,
+    piece_states,
+)
 from .payload_doubts import doubts_about, inertia_doubts, misfit_doubts, undetermined_inertia
 from .payload_fit import (
     HELD_OUT_BLOCKS,
@@ -127,12 +137,14 @@ from .payload_fit import (
     serial_correlation_factor,
     summary,
 )
+from .payload_floor import floor_ratio, sensor_variances, states_noise_var
 from .payload_friction import (
     CLASSICAL_NAME,
     chosen_friction,
     classical_parts,
     friction_structure,
     friction_term,
+    rows_residual,
     rows_rms,
 )
 from .payload_rows import (
@@ -172,6 +184,22 @@ _Unloaded = tuple[
     NDArray[np.float64],
     float | None,
 ]
+
+
+#: The noise floor of prepared recordings (:mod:`~dynid.feasibility.payload_floor`): per
+#: piece its torques [N m] (N_p, n), its torque noise variance after the low-pass
+#: [N^2 m^2] (n,) (None: not read) and the states' noise variance through the arm's model
+#: at each sample [N^2 m^2] (N_p, n).
+_Floor = tuple[
+    list[NDArray[np.float64]], list[NDArray[np.float64] | None], list[NDArray[np.float64]]
+]
+
+
+#: What a torque log's load fit is judged and widened by: the arm's residual without the
+#: load (:data:`_Unloaded`), the noise floor (:data:`_Floor`) and the covariance the
+#: identified arm's base parameters put into the load's parameters (p, p), each None
+#: when not known.
+_Judging = tuple[_Unloaded | None, _Floor | None, NDArray[np.float64] | None]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -236,11 +264,14 @@ class PayloadEstimate:
     noise_rms : float or None
         Torque logs: the RMS [N m] the torque sensors' noise alone leaves in the rows
         after the low-pass (each piece's white noise per joint through the filter's noise
-        gain): the :attr:`residual_rms` of a perfect model. None for static data, or when
-        a recording's noise could not be read.
+        gain): with the states' noise through the arm's model (:attr:`floor_rms`), the
+        :attr:`residual_rms` of a perfect model. None for static data, or when a
+        recording's noise could not be read.
     judged : JudgedResidual or None
-        The residual the load's doubt was judged on, with its ratio to the noise
-        (:mod:`dynid.feasibility.payload_difference`): the fit's, or with recordings
+        The residual the load's doubt was judged on, with its ratio to the noise (the
+        torques' and the states' through the arm's model, each sample against its own:
+        :mod:`dynid.feasibility.payload_floor`;
+        :mod:`dynid.feasibility.payload_difference`): the fit's, or with recordings
         without the load of the same motion the loaded fit's residual less the unloaded
         arm's at matched states (an arm's misfit common to both cancels); None for
         static data.
@@ -304,6 +335,13 @@ class PayloadEstimate:
     def inertia_determined(self) -> bool:
         """The inertia was identified and the data determine each of its elements."""
         return self.inertia_identified and not self.undetermined
+
+    @property
+    def floor_rms(self) -> float | None:
+        """Torque logs: the noise floor of the loaded rows [N m], :attr:`noise_rms` and
+        the states' noise through the arm's model (:mod:`dynid.feasibility.payload_floor`),
+        root sum of squares; :attr:`noise_rms` when the states' noise is not known."""
+        return loaded_floor_rms(self.noise_rms, self.judged)
 
 
 def link_params_from_frame(T_link_frame: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -415,7 +453,7 @@ def identify_payload(
     A, cols = link_params_from_frame(f.T_link_frame), slice(10 * (k - 1), 10 * k)
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
-    against: _Unloaded | None = None  # the arm's residual without the load (logs)
+    judging: _Judging = (None, None, None)  # torque logs: what judges the load's fit
     described = _description(arm, d, friction)
     if isinstance(data, StaticDataset):
         empty = None if base is None else cast(StaticDataset, base[0])
@@ -427,13 +465,13 @@ def identify_payload(
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol, terms=terms)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
-        W, yv, route, kept, record, differenced, scale, against = _log_route(
+        W, yv, route, kept, record, differenced, scale, judging = _log_route(
             arm, logs, names, without, unloaded_names, cols, A, notes, opt, described
         )
     fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
     scaled = None if described is None else scale
-    return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, against)
+    return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, *judging)
 
 
 #: One data set: static data or one recording.
@@ -525,28 +563,35 @@ def _estimate(
     scale_rows: _ScaleRows | None,
     drive: Drive | None,
     against: _Unloaded | None = None,
+    floor: _Floor | None = None,
+    spread: NDArray[np.float64] | None = None,
 ) -> PayloadEstimate:
     """The load's estimate from its rows: least squares, consistency, doubts (warned);
     ``difference``: the arm was identified from unloaded data (its hint differs);
     ``scale_rows``: the rows of the torques' scale against the arm's description (None:
     no description, or one identified from these sensors), ``drive`` for its hint;
     ``against``: the arm's residual on recordings without the load, the misfit then
-    judged on the difference at matched states (:func:`_judged`)."""
+    judged on the difference at matched states (:func:`_judged`); ``floor``: the noises
+    the residual is judged against (None: the torque noise alone); ``spread``: the
+    covariance the identified arm's parameters put into the load's, added (None: none)."""
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cols = np.ones(W.shape[1], bool) if kept is None else kept
     noise = record.get("noise_rms")
     resid = yv - W[:, cols] @ est[cols]
-    judged, judged_rows = _judged(fit.residual_rms, resid, noise, n, static, against, notes)
+    judged, judged_rows = _judged(fit.residual_rms, resid, noise, n, static, against, notes, floor)
     misfit = () if judged is None else misfit_doubts(judged, difference=difference)
     prep = record.get("preprocessing") or {}
     cov, per_period = _serial_widening(np.asarray(fit.covariance)[:p, :p], resid, n, prep, notes)
     if not static:  # static configurations are exchangeable: their blocks spread alike
         cov = _held_out_spread(cov, W[:, cols], yv, n, notes)
+    if spread is not None:  # the arm's own error: the same all along the recordings
+        cov = _with_arm_spread(cov, spread, notes)
     sm_noise = float(np.sqrt(cov[0, 0]))  # whether there is a load: the misfit says its own
-    if misfit and judged is not None and judged.noise_rms:  # the residual does not see them
-        cov = _misfit_spread(cov, W[:, cols], judged_rows, judged.noise_rms, notes)
+    floor_rms = loaded_floor_rms(noise, judged)  # the torques' scale's fit holds it too
+    if misfit and judged is not None and judged.floor_rms:  # the residual does not see them
+        cov = _misfit_spread(cov, W[:, cols], judged_rows, judged.floor_rms, notes)
     m_ls, sm_ls = float(est[0]), float(np.sqrt(cov[0, 0]))
     scale = None
     if scale_rows is not None:
@@ -565,13 +610,13 @@ def _estimate(
     try:
         phi, active, marg = load_parameters(est[:p], sm_ls, W, margin, notes)
     except DataError as exc:  # a mass not positive: the torques' scale or misfit may say why
-        said = scale_doubts(scale, m_ls, drive, noise) or misfit
+        said = scale_doubts(scale, m_ls, drive, floor_rms) or misfit
         if not said:
             raise
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
     doubts = misfit + doubts_about(kin, frame, m, sm_noise, c, misfit=bool(misfit))
-    doubts += scale_doubts(scale, m, drive, noise)
+    doubts += scale_doubts(scale, m, drive, floor_rms)
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
     at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
     every = tuple(f"I{name}" for name in INERTIA_ORDER)
@@ -618,16 +663,20 @@ def _judged(
     static: bool,
     against: _Unloaded | None,
     notes: list[str],
+    floor: _Floor | None = None,
 ) -> tuple[JudgedResidual | None, NDArray[np.float64]]:
     """The residual the load's doubt is judged on and its rows
     (:func:`~dynid.feasibility.payload_difference.judged_residual`): the fit's
     (``residual_rms`` [N m], ``resid`` its rows, ``noise`` [N m] the torque noise after the
-    low-pass), or the difference from the unloaded arm's residual ``against`` at matched
-    states, with a note; None for static data."""
+    low-pass), judged against ``floor`` (:func:`_floor_ratio`: with the states' noise
+    through the arm's model), or the difference from the unloaded arm's residual
+    ``against`` at matched states (against both recordings' noises; the states' of the
+    unloaded samples taken as the loaded ones'), with a note; None for static data."""
     if static:
         return None, resid
+    ratio, states = _floor_ratio(floor, resid, n)
     if against is None:
-        return JudgedResidual("fit", residual_rms, noise), resid
+        return JudgedResidual("fit", residual_rms, noise, 0.0, states, ratio), resid
     x1, x0, labels0, r0, noise0 = against
     judged, rows = judged_residual(resid.reshape(-1, n), noise, x1, x0, labels0, r0, noise0)
     if judged.kind == "fit":
@@ -636,8 +685,24 @@ def _judged(
             "the loaded samples within reach of the unloaded trajectory): the fit's residual "
             "is judged, the arm's model errors do not cancel"
         )
-        return JudgedResidual("fit", residual_rms, noise, judged.matched), resid
-    return judged, rows
+        return JudgedResidual("fit", residual_rms, noise, judged.matched, states, ratio), resid
+    both = None if states is None else float(np.sqrt(2.0) * states)
+    return replace(judged, states_rms=both), rows
+
+
+def _floor_ratio(
+    floor: _Floor | None, resid: NDArray[np.float64], n: int
+) -> tuple[float | None, float | None]:
+    """The fit's residual ``resid`` (N n,) [N m] over the noise ``floor`` (each sample
+    weighed against its own noise:
+    :func:`~dynid.feasibility.payload_floor.floor_ratio`) and the RMS of the states' noise
+    through the arm's model [N m]; (None, None) without a floor."""
+    if floor is None:
+        return None, None
+    tau, sensor, states = floor
+    cuts = np.cumsum([t.shape[0] for t in tau])[:-1]
+    pieces = np.split(resid.reshape(-1, n), cuts)
+    return floor_ratio(tau, pieces, sensor, states)
 
 
 def _serial_widening(
@@ -661,6 +726,24 @@ def _serial_widening(
         f"of the filtered samples (Newey-West, {lags} lags)"
     )
     return cov * factor, per_period
+
+
+def _with_arm_spread(
+    cov: NDArray[np.float64], spread: NDArray[np.float64], notes: list[str]
+) -> NDArray[np.float64]:
+    """``cov`` (the load's ``p`` parameters) plus ``spread`` (p, p), the covariance the
+    identified arm's base parameters put into them
+    (:func:`~dynid.feasibility.payload_arm.parameter_spread`), with a note of the mass's
+    widening."""
+    out = cov + spread
+    widen = np.sqrt(out[0, 0] / cov[0, 0]) if cov[0, 0] > 0 else 1.0
+    notes.append(
+        f"standard deviations include the identified arm's base parameters' uncertainty "
+        f"(their covariance carried through the load's fit: the mass's x{widen:.3g}), an "
+        "error the same all along the recordings that no residual shows; the friction's "
+        "own uncertainty is not saved with the model and not included"
+    )
+    return out
 
 
 def _misfit_spread(
@@ -738,15 +821,18 @@ def _log_route(
     dict[str, Any],
     bool,
     _ScaleRows,
-    _Unloaded | None,
+    _Judging,
 ]:
     """The rows of recordings (:func:`~dynid.feasibility.payload_rows.log_rows`) with the
-    arm given or identified from ``base``; the preprocessing, recordings and pieces left
-    out, for the record (:class:`PayloadEstimate`'s fields); whether the arm identified
-    from ``base`` differs from the one given (the difference method changed it); the rows
-    of the torques' scale against the arm's ``described`` model (on ``base`` when given:
-    :func:`_base_scale`); the arm's residual on ``base`` (:func:`_arm_on_base`, None
-    without it). ``opt``: the options of :func:`identify_payload`."""
+    arm given or identified from ``base``; the preprocessing, recordings and pieces left out, for
+    the record (:class:`PayloadEstimate`'s fields); whether the arm identified from ``base`` differs
+    from the one given (the difference method changed it); the rows of the torques' scale against
+    the arm's ``described`` model (on ``base`` when given: :func:`_base_scale`); what judges and
+    widens the fit (:data:`_Judging`): the arm's residual on ``base`` (:func:`_arm_on_base`, None
+    without it), the noise floor of the loaded recordings (:data:`_Floor`, None when the states'
+    noise is not known); the covariance the identified arm's base parameters put into the load's
+    (:func:`~dynid.feasibility.payload_arm.parameter_spread`, None for a robot description).
+    ``opt``: the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
     d = opt["drive"]
@@ -778,7 +864,9 @@ def _log_route(
         )
         differenced = _difference_said(inner, the_arm, note, notes)
     still = still_joints(logs, d)
-    fr, rows = _friction_rows(the_arm, rec, still, cols, A, notes, opt["terms"], d)
+    states = states_noise_var(the_arm, rec, logs, d, still)
+    floor = None if states is None else _floor_of(rec, states)
+    fr, rows = _friction_rows(the_arm, rec, still, cols, A, notes, opt["terms"], d, floor)
     W, yv, route, kept, modelled = rows
     scale: _ScaleRows = (yv, modelled, W, kept, 10)
     against = None
@@ -791,7 +879,14 @@ def _log_route(
     name = CLASSICAL_NAME if fr is None else fr.name.removeprefix("links + ")
     record |= {"friction_terms": name, "friction_labels": friction_term(fr, rec, kin.n).labels}
     record |= {"skipped": rec.skipped, "noise_rms": filtered_noise_rms(rec)}
-    return W, yv, route, kept, record, differenced, scale, against
+    spread = parameter_spread(the_arm, [p.log for p in rec.pieces], still, W[:, kept], 10)
+    return W, yv, route, kept, record, differenced, scale, (against, floor, spread)
+
+
+def _floor_of(rec: Recordings, states: list[NDArray[np.float64]]) -> _Floor:
+    """The noise floor (:data:`_Floor`) of the prepared recordings ``rec`` with the states'
+    noise variance ``states`` through the arm's model."""
+    return [p.log.tau for p in rec.pieces], sensor_variances(rec), states
 
 
 def _friction_rows(
@@ -803,12 +898,14 @@ def _friction_rows(
     notes: list[str],
     terms: Structure | Literal["auto"] | None,
     drive: Drive | None,
+    floor: _Floor | None = None,
 ) -> tuple[Structure | None, tuple[Any, ...]]:
     """The friction beside the load (None: classical) and the rows of
     :func:`~dynid.feasibility.payload_rows.log_rows` with it: ``terms`` given, or
     (``"auto"``) the classical unless it leaves more than
-    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise and the
-    friction ``dynid identify`` chooses on these recordings
+    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the noise (``floor``: the
+    torques' and the states' through the arm's model, :func:`_floor_ratio`; None: the
+    torques' alone) and the friction ``dynid identify`` chooses on these recordings
     (:func:`~dynid.feasibility.payload_friction.chosen_friction`) leaves less; the choice
     noted."""
     start = len(notes)
@@ -817,17 +914,20 @@ def _friction_rows(
     noise = filtered_noise_rms(rec)
     if terms != "auto" or not noise:
         return given, rows
-    first = rows_rms(rows[0], rows[1], rows[3])
-    if first <= FLOOR_FAIR * noise or (chosen := chosen_friction(arm.robot, rec, drive)) is None:
+    n = arm.robot.n
+    first_rows = rows_residual(rows[0], rows[1], rows[3])
+    first = _floor_ratio(floor, first_rows, n)[0] or rows_rms(rows[0], rows[1], rows[3]) / noise
+    if first <= FLOOR_FAIR or (chosen := chosen_friction(arm.robot, rec, drive)) is None:
         return None, rows
     mine: list[str] = []
     other = log_rows(arm, rec, still, cols, A, mine, chosen)
-    second = rows_rms(other[0], other[1], other[3])
+    other_rows = rows_residual(other[0], other[1], other[3])
+    second = _floor_ratio(floor, other_rows, n)[0] or rows_rms(other[0], other[1], other[3]) / noise
     name = chosen.name.removeprefix("links + ")
     said = (
-        f"the classical friction fv, fc, fo beside the load leaves {first / noise:.3g} x the "
-        f"torque noise; the friction dynid identify chooses on held-out data from these "
-        f"recordings, {name}, leaves {second / noise:.3g} x"
+        f"the classical friction fv, fc, fo beside the load leaves {first:.3g} x the "
+        f"noise; the friction dynid identify chooses on held-out data from these "
+        f"recordings, {name}, leaves {second:.3g} x"
     )
     if second >= first:
         notes.append(f"{said}: the classical kept")

@@ -24,6 +24,7 @@ or the one given, at the loaded data's cut-off and decimation.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,6 +48,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 
 __all__ = [
+    "parameter_spread",
     "ArmFriction",
     "ArmModel",
     "FrictionTorques",
@@ -291,3 +293,48 @@ def unloaded_arm(
         "standard deviations leave out the uncertainty of that fit"
     )
     return arm_model(model), note
+
+
+def parameter_spread(
+    arm: ArmModel,
+    pieces: Sequence[TorqueLog],
+    still: NDArray[np.bool_],
+    W: NDArray[np.float64],
+    p: int,
+) -> NDArray[np.float64] | None:
+    """The covariance (p, p) the identified arm's base parameters' own covariance puts into
+    the first ``p`` coefficients of the load's least squares on the rows ``W`` (N n, k;
+    the fitted columns only) of the prepared ``pieces`` (``still`` joints at rest).
+
+    The load's rows are the measured torques less the arm's; an error ``d beta`` of the
+    arm's base parameters moves them by ``-Y_b d beta`` (``Y_b`` the arm's base regressor
+    at the prepared states: each column the change of the arm's torques per unit of one
+    base parameter), the same error all along the recordings, which no residual shows:
+    the load moves by ``K d beta`` with ``K = -(W^T W)^-1 W^T Y_b``, of covariance
+    ``K C K^T``. Only the base parameters' covariance is known from a saved model (the
+    friction's is not saved); None for a robot description or a model without it."""
+    model = arm.model
+    if not isinstance(model, IdentifiedModel) or model.fit.covariance is None:
+        return None
+    C = np.asarray(model.fit.covariance, dtype=np.float64)
+    r = model.base.rank
+    if C.shape != (r, r) or not np.all(np.isfinite(C)):
+        return None
+    x0 = np.concatenate(
+        [np.asarray(model.fit.beta, dtype=np.float64)]
+        + [np.asarray(t.values, dtype=np.float64).ravel() for t in model.appended]
+    )
+    moving = ~still
+    states = [(x.q, x.dq * moving, x.ddq * moving) for x in pieces if x.ddq is not None]
+    base = np.concatenate([arm.torques(*s, with_friction=False).ravel() for s in states])
+    Yb = np.empty((base.size, r))
+    for i in range(r):
+        x = x0.copy()
+        x[i] += 1.0
+        other = dataclasses.replace(arm, model=model.with_coefficients(x))
+        Yb[:, i] = np.concatenate([other.torques(*s, with_friction=False).ravel() for s in states])
+        Yb[:, i] -= base
+    norms = np.linalg.norm(W, axis=0)
+    s = np.where(norms > 0, norms, 1.0)
+    K = -np.linalg.lstsq(W / s, Yb, rcond=None)[0][:p] / s[:p, None]
+    return np.asarray(K @ C @ K.T, dtype=np.float64)

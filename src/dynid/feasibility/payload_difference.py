@@ -1,8 +1,9 @@
 """The residual a load's doubt is judged on: the fit's, or what the load leaves beyond the arm.
 
-Without a recording free of the load, the fit's residual is judged against the torque
-noise after the low-pass (:class:`JudgedResidual` of kind ``"fit"``): torques the arm's
-model lacks go into the load.
+Without a recording free of the load, the fit's residual is judged against the noise
+floor: the torque noise after the low-pass and the states' noise through the arm's model
+(:mod:`~dynid.feasibility.payload_floor`; :class:`JudgedResidual` of kind ``"fit"``):
+torques the arm's model lacks go into the load.
 
 With a recording of the same motion without the load (``--unloaded``), the arm's model
 misses the same torques ``e(q, dq, ddq)`` in both (a joint spring, another friction law,
@@ -10,7 +11,9 @@ an armature left out): the loaded fit leaves ``r1 = e(x1) + p(x1) + n1`` (``p`` 
 load's model does not explain), the arm identified without the load leaves
 ``r0 = e(x0) + n0``. At matched states ``x0 = x1`` the difference ``r1 - r0 = p + n1 - n0``
 holds the load's misfit alone; it is judged against the noise of both,
-``sqrt(s1^2 + s0^2)`` (:class:`JudgedResidual` of kind ``"difference"``).
+``sqrt(s1^2 + s0^2)``, and the states' noise through the model of both (the loaded
+samples' twice: at matched states the two are alike) (:class:`JudgedResidual` of kind
+``"difference"``).
 
 Matching (:func:`matched_residual`): each state ``x = (q, dq, ddq)`` (joints taken as
 still zeroed, as in the rows) is scaled per coordinate by the unloaded samples' spread
@@ -39,6 +42,7 @@ __all__ = [
     "JudgedResidual",
     "arm_residual",
     "judged_residual",
+    "loaded_floor_rms",
     "matched_residual",
     "piece_states",
 ]
@@ -66,17 +70,38 @@ class JudgedResidual:
         low-pass, or of both recordings (``"difference"``); None when not known.
     matched : float
         Part of the loaded samples matched to the unloaded recording (0 without one).
+    states_rms : float or None
+        What the states' noise through the arm's model leaves in it [N m]
+        (:mod:`~dynid.feasibility.payload_floor`; of both recordings for
+        ``"difference"``); None when not known.
+    weighted : float or None
+        The residual over both noises with each sample weighed against its own noise
+        (:func:`~dynid.feasibility.payload_floor.floor_ratio`); None: the plain quotient.
     """
 
     kind: Literal["fit", "difference"]
     residual_rms: float
     noise_rms: float | None
     matched: float = 0.0
+    states_rms: float | None = None
+    weighted: float | None = None
+
+    @property
+    def floor_rms(self) -> float | None:
+        """The noise floor [N m]: ``noise_rms`` and ``states_rms``, root sum of squares;
+        None when the torque noise is not known."""
+        if not self.noise_rms:
+            return None
+        return float(np.hypot(self.noise_rms, self.states_rms or 0.0))
 
     @property
     def ratio(self) -> float | None:
-        """``residual_rms / noise_rms``; None when the noise is not known."""
-        return self.residual_rms / self.noise_rms if self.noise_rms else None
+        """The residual over the noise floor: ``weighted`` when known, else
+        ``residual_rms / floor_rms``; None when the noise is not known."""
+        if self.weighted is not None:
+            return self.weighted
+        floor = self.floor_rms
+        return self.residual_rms / floor if floor else None
 
     @property
     def what(self) -> str:
@@ -87,6 +112,17 @@ class JudgedResidual:
             "the loaded fit's residual less the unloaded arm's at matched states "
             f"({100 * self.matched:.0f} % of the samples matched)"
         )
+
+
+def loaded_floor_rms(noise_rms: float | None, judged: JudgedResidual | None) -> float | None:
+    """The loaded recordings' noise floor [N m]: their torque noise after the low-pass
+    ``noise_rms`` and the states' noise through the arm's model that ``judged`` holds
+    (of the loaded samples: half the variance of a difference's), root sum of squares;
+    ``noise_rms`` when the states' noise is not known."""
+    if not noise_rms or judged is None or not judged.states_rms:
+        return noise_rms
+    states = judged.states_rms / (np.sqrt(2.0) if judged.kind == "difference" else 1.0)
+    return float(np.hypot(noise_rms, states))
 
 
 def piece_states(

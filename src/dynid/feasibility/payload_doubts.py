@@ -20,16 +20,16 @@ the consistency bound is not determined as a whole: the least squares gave no bo
 inertia, and the bound, not the data, sets the result. :func:`inertia_doubts` says which
 and what to record; the mass and CoM are still handed on, the inertia is not.
 
-A fit of torque logs that leaves more than :data:`~dynid.identification.verdict.FLOOR_FAIR`
-times the torque noise after the low-pass (:func:`misfit_doubts`, the rule the residual's
-verdict and the torques' scale apply) is the arm's model missing torques, which go into
-the mass and CoM as well as the inertia, by more than the residual's covariance says: the
-whole load is in doubt, no setLoad values are written, and its standard deviations are
-raised to the largest change an unmodelled torque as large as the misfit can make
-(:func:`~dynid.feasibility.payload_fit.misfit_covariance`). With recordings of the same
-motion without the load, the residual judged is the loaded fit's less the unloaded arm's
-at matched states (:mod:`~dynid.feasibility.payload_difference`): an arm's misfit common
-to both does not doubt the load, what the load leaves unexplained does.
+A fit of torque logs that leaves more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times
+its noise floor, the torque noise after the low-pass and the states' noise through the arm's model
+(:mod:`~dynid.feasibility.payload_floor`; :func:`misfit_doubts`, the rule the residual's verdict and
+the torques' scale apply) is the arm's model missing torques, which go into the mass and CoM as well
+as the inertia, by more than the residual's covariance says: the whole load is in doubt, no setLoad
+values are written, and its standard deviations are raised to the largest change an unmodelled
+torque as large as the misfit can make (:func:`~dynid.feasibility.payload_fit.misfit_covariance`).
+With recordings of the same motion without the load, the residual judged is the loaded fit's less
+the unloaded arm's at matched states (:mod:`~dynid.feasibility.payload_difference`): an arm's misfit
+common to both does not doubt the load, what the load leaves unexplained does.
 """
 
 from __future__ import annotations
@@ -147,23 +147,26 @@ def misfit_above(residual_rms: float, noise_rms: float | None) -> float | None:
 
 def misfit_doubts(judged: JudgedResidual, *, difference: bool = False) -> tuple[str, ...]:
     """The doubt about a load whose ``judged`` residual
-    (:mod:`~dynid.feasibility.payload_difference`: the fit's, or with recordings of the
-    same motion without the load, its difference from the unloaded arm's at matched
-    states) is more than :data:`~dynid.identification.verdict.FLOOR_FAIR` times the
-    torque noise it holds (:func:`misfit_above`): torques the load's and the arm's models
-    do not explain go into the load's mass, CoM and inertia, by more than a noise-based
-    standard deviation says (an unmodelled spring on a Panda's joints 2 and 4 at 74 x the
-    noise read a 1.5 kg load as 1.04 kg, 3.7 of its std off; the standard deviations are
-    raised for it, :func:`~dynid.feasibility.payload_fit.misfit_covariance`), and no
-    setLoad values are written; the likely causes and what to record (``difference``:
-    the arm was identified from unloaded data already). Empty at or below the threshold,
+    (:mod:`~dynid.feasibility.payload_difference`: the fit's, or with recordings of the same motion
+    without the load, its difference from the unloaded arm's at matched states) is more than
+    :data:`~dynid.identification.verdict.FLOOR_FAIR` times the noise it holds
+    (:attr:`~dynid.feasibility.payload_difference.JudgedResidual.ratio`: the torques' noise and the
+    states' through the arm's model): torques the load's and the arm's models do not explain go into
+    the load's mass, CoM and inertia, by more than a noise-based standard deviation says (an
+    unmodelled spring on a Panda's joints 2 and 4 at 74 x the noise read a 1.5 kg load as 1.04 kg,
+    3.7 of its std off; the standard deviations are raised for it,
+    :func:`~dynid.feasibility.payload_fit.misfit_covariance`), and no setLoad values are written;
+    the likely causes and what to record (``difference``: the arm was identified from unloaded data
+    already). Empty at or below the threshold,
     or when the noise is not known (static data)."""
-    if (ratio := misfit_above(judged.residual_rms, judged.noise_rms)) is None:
+    ratio = judged.ratio
+    if ratio is None or not ratio > FLOOR_FAIR:
         return ()
     if judged.kind == "difference":
         return (
             f"{judged.what} leaves {ratio:.3g} x the noise of both recordings "
-            f"({judged.residual_rms:.2g} N m RMS, more than {FLOOR_FAIR:g} x): the load does "
+            f"({judged.residual_rms:.2g} N m RMS{_parts(judged)}, more than {FLOOR_FAIR:g} x): "
+            "the load does "
             "not explain what changed between the recordings (the load moved or slipped, "
             "another load, a load that is no rigid body, or the motions differ where they "
             "matched), and those torques go into its mass, CoM and inertia (the standard "
@@ -186,15 +189,38 @@ def misfit_doubts(judged: JudgedResidual, *, difference: bool = False) -> tuple[
             "fitted with; where the loaded and unloaded motions differ, record them alike "
             "(the arm's errors cancel only where the motions match)"
         )
+    if judged.states_rms and judged.noise_rms and judged.states_rms > judged.noise_rms:
+        hint = (
+            "the states' noise through the arm's model is larger than the torques' (noisy "
+            "recorded velocities through a steep friction law, or a high cut-off): where it "
+            "is the larger part of the residual, a log without the velocity columns "
+            "(velocities derived from the positions at the cut-off) or a lower --cutoff "
+            f"leaves less of it; else {hint}"
+        )
     return (
-        f"the fit leaves {ratio:.3g} x the torque noise ({judged.residual_rms:.2g} N m RMS, "
-        f"more than {FLOOR_FAIR:g} x): torques the arm's model does not explain (unmodelled "
+        f"the fit leaves {ratio:.3g} x the torque noise{_with_states(judged)} "
+        f"({judged.residual_rms:.2g} N m RMS{_parts(judged)}, more than {FLOOR_FAIR:g} x): "
+        "torques the arm's model does not explain (unmodelled "
         "friction, a joint spring, a tilted base, the links' or the drive's parameters, or "
         "the states' noise at a high cut-off) go into the load's mass, CoM and inertia, by "
         "more than a noise-based standard deviation says (the standard deviations are "
         "raised to the largest change a torque as large as the misfit makes, a rough "
         f"bound); no setLoad values are written; hint: {hint}",
     )
+
+
+def _with_states(judged: JudgedResidual) -> str:
+    """`` and the states' noise through the arm's model`` when it counts in the floor."""
+    return "" if judged.states_rms is None else " and the states' noise through the arm's model"
+
+
+def _parts(judged: JudgedResidual) -> str:
+    """The noise floor's parts in words: ``; against 0.0073 and 0.06 N m, each sample
+    weighed against its own noise``; empty when the states' noise is not known."""
+    if judged.states_rms is None or not judged.noise_rms:
+        return ""
+    how = ", each sample weighed against its own noise" if judged.weighted is not None else ""
+    return f"; against {judged.noise_rms:.2g} and {judged.states_rms:.2g} N m{how}"
 
 
 def inertia_doubts(

@@ -46,6 +46,7 @@ __all__ = [
     "classical_parts",
     "friction_structure",
     "friction_term",
+    "rows_residual",
     "rows_rms",
 ]
 
@@ -106,11 +107,19 @@ def rows_rms(
 ) -> float:
     """RMS [units of ``y``] of the least-squares residual of ``y`` (N,) on the columns
     ``kept`` of ``W`` (N, p), the columns scaled to unit norm."""
+    return float(np.sqrt(np.mean(rows_residual(W, y, kept) ** 2)))
+
+
+def rows_residual(
+    W: NDArray[np.float64], y: NDArray[np.float64], kept: NDArray[np.bool_] | None = None
+) -> NDArray[np.float64]:
+    """The least-squares residual (N,) [units of ``y``] of ``y`` (N,) on the columns
+    ``kept`` of ``W`` (N, p), the columns scaled to unit norm."""
     Wk = W if kept is None else W[:, kept]
     scale = np.linalg.norm(Wk, axis=0)
     Ws = Wk / np.where(scale > 0, scale, 1.0)
     x = np.linalg.lstsq(Ws, y, rcond=None)[0]
-    return float(np.sqrt(np.mean((y - Ws @ x) ** 2)))
+    return np.asarray(y - Ws @ x, dtype=np.float64)
 
 
 def classical_parts(

@@ -11,7 +11,8 @@
      "constraint_active": false, "pseudo_inertia_margin": ..., "rank": 10,
      "condition_number": ..., "residual_rms": ..., "noise_rms": ... | null,
      "judged_residual": {"kind": "difference", "residual_rms": ..., "noise_rms": ...,
-                         "ratio": ..., "matched": ...} | null,
+                         "states_noise_rms": ... | null, "ratio": ...,
+                         "matched": ...} | null,
      "n_rows": ..., "notes": [...], "plausible": true, "doubts": [...],
      "inertia_determined": true, "undetermined_inertia": ["Izz", ...],
      "torque_scale": {"value": ..., "std": ..., "mass": ..., "std_mass": ...,
@@ -31,16 +32,20 @@ the flange's link and its mass and CoM are not in doubt; null otherwise (and
 it). ``doubts`` says why an estimate is not plausible
 (:mod:`dynid.feasibility.payload_doubts`: a mass not significantly above zero, a CoM
 farther than the arm is long, torques of another scale than the arm description's
-(``torque_scale``), a fit of torque logs that leaves more than 3 x ``noise_rms`` (with
-``--unloaded`` logs of the same motion: ``judged_residual``'s ratio): such a load is not
+(``torque_scale``), a fit of torque logs whose ``judged_residual`` ratio is above 3 (the
+residual over its noise floor: the torque noise and the states' noise through the arm's
+model): such a load is not
 handed to a controller; inertia elements
 not determined, ``undetermined_inertia``: its inertia is not). ``residual_rms`` [N m for
 torque logs] is the fit's, ``noise_rms`` [N m] what the torque noise alone leaves after
 the low-pass (null for static data). ``judged_residual`` is the residual the load's doubt
 was judged on (:mod:`dynid.feasibility.payload_difference`): ``kind`` ``fit`` (the fit's
-residual against ``noise_rms``) or ``difference`` (with ``--unloaded`` logs of the same
-motion: the loaded fit's residual less the unloaded arm's at matched states, against the
-noise of both), its RMS and noise [N m], their ``ratio`` (a doubt above 3) and the part of
+residual against ``noise_rms`` and ``states_noise_rms``) or ``difference`` (with
+``--unloaded`` logs of the same motion: the loaded fit's residual less the unloaded arm's
+at matched states, against the noise of both), its RMS, the torque noise and the states'
+noise through the arm's model (:mod:`dynid.feasibility.payload_floor`; null: not known)
+[N m], their ``ratio`` (each sample weighed against its own noise; a doubt above 3) and
+the part of
 the loaded samples ``matched`` to the unloaded trajectory [1]; null for static data.
 ``torque_scale`` is the factor ``value`` [1] (with its ``std``) between the measured
 torques and the arm description's (:mod:`dynid.feasibility.payload_scale`), fitted on the
@@ -49,8 +54,8 @@ torques and the arm description's (:mod:`dynid.feasibility.payload_scale`), fitt
 factor); null with an identified model (its scale was fitted to the same sensors) or a
 description without inertial parameters. A factor more than 5 % and 3 standard deviations
 from 1 is a doubt; ``judged`` is false when the fit with the factor leaves more than 3 x
-``noise_rms`` (the factor then takes torques the arm's model lacks: neither a doubt nor a
-load to trust).
+its noise floor (``noise_rms`` and the states' noise; the factor then takes torques the
+arm's model lacks: neither a doubt nor a load to trust).
 ``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
 ``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
 bridged [s], null for the default rule); null for static data. ``friction_terms`` names
@@ -145,7 +150,9 @@ def payload_to_dict(
                 "inertia": "kg m^2",
                 "residual_rms": "N m (torque logs); the rows' SI units (static data)",
                 "noise_rms": "N m",
-                "judged_residual": "residual_rms, noise_rms: N m; ratio, matched: 1",
+                "judged_residual": (
+                    "residual_rms, noise_rms, states_noise_rms: N m; ratio, matched: 1"
+                ),
                 "torque_scale": "value, std: 1; mass, std_mass: kg",
             },
             "conventions": {
@@ -171,6 +178,7 @@ def _judged(est: PayloadEstimate) -> dict[str, Any] | None:
         "kind": j.kind,
         "residual_rms": _num(j.residual_rms),
         "noise_rms": None if j.noise_rms is None else _num(j.noise_rms),
+        "states_noise_rms": None if j.states_rms is None else _num(j.states_rms),
         "ratio": None if j.ratio is None else _num(j.ratio),
         "matched": _num(j.matched),
     }
@@ -187,7 +195,7 @@ def _scale(est: PayloadEstimate) -> dict[str, Any] | None:
         "mass": _num(t.mass),
         "std_mass": _num(t.std_mass),
         "data": t.data,
-        "judged": unjudged_ratio(t, est.noise_rms) is None,
+        "judged": unjudged_ratio(t, est.floor_rms) is None,
     }
 
 

@@ -6,9 +6,10 @@ with its largest standard deviation, the inertia with its largest one, or the el
 the data do not determine (``undetermined_inertia`` of ``payload.json``). The level:
 
 * not a load to trust (poor): a doubt about the mass or the CoM (no setLoad values), a
-  residual above :data:`~dynid.identification.verdict.FLOOR_FAIR` times the torque noise
-  left after the low-pass among them (effects outside the arm's model, which the mass and
-  CoM take too: :func:`~dynid.feasibility.payload_doubts.misfit_doubts`), or with
+  residual above :data:`~dynid.identification.verdict.FLOOR_FAIR` times its noise floor
+  (the torque noise left after the low-pass and the states' noise through the arm's
+  model, ``judged_residual``'s ratio) among them (effects outside the arm's model, which
+  the mass and CoM take too: :func:`~dynid.feasibility.payload_doubts.misfit_doubts`), or with
   ``--unloaded`` logs of the same motion the residual judged (``judged_residual``: the
   loaded fit's less the unloaded arm's at matched states) above that times the noise of
   both;
@@ -84,9 +85,22 @@ def payload_answer(run: RunFiles) -> Answer | None:
 
 
 def _noise_ratio(doc: dict[str, Any]) -> float | None:
-    """The fit's residual over the torque noise after the low-pass, when both are known."""
+    """The fit's residual over its noise floor (the torque noise after the low-pass, and
+    the states' noise through the arm's model when ``judged_residual`` holds it), when
+    known."""
+    if (states := _states_noise(doc)) is not None:
+        return float(states["ratio"])
     r, n = doc.get("residual_rms"), doc.get("noise_rms")
     return r / n if is_number(r) and is_number(n) and n > 0 else None
+
+
+def _states_noise(doc: dict[str, Any]) -> dict[str, Any] | None:
+    """``judged_residual`` of the fit when it holds the states' noise through the arm's
+    model (``states_noise_rms``) and its ratio, else None."""
+    j = doc.get("judged_residual")
+    if not isinstance(j, dict) or j.get("kind") != "fit" or not is_number(j.get("ratio")):
+        return None
+    return j if is_number(j.get("states_noise_rms")) else None
 
 
 def _judged(doc: dict[str, Any]) -> dict[str, Any] | None:
@@ -110,9 +124,15 @@ def _residual_fact(doc: dict[str, Any]) -> str:
         said = "at the noise floor" if ratio <= FLOOR_GOOD else "close to it"
         if ratio > FLOOR_FAIR:
             said = "effects outside the arm's model remain"
+        noise = f"torque noise after the low-pass ({number(doc['noise_rms'], 2)} N m)"
+        if (states := _states_noise(doc)) is not None:
+            noise += (
+                " and the states' noise through the arm's model "
+                f"({number(states['states_noise_rms'], 2)} N m)"
+            )
         fact = (
             f"Residual RMS {number(doc['residual_rms'], 2)} N m, {number(ratio, 3)} x the "
-            f"torque noise after the low-pass ({number(doc['noise_rms'], 2)} N m): {said}"
+            f"{noise}: {said}"
         )
         if (j := _judged(doc)) is not None:
             common = j["ratio"] <= FLOOR_FAIR
