@@ -144,6 +144,30 @@ def pinocchio_panda_urdf() -> str:
     return robot_data_urdf("panda_description/urdf/panda.urdf")
 
 
+def pinocchio_panda_model(arm=None, load=None):
+    """Pinocchio's model of example-robot-data's Panda without its fingers (their joints
+    locked), its seven links holding ``arm``'s inertials (a dynid robot; dynid's Panda by
+    default) and ``load`` (a ``pinocchio.Inertia`` in link 7's frame) added to link 7;
+    gravity 9.80665 m/s^2 along -z. Skips the test without Pinocchio."""
+    import pytest
+
+    pin = pytest.importorskip("pinocchio")
+    import dynid
+
+    arm = dynid.panda() if arm is None else arm
+    full = pin.buildModelFromUrdf(pinocchio_panda_urdf())
+    fingers = [full.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
+    model = pin.buildReducedModel(full, fingers, pin.neutral(full))
+    for i in range(7):
+        model.inertias[i + 1] = pin.Inertia(
+            float(arm.mass[i]), np.array(arm.com[i]), np.array(arm.inertia[i])
+        )
+    if load is not None:
+        model.inertias[7] += load
+    model.gravity.linear[:] = [0.0, 0.0, -9.80665]
+    return model
+
+
 def robot_data_urdf(rel: str) -> str:
     import importlib.util
     from pathlib import Path

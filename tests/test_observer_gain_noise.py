@@ -33,14 +33,9 @@ def _log(sigma: float):
 def _pinocchio_diag_rms(q: np.ndarray) -> np.ndarray:
     """``sqrt(mean_t sum_k M_jk(q_t)^2)`` (n,) from Pinocchio's CRBA [kg m^2]."""
     pin = pytest.importorskip("pinocchio")
-    from conftest import pinocchio_panda_urdf
+    from conftest import pinocchio_panda_model
 
-    full = pin.buildModelFromUrdf(pinocchio_panda_urdf())
-    fingers = [full.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
-    model = pin.buildReducedModel(full, fingers, pin.neutral(full))
-    panda = dynid.panda()
-    for i in range(7):  # dynid's Panda inertials (Gaz et al.) on Pinocchio's chain
-        model.inertias[i + 1] = pin.Inertia(panda.mass[i], panda.com[i], panda.inertia[i])
+    model = pinocchio_panda_model()  # dynid's Panda inertials (Gaz et al.) on Pinocchio's chain
     data = model.createData()
     total = np.zeros(7)
     for x in q:

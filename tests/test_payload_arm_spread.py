@@ -21,7 +21,7 @@ from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.simulation.trajectories import random_fourier, uniform_times
 
-from conftest import pinocchio_panda_urdf
+from conftest import pinocchio_panda_model
 
 MASS, COM = 1.5, np.array([0.03, -0.02, 0.08])
 INERTIA = np.diag([0.004, 0.005, 0.003])
@@ -34,14 +34,7 @@ def arm_and_load():
     """The arm identified (links only) from 6 s of the unloaded Panda, and 6 s of another
     trajectory with the load; Pinocchio's torques plus 0.05 N m noise."""
     pin = pytest.importorskip("pinocchio")
-    full = pin.buildModelFromUrdf(pinocchio_panda_urdf())
-    fingers = [full.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
-    model = pin.buildReducedModel(full, fingers, pin.neutral(full))
-    for i in range(7):
-        model.inertias[i + 1] = pin.Inertia(
-            ARM.mass[i], np.array(ARM.com[i]), np.array(ARM.inertia[i])
-        )
-    model.gravity.linear[:] = [0.0, 0.0, -9.80665]
+    model = pinocchio_panda_model(ARM)
     t = uniform_times(6.0, 500.0)
     arm7 = model.inertias[7].copy()
 

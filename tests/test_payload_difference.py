@@ -32,7 +32,7 @@ from dynid.model.drive import Drive
 from dynid.simulation.measurement import simulate_measurement
 from dynid.simulation.trajectories import random_fourier, uniform_times
 
-from conftest import pinocchio_panda_urdf
+from conftest import pinocchio_panda_model
 
 MASS, COM = 1.5, np.array([0.03, -0.02, 0.08])
 INERTIA = np.diag([0.004, 0.005, 0.003])
@@ -48,14 +48,7 @@ def logs():
     halfway, and the arm without it; Pinocchio's torques, 0.05 N m noise, and a spring
     on joint 2 in each."""
     pin = pytest.importorskip("pinocchio")
-    full = pin.buildModelFromUrdf(pinocchio_panda_urdf())
-    fingers = [full.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
-    model = pin.buildReducedModel(full, fingers, pin.neutral(full))
-    for i in range(7):
-        model.inertias[i + 1] = pin.Inertia(
-            ARM.mass[i], np.array(ARM.com[i]), np.array(ARM.inertia[i])
-        )
-    model.gravity.linear[:] = [0.0, 0.0, -9.80665]
+    model = pinocchio_panda_model(ARM)
     t = uniform_times(8.0, 500.0)
     traj = random_fourier(ARM, np.random.default_rng(4), q0=dynid.PANDA_NEUTRAL_Q)(t)
     arm7 = model.inertias[7].copy()

@@ -24,7 +24,7 @@ from dynid.io.payload_json import payload_to_dict
 from dynid.model.inertia import inertia6_from_matrix
 from dynid.simulation.trajectories import random_fourier, uniform_times
 
-from conftest import pinocchio_panda_urdf
+from conftest import pinocchio_panda_model
 
 MASS, COM = 1.5, np.array([0.03, -0.02, 0.08])
 INERTIA = np.diag([0.004, 0.005, 0.003])
@@ -36,15 +36,7 @@ FLANGE_Z = 0.107  # the flange on link 7 [m]
 def loaded_log():
     """10 s at 500 Hz of the loaded Panda, Pinocchio's torques plus 0.05 N m noise."""
     pin = pytest.importorskip("pinocchio")
-    full = pin.buildModelFromUrdf(pinocchio_panda_urdf())
-    fingers = [full.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
-    model = pin.buildReducedModel(full, fingers, pin.neutral(full))
-    for i in range(7):
-        model.inertias[i + 1] = pin.Inertia(
-            ARM.mass[i], np.array(ARM.com[i]), np.array(ARM.inertia[i])
-        )
-    model.inertias[7] += pin.Inertia(MASS, COM + [0.0, 0.0, FLANGE_Z], INERTIA)
-    model.gravity.linear[:] = [0.0, 0.0, -9.80665]
+    model = pinocchio_panda_model(ARM, pin.Inertia(MASS, COM + [0.0, 0.0, FLANGE_Z], INERTIA))
     data = model.createData()
     t = uniform_times(10.0, 500.0)
     traj = random_fourier(ARM, np.random.default_rng(4), q0=dynid.PANDA_NEUTRAL_Q)(t)

@@ -21,7 +21,7 @@ from dynid.friction.laws import LAWS
 from dynid.identification.log import TorqueLog
 from dynid.simulation.trajectories import random_fourier, uniform_times
 
-from conftest import pinocchio_panda_urdf
+from conftest import pinocchio_panda_model
 
 MASS, COM = 1.5, np.array([0.03, -0.02, 0.08])
 INERTIA = np.diag([0.004, 0.005, 0.003])
@@ -44,15 +44,7 @@ def noisy_velocities():
     torque noise, and velocities recorded with 0.02 rad/s noise."""
     pin = pytest.importorskip("pinocchio")
     arm = _arm()
-    full = pin.buildModelFromUrdf(pinocchio_panda_urdf())
-    fingers = [full.getJointId(n) for n in ("panda_finger_joint1", "panda_finger_joint2")]
-    model = pin.buildReducedModel(full, fingers, pin.neutral(full))
-    for i in range(7):
-        model.inertias[i + 1] = pin.Inertia(
-            arm.mass[i], np.array(arm.com[i]), np.array(arm.inertia[i])
-        )
-    model.inertias[7] += pin.Inertia(MASS, COM + [0.0, 0.0, FLANGE_Z], INERTIA)
-    model.gravity.linear[:] = [0.0, 0.0, -9.80665]
+    model = pinocchio_panda_model(arm, pin.Inertia(MASS, COM + [0.0, 0.0, FLANGE_Z], INERTIA))
     data = model.createData()
     t = uniform_times(10.0, 500.0)
     traj = random_fourier(arm, np.random.default_rng(4), q0=dynid.PANDA_NEUTRAL_Q)(t)
