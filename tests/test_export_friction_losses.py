@@ -174,7 +174,8 @@ def test_urdf_export_names_an_armature_without_gears_only_when_not_negligible(tm
     """Regression: identify without a drive warned that robot.urdf leaves out "the drive's
     rotor inertias" of 1e-7 kg m^2; an armature below 0.1 % of its joint's M_jj at the
     middle of the ranges is not named now, and one above is named as the armature, with
-    its share of M_jj (closed form of the 2R arm)."""
+    its share of the joint's inertia with it, M_jj + armature (closed form of the 2R
+    arm)."""
     diag = _mass_diagonal_2r_at_zero()
     below = Drive.from_gears([1.0, 1.0], rotor_inertia=0.99e-3 * diag, side="joint")
     _, lines = _warnings(export_urdf, tmp_path / "a.urdf", _arm(), ExportOptions(drive=below))
@@ -185,8 +186,11 @@ def test_urdf_export_names_an_armature_without_gears_only_when_not_negligible(tm
     assert len(lines) == 1, lines
     assert lines[0].startswith("URDF export: b.urdf leaves out the armature (rotor inertia")
     assert "drive's" not in lines[0]
-    assert f"joint2 {ia[1]:.4g} (0.15 % of its M_jj)" in lines[0], lines[0]
-    assert f"joint1 {ia[0]:.4g} (0.05 % of its M_jj)" in lines[0], lines[0]
+    assert f"joint2 {ia[1]:.4g} (0.15 % of the joint's inertia)" in lines[0], lines[0]
+    assert f"joint1 {ia[0]:.4g} (0.05 % of the joint's inertia)" in lines[0], lines[0]
+    big = Drive.from_gears([1.0, 1.0], rotor_inertia=14.0 * diag, side="joint")  # a wrist's
+    _, lines = _warnings(export_urdf, tmp_path / "c.urdf", _arm(), ExportOptions(drive=big))
+    assert "(93 % of the joint's inertia)" in lines[0], lines[0]  # 14 / 15, not 1.4e+03 %
 
 
 def test_template_dynamics_are_replaced_by_the_identified_friction(tmp_path):
