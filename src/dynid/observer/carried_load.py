@@ -7,7 +7,8 @@ throughout when it is heavy enough, one long "collision" that hides the contacts
 of it. :func:`fit_carried_load` fits ``theta`` on the samples of such an event robustly
 (weighted least squares, each joint's residual and regressor divided by its contact
 threshold at the sample, then :data:`FIT_ROUNDS` rounds that leave out the samples the
-fit leaves over the threshold at some joint: contacts on top of the load) and calls it a
+fit leaves over the threshold at some joint, or over :data:`SPREAD` times the kept
+samples' median misfit where that is larger: contacts on top of the load) and calls it a
 load only where
 
 * the event lasts :data:`MIN_LOAD_S` or more;
@@ -67,6 +68,9 @@ MIN_INLIERS = 0.5
 MIN_EXPLAINED = 0.9
 #: Range of some joint over the event [rad]: configurations varied enough to tell a weight.
 MIN_MOTION_RAD = 0.2
+#: The misfit left out, in medians of the kept samples' misfit, where it exceeds the
+#: threshold (the load's inertia on a fast motion: the fit models its weight alone).
+SPREAD = 3.0
 #: Rounds of the robust fit.
 FIT_ROUNDS = 6
 #: Time after the pick and after the release [s] whose events are the step's rest.
@@ -191,7 +195,9 @@ def fit_carried_load(
     keep = np.ones(ta.shape[0], dtype=bool)
     theta, left = _weighted_fit(A, b, keep)
     for _ in range(FIT_ROUNDS):
-        inside = np.all(np.abs(left) <= 1.0, axis=1)
+        worst = np.max(np.abs(left), axis=1)  # each sample's largest, over its threshold
+        cut = max(1.0, SPREAD * float(np.median(worst[keep])))  # the load's own misfit
+        inside = worst <= cut
         if inside.sum() < 20 or np.array_equal(inside, keep):
             break
         keep = inside

@@ -301,10 +301,11 @@ class ObserveResult:
             out += tuple(x for x in (own, banded) if x is not None)
         u = self.unmodelled  # its note says the same of a model without friction
         said = u is not None and u.overall is not None and u.flagged_share() > MOST_FLAGGED
-        if not said and (flagged := self.mostly_flagged_note()) is not None:
+        held = any(ld.whole for ld in carried)  # its note names the cause, not the model
+        if not said and not held and (flagged := self.mostly_flagged_note()) is not None:
             out += (flagged,)
         load = load_note(self.load, self.model.robot.joint_names, identified=identified)
-        if not carried and load:
+        if load:
             out += (load,)
         if (
             self.frame is not None
