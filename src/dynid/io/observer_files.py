@@ -72,6 +72,7 @@ from numpy.typing import NDArray
 from .. import __version__
 from .._checks import text
 from ..exceptions import DataError, DynidError
+from ..observer.carried_load import load_words
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
@@ -532,7 +533,8 @@ class ResidualTables:
         path = self.out / f"{residual_names(paths)[index]}.csv"
         with residuals_csv(path, rows, n, frame=frame, kind=kind) as put:
             yield put
-        self.written.append(path)
+        if path not in self.written:
+            self.written.append(path)
 
 
 def log_labels(paths: Sequence[str | Path]) -> list[str]:
@@ -668,6 +670,7 @@ def save_observation(
         **({} if result.frame is None else {"wrench": _estimate_info(result)}),
         **({} if (total := result.score()) is None else {"score": _score_info(result, total)}),
         **({} if result.min_duration_s is None else {"dropped": _dropped_info(result, joints)}),
+        **_loads_info(result, labels),
         **meta,
     }
     paths.insert(
@@ -684,6 +687,18 @@ def save_observation(
         ),
     )
     return paths
+
+
+def _loads_info(result: ObserveResult, labels: Sequence[str]) -> dict[str, Any]:
+    """``loads``: the loads carried at the flange over an event of each log (neither
+    contacts nor false alarms; :mod:`~dynid.observer.carried_load`), each with its log
+    and its line; nothing when none."""
+    out = [
+        {**ld.as_dict(), "log": label, "summary": load_words(ld)}
+        for label, x in zip(labels, result.logs, strict=True)
+        for ld in x.loads
+    ]
+    return {"loads": out} if out else {}
 
 
 def _dropped_info(result: ObserveResult, joints: Sequence[str]) -> dict[str, Any]:

@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 from ..exceptions import DataError
 from ..friction.model import FrictionModel, FrictionSum
 from .calibration_check import CalibrationCheck
+from .carried_load import CarriedLoad, load_words
 from .detection import ContactEvent, Thresholds
 from .events import DroppedCrossing
 from .friction import banding_note
@@ -129,6 +130,10 @@ class LogObservation:
         ``sqrt(sum |r - J^T w|^2 / sum |r|^2)``
         (:func:`~dynid.observer.wrench_fit.unexplained_shares`), in the order of
         ``events``; None: no wrench estimated.
+    loads : tuple of CarriedLoad
+        Loads carried at the flange over a long event (:mod:`~dynid.observer.carried_load`):
+        neither contacts nor false alarms; ``events`` and the residual are those of the
+        detection run again without their torque.
     """
 
     path: Path
@@ -151,6 +156,7 @@ class LogObservation:
     dropped_count: int = 0
     damped: tuple[float, ...] | None = None
     unexplained: tuple[float, ...] | None = None
+    loads: tuple[CarriedLoad, ...] = ()
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -273,10 +279,18 @@ class ObserveResult:
         fewer than six joints move is the least-norm one
         (:func:`~dynid.observer.wrench.underdetermined_note`), a force alone at a frame
         that fewer than three joints move too; a residual off contacts that follows the
-        weight of a load at the flange (:func:`~dynid.observer.unmodelled_load.load_note`);
+        weight of a load at the flange (:func:`~dynid.observer.unmodelled_load.load_note`),
+        first a load carried over an event, held through a log or picked and released
+        (:func:`~dynid.observer.carried_load.load_words`);
         false alarms that each start shortly before a missed labelled contact: labels that
         look late (:func:`~dynid.observer.scoring.shifted_labels_note`)."""
-        out: tuple[str, ...] = ()
+        identified = self.model.source == "identified"
+        carried = [ld for x in self.logs for ld in x.loads]
+        out: tuple[str, ...] = tuple(
+            f"{x.path.name}: {load_words(ld, identified=identified)}"
+            for x in self.logs
+            for ld in x.loads
+        )
         if self.model.friction is None:
             out = (no_friction_note(self.unmodelled, self.model.robot.joint_names),)
         if self.model.friction is not None:
@@ -287,10 +301,11 @@ class ObserveResult:
             out += tuple(x for x in (own, banded) if x is not None)
         u = self.unmodelled  # its note says the same of a model without friction
         said = u is not None and u.overall is not None and u.flagged_share() > MOST_FLAGGED
-        if not said and (flagged := self.mostly_flagged_note()) is not None:
+        held = any(ld.whole for ld in carried)  # its note names the cause, not the model
+        if not said and not held and (flagged := self.mostly_flagged_note()) is not None:
             out += (flagged,)
-        identified = self.model.source == "identified"
-        if load := load_note(self.load, self.model.robot.joint_names, identified=identified):
+        load = load_note(self.load, self.model.robot.joint_names, identified=identified)
+        if load:
             out += (load,)
         if (
             self.frame is not None

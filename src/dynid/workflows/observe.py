@@ -66,6 +66,7 @@ import logging
 import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -551,6 +552,9 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 keep_series=opts.keep_series,
                 figure_points=opts.figure_points,
                 table=table,
+                retable=None
+                if sink is None
+                else partial(sink.table, paths, k, rows, model.n, opts.frame, kind),
                 kind=kind,
                 labels=labels,
                 tolerance_s=opts.label_tolerance_s,

@@ -18,7 +18,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -29,6 +29,13 @@ from .. import _checks
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
+from ..observer.carried_load import (
+    CarriedLoad,
+    LoadSamples,
+    LoadTorque,
+    at_load_edge,
+    carried_loads,
+)
 from ..observer.events import ContactEvent, EventDetector, time_slack
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
@@ -163,7 +170,7 @@ def contact_labels(prep: PreparedLog, columns: ColumnMap | None) -> Labels | Non
     return Labels(f"column {name!r}", _checks.frozen(np.asarray(flags, dtype=np.float64)))
 
 
-def detected_log(
+def _detected_once(
     prep: PreparedLog,
     model: ObserverModel,
     mapped: bool,
@@ -182,6 +189,8 @@ def detected_log(
     tolerance_s: float = DEFAULT_TOLERANCE_S,
     unmodelled: FrictionTally | None = None,
     load: LoadTally | None = None,
+    carried: Sequence[CarriedLoad] = (),
+    samples: LoadSamples | None = None,
 ) -> LogObservation:
     """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
     of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
@@ -191,7 +200,9 @@ def detected_log(
     (:func:`contact_labels`), else against the true torques stored beside the log (in
     contact above :data:`~dynid.observer.scoring.TRUTH_LEVEL`), with ``tolerance_s``
     (:func:`scored`); ``unmodelled`` (a model without friction) and ``load`` (the fit of
-    a load at the flange) are fed the samples under the contact threshold."""
+    a load at the flange) are fed the samples under the contact threshold; ``carried``:
+    loads whose torque is taken from the residual first; ``samples`` keeps the samples
+    over the threshold for their fit."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
     steps = np.diff(log.t)
@@ -217,8 +228,9 @@ def detected_log(
     seen = model.friction
     if unmodelled is not None:
         unmodelled.new_log()
+    less = LoadTorque(model.robot, carried, options.gains(n)) if carried else None
     with about_file(prep.path.name), table or nullcontext(None) as put:
-        for blk in observed_rows(prep, model, options, *wants):
+        for blk in _less_load(prep, observed_rows(prep, model, options, *wants), less):
             a, b = blk.a, blk.a + blk.r.shape[0]
             if blk.friction is not None and blk.friction is not model.friction:
                 seen = blk.friction  # banded for the velocity noise (a note says so)
@@ -235,18 +247,13 @@ def detected_log(
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
             sign.add(log.tau[a:b], blk.r)
-            if unmodelled is not None or load is not None:  # contacts left out
-                contact, _ = threshold_series(thresholds, b - a, blk.std, blk.margin)
-                under = ~(np.abs(blk.r) > contact)
-                if unmodelled is not None:  # the friction the model misses
-                    unmodelled.add(log.t[a:b], prep.dq[a:b], blk.r, under)
-                if load is not None:  # a load at the flange the model misses
-                    load.add(log.q[a:b], blk.r, contact)
+            _tallied(prep, thresholds, blk, unmodelled, load, samples)
             if keep is not None:
                 keep.put(blk)
             if strided is not None:
                 strided.add(log.t, blk, None if ext is None else ext[a:b])
         events += det.finish()
+    events = [e for e in events if not at_load_edge(e.start, e.end, carried)]
     if (opposite := opposite_finding(sign, model.robot.joint_names)) is not None:
         warnings.warn(  # a whole-log "collision" on each such joint follows
             f"{prep.path.name}: {opposite}", DynidWarning, stacklevel=3
@@ -276,7 +283,95 @@ def detected_log(
         dropped_count=det.dropped_count,
         damped=None if damped is None else damped_shares(log.t, events, damped),
         unexplained=unexplained,
+        loads=tuple(carried),
     )
+
+
+def detected_log(
+    prep: PreparedLog,
+    model: ObserverModel,
+    mapped: bool,
+    thresholds: Thresholds,
+    options: ObserverOptions,
+    *,
+    table: AbstractContextManager[Callable[..., None] | None] | None = None,
+    retable: Callable[[], AbstractContextManager[Callable[..., None] | None] | None] | None = None,
+    **kw: Any,
+) -> LogObservation:
+    """The events of one prepared log (:func:`_detected_once`, its keywords), and where
+    an event is a load carried at the flange (:mod:`~dynid.observer.carried_load`), the
+    detection run again on the residual without the load's torque: its events inside the
+    load's window are the contacts on top of it, and the load is kept beside them
+    (:attr:`~dynid.observer.results.LogObservation.loads`), neither a contact nor a false
+    alarm. ``retable`` opens the residual table again for that second run."""
+    log = prep.log
+    steps = np.diff(log.t)
+    period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
+    samples = LoadSamples(period)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        first = _detected_once(
+            prep, model, mapped, thresholds, options, table=table, samples=samples, **kw
+        )
+    if not log.t.shape[0]:
+        _said_again(said)
+        return first
+    span = (float(log.t[0]), float(log.t[-1]))
+    events = [(e.start, e.end) for e in first.events]
+    loads = carried_loads(model.robot, samples, events, options.gains(model.n), span)
+    if not loads:
+        _said_again(said)
+        return first
+    kw = {**kw, "unmodelled": None, "load": None}  # fed once, by the first run
+    again = None if retable is None else retable()
+    return _detected_once(
+        prep, model, mapped, thresholds, options, table=again, carried=loads, **kw
+    )
+
+
+def _said_again(said: list[warnings.WarningMessage]) -> None:
+    """The warnings of a run held back, said (the run's answer stands)."""
+    for w in said:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def _less_load(prep: PreparedLog, blocks: Any, less: LoadTorque | None) -> Any:
+    """The observed ``blocks`` with the carried loads' torque ``less`` taken from their
+    residual (the lag restarted at each piece of the log)."""
+    starts = {a for a, _ in prep.spans}
+    for blk in blocks:
+        if less is None:
+            yield blk
+            continue
+        if blk.a in starts:
+            less.restart()
+        b = blk.a + blk.r.shape[0]
+        yield replace(blk, r=blk.r - less.block(prep.log.t[blk.a : b], prep.log.q[blk.a : b]))
+
+
+def _tallied(
+    prep: PreparedLog,
+    thresholds: Thresholds,
+    blk: ObservedBlock,
+    unmodelled: FrictionTally | None,
+    load: LoadTally | None,
+    samples: LoadSamples | None,
+) -> None:
+    """One block fed to the tallies off contacts (``unmodelled``: the friction the model
+    misses; ``load``: a load at the flange it misses) and its samples over the threshold
+    to ``samples`` (a carried load's fit)."""
+    if unmodelled is None and load is None and samples is None:
+        return
+    log = prep.log
+    a, b = blk.a, blk.a + blk.r.shape[0]
+    contact, _ = threshold_series(thresholds, b - a, blk.std, blk.margin)
+    under = ~(np.abs(blk.r) > contact)
+    if unmodelled is not None:  # the friction the model misses
+        unmodelled.add(log.t[a:b], prep.dq[a:b], blk.r, under)
+    if load is not None:  # a load at the flange the model misses
+        load.add(log.q[a:b], blk.r, contact)
+    if samples is not None:
+        samples.add(log.t[a:b], log.q[a:b], blk.r, contact)
 
 
 def _off_frame(
