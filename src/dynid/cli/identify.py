@@ -44,7 +44,10 @@ fitted to the corrected currents, is the one kept (identification.json's drive h
 corrected constants), and the verdict names the factors (a note in the summary says why);
 with --consistent the consistent fit is of that model, fitted to the corrected currents too
 (feasible.json's drive holds the corrected constants; a note names the factors). A rotor
-inertia fitted below zero is a warning naming the joint and its likely cause.
+inertia fitted below zero is a warning naming the joint and its likely cause. Of several
+recordings, one whose held-out error is far above the others' (a payload or contacts the
+model lacks) is named in a warning and left out of the structure's choice and of the
+final fit (--keep-outlying fits it).
 
 Gravity vector. The robot's gravity vector is the description's (--gravity sets it).
 A base mounted off level by a few tenths of a degree, or a description whose base frame is
