@@ -278,6 +278,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "significant frequency, read from the log; decimation keeps at least 10 %% of the "
         "samples; none for a log exact to round-off)" + CUTOFF_NONE_HELP,
     )
+    _add_heldout_options(p)
+    return p
+
+
+def _add_heldout_options(p: argparse.ArgumentParser) -> None:
+    """The held-out judgement's options: time blocks, a separate log, outlying recordings."""
     p.add_argument(
         "--folds",
         type=number(int, min=2),
@@ -299,7 +305,6 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "held-out error is far above the others', a payload or contacts the model lacks, is "
         "left out of the structure's choice and of the final fit, and named in a warning)",
     )
-    return p
 
 
 def run(args: argparse.Namespace, console: Console) -> int:

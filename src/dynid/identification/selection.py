@@ -245,7 +245,7 @@ def select_structure(
     validation: Recordings | None = None,
     rtol: float | None = None,
     per_joint: bool = True,
-    keep_outlying: bool | None = None,
+    keep: bool | None = None,
 ) -> Selection | None:
     """Judge candidate structures on held-out data and choose one (module docstring).
 
@@ -260,8 +260,8 @@ def select_structure(
         Default :func:`candidate_structures` (the armature only where the rotor inertias
         are not known; the friction at the motors and at the joints of a coupled drive,
         :func:`~dynid.identification.structure.friction_placements`).
-    estimator, folds, rtol
-        As :func:`identify_recordings`.
+    estimator, folds, rtol, keep
+        As :func:`identify_recordings` (``keep``: its ``keep_outlying``, None: not said).
     validation : Recordings, optional
         A separate recording to judge on instead of the folds.
     per_joint : bool
@@ -269,9 +269,6 @@ def select_structure(
         (:func:`~dynid.identification.widths.per_joint_widths`), single joints' friction
         coefficients left out within one standard error of the lowest held-out error,
         none the fit determines (:attr:`~dynid.identification.structure.Structure.drop`).
-    keep_outlying : bool, optional
-        What the warning and note of an outlying recording say of the final fit
-        (:func:`identify_recordings`): True keeps it, False leaves it out; None: nothing.
 
     Returns
     -------
@@ -322,11 +319,8 @@ def select_structure(
     if not judged:
         return None
     full = list(judged)
-    skip: tuple[int, ...] = ()
-    if len(data.names) > 2 and validation is None:
-        judged, skip = _without_odd(
-            judged, columns, groups, data.names, fit_rtol, notes, keep_outlying
-        )
+    names = data.names if validation is None else ()  # judged on a separate one: none odd
+    judged, skip = _without_odd(judged, columns, groups, names, fit_rtol, notes, keep)
     # each candidate's regressor; a per-joint structure's that of the candidate its search
     # began at (a smooth-sign Stribeck law without its bumps, in the Stribeck law's)
     where = {c: key for c, _, key in columns}
@@ -350,7 +344,7 @@ def select_structure(
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, where, data.names, fit_rtol)
-    _warn_outlying(skip, per, keep_outlying)
+    _warn_outlying(skip, per, keep)
     return Selection(
         tuple(judged),
         chosen,
@@ -426,7 +420,7 @@ def _final_fit(keep: bool, k: int) -> str:
     """What the final fit does with ``k`` outlying recordings: kept (``keep``) or left out."""
     them = "it" if k == 1 else "them"
     if keep:
-        return f"the final fit keeps {them} (keep_outlying)"
+        return f"the final fit keeps {them} (--keep-outlying, keep_outlying=True)"
     return (
         f"the final fit leaves {them} out too (--keep-outlying, keep_outlying=True, keeps "
         f"{them}; metadata.recordings[].left_out)"
@@ -523,8 +517,10 @@ def _without_odd(
     (contacts, a payload), which spoil the fit of every other fold while among them
     (:func:`~.candidates.recording_oddness` above :data:`OUTLIER_RATIO`), with those
     recordings; the candidates as they were and none when none is odd or fewer than two
-    would be left. A note names each, with what the final fit does with it (``keep``,
-    :func:`_final_fit`)."""
+    would be left (of two recordings or fewer, none). A note names each, with what the
+    final fit does with it (``keep``, :func:`_final_fit`)."""
+    if len(names) < 3:
+        return judged, ()
     ref = min(judged, key=lambda c: c.heldout_error_percent)
     _, use0, g0 = columns[next(i for i, c in enumerate(judged) if c is ref)]
     scores = recording_oddness(use0, groups[g0][0], rtol)
@@ -1065,7 +1061,7 @@ def identify_recordings(
     if structure == "auto":
         selection = select_structure(
             robot, data, drive=drive, estimator=est, folds=folds, validation=validation,
-            rtol=rtol, keep_outlying=keep_outlying,
+            rtol=rtol, keep=keep_outlying,
         )  # fmt: skip
         structure = _fitted_structure(robot, data, selection, friction)
         selection = selection and replace(selection, notes=(*exact, *selection.notes))
