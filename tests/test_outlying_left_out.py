@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from dynid.cli.summaries import recordings_lines
+from dynid.feasibility.payload_arm import holds_the_load
 from dynid.friction.model import ClassicalFriction, friction_of
 from dynid.identification.recordings import prepare_recordings
 from dynid.identification.selection import fitted_logs, identify_recordings
@@ -80,6 +81,10 @@ def test_an_outlying_recording_is_left_out_of_the_final_fit_and_named(arm, logs)
     np.testing.assert_allclose(fv, FV, rtol=0.05)
     np.testing.assert_allclose(fc, FC, rtol=0.05)
     assert np.max(np.abs(kept.friction.params[:, 0] / FV - 1)) > 0.5  # the payload in them
+    # the recording left out is not the model's own: validate judges it held out, payload
+    # --model takes its load
+    assert model.info.fitted_on(NAMES) == ("a.csv", "c.csv")
+    assert holds_the_load(model, [recs[1]]) is None and holds_the_load(kept, [recs[1]])
     lines = recordings_lines(recs)
     assert lines[1].startswith("recording load.csv: left out of the fit")
     assert "left out" not in lines[0] + lines[2]
