@@ -44,7 +44,10 @@ fitted to the corrected currents, is the one kept (identification.json's drive h
 corrected constants), and the verdict names the factors (a note in the summary says why);
 with --consistent the consistent fit is of that model, fitted to the corrected currents too
 (feasible.json's drive holds the corrected constants; a note names the factors). A rotor
-inertia fitted below zero is a warning naming the joint and its likely cause.
+inertia fitted below zero is a warning naming the joint and its likely cause. Of several
+recordings, one whose held-out error is far above the others' (a payload or contacts the
+model lacks) is named in a warning and left out of the structure's choice and of the
+final fit (--keep-outlying fits it).
 
 Gravity vector. The robot's gravity vector is the description's (--gravity sets it).
 A base mounted off level by a few tenths of a degree, or a description whose base frame is
@@ -130,6 +133,7 @@ import numpy as np
 from ..exceptions import OptionError
 from ..identification.estimators import ESTIMATORS
 from ..identification.least_squares import STD_METHODS
+from ..identification.selection import fitted_logs
 from ..identification.torque_delay import TorqueDelay, applied_delay
 from ..identification.verdict import Verdict
 from ..io.feasible_bundle import save_feasible_bundle
@@ -274,6 +278,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "significant frequency, read from the log; decimation keeps at least 10 %% of the "
         "samples; none for a log exact to round-off)" + CUTOFF_NONE_HELP,
     )
+    _add_heldout_options(p)
+    return p
+
+
+def _add_heldout_options(p: argparse.ArgumentParser) -> None:
+    """The held-out judgement's options: time blocks, a separate log, outlying recordings."""
     p.add_argument(
         "--folds",
         type=number(int, min=2),
@@ -288,7 +298,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="FILE",
         help="torque logs: judge on this separate log (read as --data) instead of time blocks",
     )
-    return p
+    p.add_argument(
+        "--keep-outlying",
+        action="store_true",
+        help="several recordings: fit those found outlying too (default: a recording whose "
+        "held-out error is far above the others', a payload or contacts the model lacks, is "
+        "left out of the structure's choice and of the final fit, and named in a warning)",
+    )
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
@@ -319,7 +335,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if held is not None:  # every sample of the figures' data, not the decimated rows
         doc = held.as_dict()
         files.append(save_json(args.out / "heldout.json", doc, schema="dynid-heldout-torques/1"))
-        fitted = [Path(str(r.get("file", ""))).name for r in result.model.info.recordings]
+        recs = fitted_logs(result.model, result.model.info.recordings)
+        fitted = [Path(str(r.get("file", ""))).name for r in recs]
         files += [] if args.no_figures else save_heldout_figures(args.out, held, fitted)
         v = held.verdict
         text += _delay_first(result.torque_delay, v)
@@ -327,7 +344,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
     elif result.torque_delay is not None and result.torque_delay.named:
         text.append(f"note: {result.torque_delay.sentence()}")
     if result.consistent is not None:
-        sources = [str(p) for p in args.data]  # every recording fitted, not the first alone
+        # every recording fitted, not the first alone; none left out as outlying
+        sources = [str(p) for p in fitted_logs(result.model, args.data)]
         files += save_feasible_bundle(args.out, result.consistent, sources=sources)
         files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)
         text += ["", format_consistent(result.consistent)]

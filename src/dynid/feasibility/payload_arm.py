@@ -207,8 +207,9 @@ def holds_the_load(model: IdentifiedModel, recordings: Sequence[Mapping[str, Any
     a recording the model was identified from, by the SHA-256 of its samples where both
     records hold one (whatever the files are called), else (a model recorded without it)
     by its file name and number of samples. The model's base parameters then hold the
-    load's, and the load left beside them is none."""
-    own = [dict(r) for r in model.info.recordings]
+    load's, and the load left beside them is none. A recording left out of the model's fit
+    as outlying (``left_out``: a payload recording among unloaded ones) is not its own."""
+    own = [dict(r) for r in model.info.recordings if not r.get("left_out")]
     sums = {r["sha256"] for r in own if "sha256" in r}
     same: list[str] = []
     how = "the same samples"

@@ -216,6 +216,9 @@ class IdentificationInfo:
 
     def fitted_on(self, names: Sequence[str]) -> tuple[str, ...]:
         """Those of ``names`` (recordings' file names or paths) that name a recording the
-        model was identified from (by file name: the record holds no path)."""
-        fitted = {Path(str(r.get("file", ""))).name for r in self.recordings}
+        model was identified from (by file name: the record holds no path); not one left
+        out of the fit as outlying (``left_out``)."""
+        fitted = {
+            Path(str(r.get("file", ""))).name for r in self.recordings if not r.get("left_out")
+        }
         return tuple(n for n in names if Path(str(n)).name in fitted)

@@ -50,7 +50,7 @@ import re
 import warnings
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -120,6 +120,7 @@ __all__ = [
     "OUTLIER_RATIO",
     "Candidate",
     "Selection",
+    "fitted_logs",
     "identify_recordings",
     "reversed_friction",
     "select_structure",
@@ -244,6 +245,7 @@ def select_structure(
     validation: Recordings | None = None,
     rtol: float | None = None,
     per_joint: bool = True,
+    keep: bool | None = None,
 ) -> Selection | None:
     """Judge candidate structures on held-out data and choose one (module docstring).
 
@@ -258,8 +260,8 @@ def select_structure(
         Default :func:`candidate_structures` (the armature only where the rotor inertias
         are not known; the friction at the motors and at the joints of a coupled drive,
         :func:`~dynid.identification.structure.friction_placements`).
-    estimator, folds, rtol
-        As :func:`identify_recordings`.
+    estimator, folds, rtol, keep
+        As :func:`identify_recordings` (``keep``: its ``keep_outlying``, None: not said).
     validation : Recordings, optional
         A separate recording to judge on instead of the folds.
     per_joint : bool
@@ -317,9 +319,8 @@ def select_structure(
     if not judged:
         return None
     full = list(judged)
-    skip: tuple[int, ...] = ()
-    if len(data.names) > 2 and validation is None:
-        judged, skip = _without_odd(judged, columns, groups, data.names, fit_rtol, notes)
+    names = data.names if validation is None else ()  # judged on a separate one: none odd
+    judged, skip = _without_odd(judged, columns, groups, names, fit_rtol, notes, keep)
     # each candidate's regressor; a per-joint structure's that of the candidate its search
     # began at (a smooth-sign Stribeck law without its bumps, in the Stribeck law's)
     where = {c: key for c, _, key in columns}
@@ -343,7 +344,7 @@ def select_structure(
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, where, data.names, fit_rtol)
-    _warn_outlying(skip, per)
+    _warn_outlying(skip, per, keep)
     return Selection(
         tuple(judged),
         chosen,
@@ -392,18 +393,38 @@ def reversed_friction(selection: Selection) -> tuple[Violation, ...]:
     return tuple(v for v in best_any.unphysical if v.everywhere)
 
 
-def _warn_outlying(skip: tuple[int, ...], per: tuple[tuple[str, float], ...]) -> None:
-    """A warning for each recording ``skip`` left out of the judgement (its name and
-    held-out error with the chosen structure in ``per``)."""
-    for i in skip:
-        warnings.warn(
-            f"{per[i][0]}: held-out error {per[i][1]:.3g} % with the chosen structure, far "
-            "above the other recordings' (metadata.selection.heldout_per_recording): it holds "
-            "torques the model does not (contacts, a payload?); the structure is chosen on "
-            "the other recordings",
-            DynidWarning,
-            stacklevel=3,
-        )
+def _warn_outlying(
+    skip: tuple[int, ...], per: tuple[tuple[str, float], ...], keep: bool | None = None
+) -> None:
+    """One warning naming the recordings ``skip`` left out of the judgement, their held-out
+    errors with the chosen structure against the others' (``per``), and what the final
+    fit does with them (``keep``, :func:`_final_fit`)."""
+    if not skip:
+        return
+    odd = [per[i] for i in skip]
+    rest = [e for i, (_, e) in enumerate(per) if i not in skip]
+    others = f"{min(rest):.3g} %" if len(rest) == 1 else f"{min(rest):.3g} to {max(rest):.3g} %"
+    errors = ", ".join(f"{e:.3g} %" for _, e in odd)
+    warnings.warn(
+        f"{', '.join(n for n, _ in odd)}: held-out error{'s' if len(odd) > 1 else ''} "
+        f"{errors} with the chosen structure, far above the other recordings' ({others}; "
+        "metadata.selection.heldout_per_recording): it holds torques the model does not "
+        "(contacts, a payload?); the structure is chosen on the other recordings"
+        + ("" if keep is None else f"; {_final_fit(keep, len(skip))}"),
+        DynidWarning,
+        stacklevel=3,
+    )
+
+
+def _final_fit(keep: bool, k: int) -> str:
+    """What the final fit does with ``k`` outlying recordings: kept (``keep``) or left out."""
+    them = "it" if k == 1 else "them"
+    if keep:
+        return f"the final fit keeps {them} (--keep-outlying, keep_outlying=True)"
+    return (
+        f"the final fit leaves {them} out too (--keep-outlying, keep_outlying=True, keeps "
+        f"{them}; metadata.recordings[].left_out)"
+    )
 
 
 #: Recordings disagree (:func:`_disagreement_note`) when each one's held-out error is at
@@ -476,6 +497,7 @@ def _candidate_notes(judged: Sequence[Candidate]) -> list[str]:
     return notes
 
 
+_T = TypeVar("_T")
 _Key = tuple[bool, str, str]  # regressor_group
 _Groups = dict[_Key, tuple[IdentifiedModel, list[tuple[ModelTerm, Any]]]]
 #: The regressors and the folds they are judged on.
@@ -489,12 +511,16 @@ def _without_odd(
     names: Sequence[str],
     rtol: float,
     notes: list[str],
+    keep: bool | None = None,
 ) -> tuple[list[Candidate], tuple[int, ...]]:
     """The candidates judged without the recordings that hold what no candidate models
     (contacts, a payload), which spoil the fit of every other fold while among them
     (:func:`~.candidates.recording_oddness` above :data:`OUTLIER_RATIO`), with those
     recordings; the candidates as they were and none when none is odd or fewer than two
-    would be left."""
+    would be left (of two recordings or fewer, none). A note names each, with what the
+    final fit does with it (``keep``, :func:`_final_fit`)."""
+    if len(names) < 3:
+        return judged, ()
     ref = min(judged, key=lambda c: c.heldout_error_percent)
     _, use0, g0 = columns[next(i for i, c in enumerate(judged) if c is ref)]
     scores = recording_oddness(use0, groups[g0][0], rtol)
@@ -505,8 +531,8 @@ def _without_odd(
         f"{names[i]}: held-out error {ref.fold_errors_percent[i]:.3g} %, "
         f"{scores[i]:.3g} x the other recordings' median when it is left out of "
         "their fits too: it holds torques the model does not (contacts, a payload, "
-        "another set-up?); the structure is chosen on the other recordings, the "
-        "final fit uses every recording"
+        "another set-up?); the structure is chosen on the other recordings"
+        + ("" if keep is None else f", {_final_fit(keep, 1)}")
         for i in skip
     ]
     return [
@@ -951,12 +977,14 @@ def identify_recordings(
     friction: tuple[str, ...] | None = None,
     base: BaseParameters | None = None,
     torque_delay_s: float = 0.0,
+    keep_outlying: bool = False,
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
     Each recording (and each piece of one between its gaps) is prepared on its own
     (:func:`~dynid.identification.recordings.prepare_recordings`); the structure is chosen
-    on held-out data (:func:`select_structure`) unless given, then fitted on all the data.
+    on held-out data (:func:`select_structure`) unless given, then fitted on all the data
+    but the recordings found outlying there (the structure chosen without them).
 
     Parameters
     ----------
@@ -998,6 +1026,9 @@ def identify_recordings(
         placement kept; the consistent fit's classical parts): the data prepared once.
     base : BaseParameters, optional
         The base parameters of a structure given (default: the structural ones).
+    keep_outlying : bool
+        Fit the recordings the structure's choice found outlying too (default: left out,
+        ``left_out`` in their ``info.recordings`` entry, said in a warning).
 
     Returns
     -------
@@ -1029,24 +1060,75 @@ def identify_recordings(
     selection = None
     if structure == "auto":
         selection = select_structure(
-            robot, data, drive=drive, estimator=est, folds=folds, validation=validation, rtol=rtol
-        )
+            robot, data, drive=drive, estimator=est, folds=folds, validation=validation,
+            rtol=rtol, keep=keep_outlying,
+        )  # fmt: skip
         structure = _fitted_structure(robot, data, selection, friction)
         selection = selection and replace(selection, notes=(*exact, *selection.notes))
+    gone = () if selection is None or keep_outlying else _outlying(data, selection)
+    fitted = data.without(gone) if gone else data
+    with stage("the fit of the structure chosen" if selection else "the fit", rows=fitted.n_rows):
+        model, terms = _fitted(
+            robot, fitted, structure, drive, folds, validation, estimator=est, std=std,
+            base=base, max_std_percent=max_std_percent, rtol=rtol,
+        )  # fmt: skip
+    warn_unphysical(model, terms)
+    heldout = _heldout_record(model, fitted if validation is None else validation)
+    combined = _combined(robot, fitted, structure, drive, model.base)
+    model = _recorded(model, exact, combined, heldout, structure, selection)
+    return _with_left_out(model, data, gone) if gone else model
+
+
+def fitted_logs(model: IdentifiedModel, logs: Sequence[_T]) -> list[_T]:
+    """Of ``logs`` (one per recording, in the order given to :func:`identify_recordings`),
+    those ``model`` was fitted on: all but those its record marks ``left_out``."""
+    recs = model.info.recordings or ()
+    if len(recs) != len(logs):
+        return list(logs)
+    return [log for log, r in zip(logs, recs, strict=True) if not r.get("left_out")]
+
+
+def _outlying(data: Recordings, selection: Selection) -> tuple[int, ...]:
+    """The indices of the recordings ``selection`` found outlying (into ``data.names``)."""
+    return tuple(i for i, name in enumerate(data.names) if name in selection.outlying)
+
+
+def _fitted(
+    robot: Robot,
+    data: Recordings,
+    structure: Structure,
+    drive: Drive | None,
+    folds: int,
+    validation: Recordings | None,
+    *,
+    estimator: Estimator,
+    **kw: Any,
+) -> tuple[IdentifiedModel, tuple[ModelTerm, ...]]:
+    """``structure`` fitted on ``data`` (:func:`~.core.identify` with ``kw``), judged on
+    its held-out folds (or ``validation``), and its terms; a rank deficiency with the hint
+    of the terms that leave the unexcited coefficients out (:func:`_without_hint`)."""
     model_drive, terms = _terms_of(structure, drive, robot.n, data, _limits_middle(robot))
-    judge, _, fold_labels = heldout_judge(robot, data, est, folds, validation)
+    judge, _, fold_labels = heldout_judge(robot, data, estimator, folds, validation)
     try:
-        with stage("the fit of the structure chosen" if selection else "the fit", rows=data.n_rows):
-            model = identify(
-                robot, data, drive=model_drive, terms=terms, estimator=est, std=std, base=base,
-                max_std_percent=max_std_percent, rtol=rtol, judge=judge, fold_labels=fold_labels,
-            )  # fmt: skip
+        model = identify(
+            robot, data, drive=model_drive, terms=terms, estimator=estimator, judge=judge,
+            fold_labels=fold_labels, **kw,
+        )  # fmt: skip
     except RankDeficientError as exc:
         raise _without_hint(exc, structure) from exc
-    warn_unphysical(model, terms)
-    heldout = _heldout_record(model, data if validation is None else validation)
-    combined = _combined(robot, data, structure, drive, model.base)
-    return _recorded(model, exact, combined, heldout, structure, selection)
+    return model, terms
+
+
+def _with_left_out(
+    model: IdentifiedModel, data: Recordings, gone: tuple[int, ...]
+) -> IdentifiedModel:
+    """``model``, fitted without the recordings ``gone`` of ``data``, with every
+    recording in its record (``info.recordings``, :meth:`~.recordings.Recordings.summary`),
+    those left out marked ``left_out``."""
+    recordings = tuple(
+        {**r, "left_out": True} if i in gone else r for i, r in enumerate(data.summary())
+    )
+    return replace(model, info=replace(model.info, recordings=recordings))
 
 
 def _recorded(

@@ -58,7 +58,7 @@ from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.residual_dependence import outside_model_note, round_off_note
-from ..identification.selection import identify_recordings
+from ..identification.selection import fitted_logs, identify_recordings
 from ..identification.static import identify_static
 from ..identification.structure import Structure
 from ..identification.torque_delay import TorqueDelay
@@ -258,6 +258,10 @@ class IdentifyOptions:
         Torque logs: contiguous time blocks of the held-out judgement (>= 2).
     validate_on : str or Path, optional
         Torque logs: judge on this separate log (read as the data) instead of time blocks.
+    keep_outlying : bool
+        Torque logs: fit the recordings found outlying too (default: the structure is
+        chosen without them and the final fit leaves them out,
+        :func:`~dynid.identification.selection.identify_recordings`).
     consistent : bool
         Also identify physically consistent link parameters in one step (convex).
     prior : str, Path or Robot, optional
@@ -296,6 +300,7 @@ class IdentifyOptions:
     q_start: tuple[float, ...] | None = None
     folds: int | None = None
     validate_on: str | Path | None = None
+    keep_outlying: bool = False
     consistent: bool = False
     prior: str | Path | Robot | None = None
     prior_base: str | None = None
@@ -556,6 +561,7 @@ def _fit_logs(
                 estimator=opt.estimator,
                 std=opt.std or "hac",  # the consistent fit's data term is the residual itself
                 cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
+                keep_outlying=opt.keep_outlying,
                 **heldout,
             )
 
@@ -573,6 +579,7 @@ def _fit_logs(
             extra={**model.info.extra, "gravity_fitted": gravity.as_dict()},
         )
         model = dataclasses.replace(model, info=info)
+    logs = fitted_logs(model, logs)  # without the recordings found outlying
     _say_gravity_scale(robot, model, logs, opt.drive, held)
     if opt.consistent:
         result = _consistent_of(robot, model, held, first, opt, prior)
@@ -609,8 +616,10 @@ def _predicted_heldout(
     model: IdentifiedModel, logs: Sequence[TorqueLog], separate: TorqueLog | None
 ) -> HeldOutTorques | None:
     """The held-out prediction of ``model`` fitted to ``logs`` (``separate``: the
-    ``validate_on`` log), from the logs as the fit took them; one it cannot make (every
+    ``validate_on`` log), from the logs as the fit took them (without those it left out,
+    :func:`~dynid.identification.selection.fitted_logs`); one it cannot make (every
     held-out piece too short to filter) is a warning, never a failed identification."""
+    logs = fitted_logs(model, logs)
     try:
         return heldout_torques(model, logs[-1], separate=separate, others=logs[:-1])
     except DynidError as exc:
