@@ -500,6 +500,12 @@ def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
     per = next(t for t in page.tables if t[0][0] == "recording")
     assert per[1][0] == "a.csv" and per[1][2] == ""
     assert per[2][0] == "hit.csv" and per[2][2].startswith("outlying")
+    assert per[2][2].endswith("fitted (--keep-outlying)")  # no record of it left out
+    doc["metadata"]["recordings"] = [{"file": "a.csv"}, {"file": "hit.csv", "left_out": True}]
+    p.write_text(json.dumps(doc))
+    page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))
+    per = next(t for t in page.tables if t[0][0] == "recording")
+    assert per[2][2] == "outlying: left out of the judgement and of the fit"
     del doc["metadata"]["selection"]
     p.write_text(json.dumps(doc))
     page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))

@@ -875,10 +875,19 @@ def _structure_section(doc: dict) -> str:
     per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
     if per:
         odd = set(sel.get("outlying_recordings") or ())
-        said = "outlying: left out of the judgement"
+        recs = _get(doc, "metadata", "recordings") or ()
+        out = {r.get("file") for r in recs if isinstance(r, dict) and r.get("left_out")}
+
+        def said(name: Any) -> str:
+            if name not in odd:
+                return ""
+            if name in out:
+                return "outlying: left out of the judgement and of the fit"
+            return "outlying: left out of the judgement, fitted (--keep-outlying)"
+
         rows = [
             [esc(r.get("file", "")), cell(r.get("heldout_error_percent"))]
-            + ([said if r.get("file") in odd else ""] if odd else [])
+            + ([said(r.get("file"))] if odd else [])
             for r in per
         ]
         head = ["recording", "held-out error [%]"] + (["judgement"] if odd else [])
