@@ -296,8 +296,10 @@ def fit_carried_load(
     ``contact`` (N, n) [N m] (module docstring); ``gain`` the observer's K (n,) [1/s],
     ``log_span`` the log's first and last time [s]; ``rigid`` (N, n, 10): the lagged
     rigid-body regressor at the samples (:func:`lagged_rigid_regressor`), fitted where
-    it determines the inertia (:func:`inertia_determined`), else (or None) the weight
-    alone. None: no load explains it."""
+    it determines the inertia (:func:`inertia_determined`) and leaves less misfit than the
+    weight alone on the samples both fits keep (a force that follows gravity without the
+    inertia a mass carries, a weight hung by a spring, stays the weight's), else (or
+    None) the weight alone. None: no load explains it."""
     ta = np.asarray(t, dtype=np.float64)
     R, C = np.asarray(r, dtype=np.float64), np.asarray(contact, dtype=np.float64)
     qa = np.asarray(q, dtype=np.float64)
@@ -311,7 +313,10 @@ def fit_carried_load(
     if rigid is not None:
         A10 = np.asarray(rigid, dtype=np.float64)[good] / C[:, :, None]
         if inertia_determined(A10[keep]):
-            A, (theta, left, keep) = A10, _robust_fit(A10, b)
+            rigid_fit = _robust_fit(A10, b)
+            both = keep & rigid_fit[2]
+            if np.sum(rigid_fit[1][both] ** 2) < np.sum(left[both] ** 2):
+                A, (theta, left, keep) = A10, rigid_fit
     kept = float(np.mean(keep))
     total = float(np.sum(b[keep] ** 2))
     explained = 1.0 - float(np.sum(left[keep] ** 2)) / total if total > 0 else 0.0
