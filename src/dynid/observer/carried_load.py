@@ -20,8 +20,17 @@ load only where
   arm reads as any weight would);
 * ``m > 0`` (an arm lighter than its model is the model's error).
 
+A load is a rigid body: on a fast motion its inertia adds to its weight's torque. Given
+the log's accelerations, the fit takes the load's full dynamics at the flange, ``theta =
+(m, m c, J)`` (:func:`rigid_load_regressor`, the payload's regressor of ``dynid
+payload``), passed through the observer's lag (:func:`lagged_rigid_regressor`), where
+the event's motion determines the inertia (:func:`inertia_determined`) and the ten
+parameters leave less misfit than the weight alone; else the weight alone. On the trial
+below the weight alone left 4 short events inside the window (its inertia) and read
+0.81 kg, CoM z 0.046 m; the rigid load none, 0.80 kg and 0.050 m (0.05 m true).
+
 The load is then taken out: :class:`LoadTorque` gives, block by block, its torque as the
-observer sees it, ``Y(q) theta`` switched on at the pick and off at the release and
+observer sees it, ``Y theta`` switched on at the pick and off at the release and
 passed through the observer's ``K/(s + K)`` (the residual's own lag), and the detection
 runs again on the residual minus it (the wrench estimate loses the load's wrench with
 it). The pick and the release are read off the residual at the event's edges (the first
@@ -372,9 +381,9 @@ def carried_loads(
 
 
 class LoadTorque:
-    """The loads' torque as the observer's residual carries it, a block at a time: ``Y(q)
-    theta`` on from each load's pick to its release, through ``K/(s + K)`` (module
-    docstring).
+    """The loads' torque as the observer's residual carries it, a block at a time: ``Y
+    theta`` (the weight's or the rigid load's regressor) on from each load's pick to its
+    release, through ``K/(s + K)`` (module docstring).
 
     Parameters
     ----------
