@@ -204,17 +204,24 @@ def rigid_load_regressor(
     return np.asarray(-(Y @ link_params_from_frame(f.T_link_frame)), dtype=np.float64)
 
 
-def _lag(u: NDArray[np.float64], K: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
+def _lag(
+    u: NDArray[np.float64], K: NDArray[np.float64], dt: float, state: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """``u`` (N, n, ...) through each joint's ``K/(s + K)`` (exact for a step held over
-    a sample, ``dt`` [s]), started at rest on ``u[0]``."""
+    a sample, ``dt`` [s]) from the output ``state`` (n, ...) before the first sample."""
     from scipy.signal import lfilter
 
     out = np.empty_like(u)
     for j in range(u.shape[1]):
         a = 1.0 - float(np.exp(-K[j] * dt))
-        zi = (1.0 - a) * u[0, j][None, ...]
+        zi = (1.0 - a) * state[j][None, ...]
         out[:, j], _ = lfilter([a], [1.0, a - 1.0], u[:, j], axis=0, zi=zi)
     return out
+
+
+#: Samples of the rigid load's regressor computed at a time (the torque regressor of a
+#: block held: 7 joints, 70 columns, 32 MB).
+RIGID_BLOCK = 8192
 
 
 def lagged_rigid_regressor(
@@ -227,7 +234,9 @@ def lagged_rigid_regressor(
     """:func:`rigid_load_regressor` over the samples of ``motion`` (times [s], positions
     [rad], velocities [rad/s], accelerations [rad/s^2], each (N, ...)) from ``span[0]``
     to ``span[1]`` [s], passed through the observer's lag ``K/(s + K)`` (``gain`` (n,)
-    [1/s]) as the residual is, read at the times ``at`` (M,) [s]: (M, n, 10).
+    [1/s]; started on the first sample's value) as the residual is, read at the times
+    ``at`` (M,) [s] (the nearest sample at or after): (M, n, 10). Computed
+    :data:`RIGID_BLOCK` samples at a time, the lag's state carried.
 
     The accelerations are a low-passed derivative of the log's velocities (the
     observer's preparation): the observer avoids them, its residual the momentum's
@@ -237,14 +246,21 @@ def lagged_rigid_regressor(
     noise away (what is left is far below the contact threshold), while the inertial
     torque they carry (slow, at the motion's rate) is what the weight alone misses."""
     t, q, dq, ddq = motion
-    a, b = np.searchsorted(t, span[0]), np.searchsorted(t, span[1], side="right")
-    tt = t[a:b]
-    Y = rigid_load_regressor(robot, q[a:b], dq[a:b], ddq[a:b])
-    steps = np.diff(tt)
+    a, b = int(np.searchsorted(t, span[0])), int(np.searchsorted(t, span[1], side="right"))
+    K = np.asarray(gain, dtype=np.float64)
+    steps = np.diff(t[a:b])
     dt = float(np.median(steps)) if steps.size else 0.0
-    Y = _lag(Y, np.asarray(gain, dtype=np.float64), dt)
-    idx = np.clip(np.searchsorted(tt, at), 0, max(tt.shape[0] - 1, 0))
-    return Y[idx]
+    idx = a + np.clip(np.searchsorted(t[a:b], at), 0, max(b - a - 1, 0))
+    out = np.zeros((idx.shape[0], robot.n, 10))
+    state: NDArray[np.float64] | None = None
+    for k in range(a, b, RIGID_BLOCK):
+        e = min(k + RIGID_BLOCK, b)
+        Y = rigid_load_regressor(robot, q[k:e], dq[k:e], ddq[k:e])
+        Y = _lag(Y, K, dt, Y[0] if state is None else state)
+        state = Y[-1]
+        here = (idx >= k) & (idx < e)
+        out[here] = Y[idx[here] - k]
+    return out
 
 
 def _weighted_fit(
