@@ -30,6 +30,7 @@ from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
 from ..observer.carried_load import (
+    MIN_LOAD_S,
     CarriedLoad,
     LoadSamples,
     LoadTorque,
@@ -37,6 +38,7 @@ from ..observer.carried_load import (
     carried_loads,
 )
 from ..observer.events import ContactEvent, EventDetector, time_slack
+from ..observer.friction import DERIVED_CUTOFF_HZ
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
@@ -56,6 +58,7 @@ from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
 from ..observer.wrench_fit import off_frame_warning, unexplained_shares
+from ..signals import filtered_derivative
 from .data_files import in_file
 from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
 
@@ -191,6 +194,7 @@ def _detected_once(
     load: LoadTally | None = None,
     carried: Sequence[CarriedLoad] = (),
     samples: LoadSamples | None = None,
+    motion: tuple[NDArray, NDArray, NDArray, NDArray] | None = None,
 ) -> LogObservation:
     """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
     of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
@@ -202,7 +206,8 @@ def _detected_once(
     (:func:`scored`); ``unmodelled`` (a model without friction) and ``load`` (the fit of
     a load at the flange) are fed the samples under the contact threshold; ``carried``:
     loads whose torque is taken from the residual first; ``samples`` keeps the samples
-    over the threshold for their fit."""
+    over the threshold for their fit; ``motion`` the log's accelerations beside
+    (:func:`_load_motion`), for their inertia."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
     steps = np.diff(log.t)
@@ -230,7 +235,7 @@ def _detected_once(
         unmodelled.new_log()
     less = LoadTorque(model.robot, carried, options.gains(n)) if carried else None
     with about_file(prep.path.name), table or nullcontext(None) as put:
-        for blk in _less_load(prep, observed_rows(prep, model, options, *wants), less):
+        for blk in _less_load(prep, observed_rows(prep, model, options, *wants), less, motion):
             a, b = blk.a, blk.a + blk.r.shape[0]
             if blk.friction is not None and blk.friction is not model.friction:
                 seen = blk.friction  # banded for the velocity noise (a note says so)
@@ -318,11 +323,13 @@ def detected_log(
         return first
     span = (float(log.t[0]), float(log.t[-1]))
     events = [(e.start, e.end) for e in first.events]
-    loads = carried_loads(model.robot, samples, events, options.gains(model.n), span)
+    long = any(b - a >= MIN_LOAD_S for a, b in events)
+    motion = _load_motion(prep) if long else None
+    loads = carried_loads(model.robot, samples, events, options.gains(model.n), span, motion)
     if not loads:
         _said_again(said)
         return first
-    kw = {**kw, "unmodelled": None, "load": None}  # fed once, by the first run
+    kw = {**kw, "unmodelled": None, "load": None, "motion": motion}  # fed once, by the first
     again = None if retable is None else retable()
     return _detected_once(
         prep, model, mapped, thresholds, options, table=again, carried=loads, **kw
@@ -335,9 +342,31 @@ def _said_again(said: list[warnings.WarningMessage]) -> None:
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
-def _less_load(prep: PreparedLog, blocks: Any, less: LoadTorque | None) -> Any:
+def _load_motion(prep: PreparedLog) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """The log's times [s], positions [rad], the observer's velocities [rad/s] and their
+    accelerations [rad/s^2] for a carried load's inertia: each piece's velocities
+    low-passed at the observer's cut-off (:data:`~dynid.observer.friction.DERIVED_CUTOFF_HZ`,
+    as a log without velocities has them derived) and differentiated, on its own (NaN
+    where a piece is too short to filter: none of its samples is fitted)."""
+    log = prep.log
+    ddq = np.full_like(prep.dq, np.nan)
+    for a, b in prep.spans:
+        try:
+            ddq[a:b] = filtered_derivative(log.t[a:b], prep.dq[a:b], DERIVED_CUTOFF_HZ)
+        except DataError:
+            pass
+    return log.t, log.q, prep.dq, np.nan_to_num(ddq)
+
+
+def _less_load(
+    prep: PreparedLog,
+    blocks: Any,
+    less: LoadTorque | None,
+    motion: tuple[NDArray, NDArray, NDArray, NDArray] | None = None,
+) -> Any:
     """The observed ``blocks`` with the carried loads' torque ``less`` taken from their
-    residual (the lag restarted at each piece of the log)."""
+    residual (the lag restarted at each piece of the log); ``motion``
+    (:func:`_load_motion`) gives a rigid load's inertia."""
     starts = {a for a, _ in prep.spans}
     for blk in blocks:
         if less is None:
@@ -346,7 +375,9 @@ def _less_load(prep: PreparedLog, blocks: Any, less: LoadTorque | None) -> Any:
         if blk.a in starts:
             less.restart()
         b = blk.a + blk.r.shape[0]
-        yield replace(blk, r=blk.r - less.block(prep.log.t[blk.a : b], prep.log.q[blk.a : b]))
+        t, q = prep.log.t[blk.a : b], prep.log.q[blk.a : b]
+        dq, ddq = (None, None) if motion is None else (motion[2][blk.a : b], motion[3][blk.a : b])
+        yield replace(blk, r=blk.r - less.block(t, q, dq, ddq))
 
 
 def _tallied(
