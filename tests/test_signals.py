@@ -219,3 +219,14 @@ def test_filtered_derivative_of_a_jittered_sinusoid():
     expect = 2 * np.pi * f * np.cos(2 * np.pi * f * t[:, None])
     assert dx.shape == x.shape
     assert np.max(np.abs(dx[inner] - expect[inner])) < 1e-3 * np.max(np.abs(expect))
+
+
+def test_a_motion_a_decade_below_the_cutoff_within_the_tolerance_trims_half_a_period():
+    """Two recordings of one excitation read its frequency 2e-6 apart: the cut-off of
+    one (10 times its motion frequency) trims the other's pieces half a period, as its
+    own (the tie was decided by round-off: 4840 or 4951 samples of one log validated);
+    a motion 1 % above a decade below trims two periods."""
+    fc = 5.349790
+    assert signals.edge_seconds(fc, fc / 10.0 * (1.0 + 2e-6)) == signals.MOTION_EDGE_PERIODS / fc
+    assert signals.edge_seconds(fc, fc / 10.0) == signals.MOTION_EDGE_PERIODS / fc
+    assert signals.edge_seconds(fc, fc / 10.0 * 1.01) == signals.EDGE_PERIODS / fc
