@@ -116,3 +116,22 @@ def test_recordings_without_some_are_those_prepared_alone(arm, logs):
         np.testing.assert_array_equal(p.log.tau, q.log.tau)
     with pytest.raises(Exception, match="one must stay"):
         every.without([0, 1, 2])
+
+
+def test_validate_says_the_recording_was_left_out_as_outlying(arm, logs):
+    """Validating the model on the recording its fit left out as outlying: a warning says
+    so (its errors are what it holds beyond the others), not that they are training
+    errors; a recording the model was fitted from is still called training data."""
+    from dynid.exceptions import DynidWarning
+    from dynid.workflows.validate import _say_training_data
+
+    train, _ = logs
+    model, _ = said_warnings(identify_recordings, arm, train, NAMES)
+    with pytest.warns(DynidWarning) as said:
+        _say_training_data(model, ["data/load.csv", "a.csv"])
+    texts = [str(w.message) for w in said]
+    assert any(
+        t.startswith("data/load.csv: left out of the model's fit as outlying") for t in texts
+    )
+    assert any(t.startswith("a.csv: the model was identified from") for t in texts), texts
+    assert not any("load.csv" in t and "training errors" in t for t in texts), texts

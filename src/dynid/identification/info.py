@@ -222,3 +222,9 @@ class IdentificationInfo:
             Path(str(r.get("file", ""))).name for r in self.recordings if not r.get("left_out")
         }
         return tuple(n for n in names if Path(str(n)).name in fitted)
+
+    def left_out_of(self, names: Sequence[str]) -> tuple[str, ...]:
+        """Those of ``names`` that name a recording left out of the fit as outlying
+        (``left_out``; by file name)."""
+        out = {Path(str(r.get("file", ""))).name for r in self.recordings if r.get("left_out")}
+        return tuple(n for n in names if Path(str(n)).name in out)

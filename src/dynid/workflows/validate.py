@@ -806,6 +806,15 @@ def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> 
             DynidWarning,
             stacklevel=3,
         )
+    if odd := model.info.left_out_of(names):
+        warnings.warn(
+            f"{', '.join(odd)}: left out of the model's fit as outlying (its held-out error "
+            "far above the other recordings', metadata.selection.outlying_recordings): the "
+            "errors below are what it holds beyond the others (a payload, contacts?), not "
+            "the model's error on data like its own",
+            DynidWarning,
+            stacklevel=3,
+        )
 
 
 def _reference(model: IdentifiedModel | Robot) -> Robot | None:
