@@ -434,17 +434,14 @@ def test_a_log_whose_comment_lines_say_currents_is_not_read_as_torques(panda, lo
     assert declared_tau_unit(other) == "A"
 
 
-@pytest.mark.parametrize("torque", [True, False])
-def test_a_joint_recorded_reversed_is_found_and_read_back(panda, tmp_path, torque):
-    """A Panda log (friction and armature the description lacks, sensor noise) whose
-    joint 3 was recorded reversed: its position and velocity negated, with its torque (a
-    motor mounted the other way) or without (its encoder alone). The fit refuses it naming
-    the joint and the entries that read it back; with them, the fit is that of the log as
-    recorded the right way, bit for bit; the log itself is not called reversed."""
+@pytest.fixture(scope="module")
+def recorded_right(panda, tmp_path_factory):
+    """A Panda log (friction and armature the description lacks, sensor noise) recorded
+    the right way, its CSV file, and its fit with default options: computed once for both
+    ways of recording joint 3 reversed."""
     from dynid.friction.model import ClassicalFriction
-    from dynid.identification.recorded_signs import reversed_joint
     from dynid.simulation.measurement import SensorNoise
-    from dynid.workflows.identify import IdentifyOptions, identify_files
+    from dynid.workflows.identify import identify_files
 
     from conftest import recordings
 
@@ -452,15 +449,29 @@ def test_a_joint_recorded_reversed_is_found_and_read_back(panda, tmp_path, torqu
     noise = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
     kw = dict(friction=fr, armature=np.full(7, 0.2), duration=4.0, noise=noise)
     (right,) = recordings(panda, (81,), **kw)
+    path = tmp_path_factory.mktemp("right") / "right.csv"
+    save_torque_log(path, right)
+    return right, identify_files(panda, [path])
+
+
+@pytest.mark.parametrize("torque", [True, False])
+def test_a_joint_recorded_reversed_is_found_and_read_back(panda, tmp_path, torque, recorded_right):
+    """A Panda log (friction and armature the description lacks, sensor noise) whose
+    joint 3 was recorded reversed: its position and velocity negated, with its torque (a
+    motor mounted the other way) or without (its encoder alone). The fit refuses it naming
+    the joint and the entries that read it back; with them, the fit is that of the log as
+    recorded the right way, bit for bit; the log itself is not called reversed."""
+    from dynid.identification.recorded_signs import reversed_joint
+    from dynid.workflows.identify import IdentifyOptions, identify_files
+
+    right, as_is = recorded_right
     assert reversed_joint(panda, right) is None
     sign = np.array([1.0, 1, -1, 1, 1, 1, 1])
     tau = right.tau * sign if torque else right.tau
-    save_torque_log(tmp_path / "right.csv", right)
     save_torque_log(tmp_path / "rev.csv", TorqueLog(right.t, right.q * sign, right.dq * sign, tau))
     entries = "q3=-1,dq3=-1" + (",tau3=-1" if torque else "")
     with pytest.raises(DataError, match="joint3 looks recorded reversed") as exc:
         identify_files(panda, [tmp_path / "rev.csv"])
     assert f"--units q3=-1{',tau3=-1' if torque else ''} reads it so" in str(exc.value)
     back = identify_files(panda, [tmp_path / "rev.csv"], IdentifyOptions(columns=(None, entries)))
-    as_is = identify_files(panda, [tmp_path / "right.csv"])
     np.testing.assert_array_equal(back.model.fit.beta, as_is.model.fit.beta)
