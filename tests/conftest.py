@@ -168,6 +168,20 @@ def pinocchio_panda_model(arm=None, load=None):
     return model
 
 
+def mujoco_inverse(model, q, dq, ddq):
+    """MuJoCo's inverse dynamics ``qfrc_inverse`` (N, nv) of ``model`` (an ``MjModel``) at
+    each state (N, nv)."""
+    import mujoco
+
+    data = mujoco.MjData(model)
+    out = np.empty_like(q)
+    for s in range(q.shape[0]):
+        data.qpos[:], data.qvel[:], data.qacc[:] = q[s], dq[s], ddq[s]
+        mujoco.mj_inverse(model, data)
+        out[s] = data.qfrc_inverse
+    return out
+
+
 def robot_data_urdf(rel: str) -> str:
     import importlib.util
     from pathlib import Path

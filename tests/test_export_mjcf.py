@@ -15,19 +15,9 @@ from dynid.friction.mujoco import coulomb_viscous_from_sigmoid
 from dynid.io.export import export_format, save_robot
 from dynid.io.robot.mjcf import mjcf_from_robot, save_mjcf
 
-from conftest import planar_2r, random_states, robot_data_urdf
+from conftest import mujoco_inverse, planar_2r, random_states, robot_data_urdf
 
 mujoco = pytest.importorskip("mujoco")
-
-
-def _mj_inverse(model, q, dq, ddq):
-    data = mujoco.MjData(model)
-    out = np.empty_like(q)
-    for s in range(q.shape[0]):
-        data.qpos[:], data.qvel[:], data.qacc[:] = q[s], dq[s], ddq[s]
-        mujoco.mj_inverse(model, data)
-        out[s] = data.qfrc_inverse
-    return out
 
 
 def _rpp_robot() -> dynid.Robot:
@@ -70,7 +60,7 @@ def test_mj_inverse_equals_rnea_at_random_states(make, tmp_path):
     assert model.nv == robot.n
     np.testing.assert_allclose(model.opt.gravity, robot.gravity, rtol=0, atol=0)
     q, dq, ddq = random_states(robot, 100, seed=3)
-    tau_mj = _mj_inverse(model, q, dq, ddq)
+    tau_mj = mujoco_inverse(model, q, dq, ddq)
     tau = dynid.rnea(robot, q, dq, ddq)
     scale = np.max(np.abs(tau), axis=1, keepdims=True)
     assert np.max(np.abs(tau_mj - tau) / scale) < 1e-9
@@ -239,7 +229,7 @@ def test_massless_link_compiles_with_negligible_bound(tmp_path):
     np.testing.assert_allclose(model.body_mass[2:], [1e-10, 1.0])
     q, dq, ddq = random_states(robot, 50, seed=9)
     tau = dynid.rnea(robot, q, dq, ddq)
-    assert np.max(np.abs(_mj_inverse(model, q, dq, ddq) - tau)) < 1e-9 * np.max(np.abs(tau))
+    assert np.max(np.abs(mujoco_inverse(model, q, dq, ddq) - tau)) < 1e-9 * np.max(np.abs(tau))
 
 
 def test_mj_inverse_with_armature_equals_rnea_plus_rotor_torques(tmp_path):
@@ -257,7 +247,7 @@ def test_mj_inverse_with_armature_equals_rnea_plus_rotor_torques(tmp_path):
         model.dof_armature, np.diag(drive.rotor_mass_matrix(np.full(6, 2e-5)))
     )
     q, dq, ddq = random_states(robot, 50, seed=4)
-    tau_mj = _mj_inverse(model, q, dq, ddq)
+    tau_mj = mujoco_inverse(model, q, dq, ddq)
     tau = dynid.rnea(robot, q, dq, ddq) + drive.rotor_torques(ddq, drive.rotor_inertia)
     scale = np.max(np.abs(tau), axis=1, keepdims=True)
     assert np.max(np.abs(tau_mj - tau) / scale) < 1e-9

@@ -19,6 +19,8 @@ from dynid.friction.mujoco_soft import frictionloss_slope
 from dynid.io.robot.mjcf import invweight0, mjcf_from_robot
 from dynid.model.drive import Drive
 
+from conftest import mujoco_inverse
+
 mujoco = pytest.importorskip("mujoco")
 
 FV = np.array([0.6, 0.5, 0.4, 0.4, 0.3, 0.2, 0.1])  # N m s/rad
@@ -31,16 +33,6 @@ def _model(friction, drive=None):
         warnings.simplefilter("always")
         text, _ = mjcf_from_robot(dynid.panda(), friction=friction, drive=drive)
     return mujoco.MjModel.from_xml_string(text), [str(w.message) for w in got]
-
-
-def _mj_inverse(model, q, dq, ddq):
-    data = mujoco.MjData(model)
-    out = np.empty_like(q)
-    for s in range(q.shape[0]):
-        data.qpos[:], data.qvel[:], data.qacc[:] = q[s], dq[s], ddq[s]
-        mujoco.mj_inverse(model, data)
-        out[s] = data.qfrc_inverse
-    return out
 
 
 def _states(robot, n, seed):
@@ -66,7 +58,7 @@ def test_the_slope_formula_is_mujocos():
         model = mujoco.MjModel.from_xml_string(xml)
         S = float(frictionloss_slope(tc, d, model.dof_invweight0[0]))
         v = np.array([[0.3 / S], [100.0 / S]])
-        tau = _mj_inverse(model, np.zeros((2, 1)), v, np.zeros((2, 1)))[:, 0]
+        tau = mujoco_inverse(model, np.zeros((2, 1)), v, np.zeros((2, 1)))[:, 0]
         np.testing.assert_allclose(tau, [0.3, 3.0], rtol=1e-9)
 
 
@@ -94,7 +86,7 @@ def test_a_smooth_law_is_held_by_the_slope_not_refitted():
     assert len(lines) == 1 and "written with its rounding fc tanh(dq / width)" in lines[0]
     q, dq, ddq = _states(robot, 300, seed=3)
     tau = dynid.rnea(robot, q, dq, ddq) + law.torques(dq)
-    err = _mj_inverse(model, q, dq, ddq) - tau
+    err = mujoco_inverse(model, q, dq, ddq) - tau
     assert np.sqrt(np.sum(err**2) / np.sum(tau**2)) < 0.01
     assert np.all(np.sqrt(np.mean(err**2, axis=0) / np.mean(tau**2, axis=0)) < 0.1)
 
@@ -110,7 +102,7 @@ def test_the_friction_curve_follows_the_law_at_rest_acceleration():
     dq = np.zeros((v.size, 7))
     dq[:, 0] = v
     q, ddq = np.zeros_like(dq), np.zeros_like(dq)
-    odd = 0.5 * (_mj_inverse(model, q, dq, ddq) - _mj_inverse(model, q, -dq, ddq))[:, 0]
+    odd = 0.5 * (mujoco_inverse(model, q, dq, ddq) - mujoco_inverse(model, q, -dq, ddq))[:, 0]
     diff = odd - (FV[0] * v + FC[0] * np.tanh(v / WIDTH))
     assert np.max(np.abs(diff)) < 0.15 * FC[0] and np.sqrt(np.mean(diff**2)) < 0.08
 
@@ -124,7 +116,7 @@ def test_a_sharp_law_gets_the_steepest_slope():
     law = law_named("classical").model(P)
     model, _ = _model(law)
     q, dq = 0.5 * (robot.q_min + robot.q_max)[None], np.full((1, 7), 1e-3)
-    tau = _mj_inverse(model, q, dq, np.zeros((1, 7)))[0]
+    tau = mujoco_inverse(model, q, dq, np.zeros((1, 7)))[0]
     rigid = dynid.rnea(robot, q[0], dq[0], np.zeros(7))
     np.testing.assert_allclose(tau - rigid, FC + FV * 1e-3, rtol=1e-6)
     model.opt.gravity[:] = 0.0
@@ -171,5 +163,5 @@ def test_other_laws_get_the_slope_closest_to_them(which):
     model, _ = _model(arg)
     q, dq, ddq = _states(robot, 300, seed=3)
     tau = dynid.rnea(robot, q, dq, ddq) + law.torques(dq)
-    err = _mj_inverse(model, q, dq, ddq) - tau
+    err = mujoco_inverse(model, q, dq, ddq) - tau
     assert np.sqrt(np.sum(err**2) / np.sum(tau**2)) < bound
