@@ -806,11 +806,10 @@ def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
         raise OptionError(
             f"applies to torque logs, not static data ({paths[0].name})", field="terms"
         )
-    for name in ("cutoff_hz", "max_gap_s", "torque_delay_s", "q_start"):
-        if getattr(opt, name) is not None:
-            raise OptionError(
-                f"applies to torque logs, not static data ({paths[0].name})", field=name
-            )
+    given = {n: getattr(opt, n) is not None for n in ("cutoff_hz", "max_gap_s", "torque_delay_s")}
+    given |= {"q_start": opt.q_start is not None, "keep_outlying": opt.keep_outlying}
+    for name in (n for n, said in given.items() if said):
+        raise OptionError(f"applies to torque logs, not static data ({paths[0].name})", field=name)
 
 
 def _with_outside_model_note(
