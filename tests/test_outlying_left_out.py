@@ -18,7 +18,6 @@ import pytest
 from dynid.cli.summaries import recordings_lines
 from dynid.feasibility.payload_arm import holds_the_load
 from dynid.friction.model import ClassicalFriction, friction_of
-from dynid.identification.recordings import prepare_recordings
 from dynid.identification.selection import fitted_logs, identify_recordings
 from dynid.simulation.measurement import SensorNoise
 
@@ -100,22 +99,6 @@ def test_without_an_outlier_the_default_fit_is_unchanged(arm, logs):
     assert not any("left_out" in r for r in model.info.recordings)
     np.testing.assert_allclose(model.fit.beta, kept.fit.beta, rtol=1e-12, atol=1e-12)
     assert not [m for m in said if "held-out error" in m]
-
-
-def test_recordings_without_some_are_those_prepared_alone(arm, logs):
-    """Recordings.without([1]) holds what preparing the other two alone gives: pieces,
-    names, sample counts, digests, starts and the samples as read."""
-    train, _ = logs
-    every = prepare_recordings(arm, train, NAMES, cutoff_hz=8.0)
-    alone = prepare_recordings(arm, [train[0], train[2]], ["a.csv", "c.csv"], cutoff_hz=8.0)
-    two = every.without([1])
-    assert two.names == alone.names and two.recording == alone.recording
-    assert two.summary() == alone.summary()
-    assert two.n_recorded == alone.n_recorded and two.starts == alone.starts
-    for p, q in zip(two.pieces, alone.pieces, strict=True):
-        np.testing.assert_array_equal(p.log.tau, q.log.tau)
-    with pytest.raises(Exception, match="one must stay"):
-        every.without([0, 1, 2])
 
 
 def test_validate_says_the_recording_was_left_out_as_outlying(arm, logs):

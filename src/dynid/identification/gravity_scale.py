@@ -111,9 +111,8 @@ def _at_the_motors(drive: Drive, factor: float) -> str:
     """A clause when ``factor``, the torque constants' correction, is near the gear ratio
     every joint of a joint-side ``drive`` shares (within 1/3 to 3 times): constants given
     at the motors, where ``side = "joint"`` wants each joint's torque per A."""
-    K = np.asarray(drive.transmission, dtype=np.float64)
-    ratio = np.abs(np.diag(K))
-    if drive.side != "joint" or np.count_nonzero(K - np.diag(np.diag(K))):
+    ratio = np.abs(np.diag(np.asarray(drive.transmission, dtype=np.float64)))
+    if drive.side != "joint" or drive.is_coupled:
         return ""
     if not np.allclose(ratio, ratio[0]) or ratio[0] == 1 or not 1 / 3 <= factor / ratio[0] <= 3:
         return ""

@@ -90,9 +90,8 @@ def gear_ratio_pattern(gains: DriveGains, drive: Drive) -> GearRatioPattern | No
     """
     if drive.side != "joint" or drive.effort != "current" or not gains.scaled:
         return None
-    K = np.asarray(drive.transmission, dtype=np.float64)
-    ratio = np.abs(np.diag(K))
-    if np.count_nonzero(K - np.diag(np.diag(K))) or gains.factor.shape != ratio.shape:
+    ratio = np.abs(np.diag(np.asarray(drive.transmission, dtype=np.float64)))
+    if drive.is_coupled or gains.factor.shape != ratio.shape:
         return None
     motors = np.flatnonzero(gains.determined)
     if motors.size < 2 or ratio[motors].max() < _DISTINCT * ratio[motors].min():

@@ -37,14 +37,14 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import warnings
-from collections.abc import Collection, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
+from ..exceptions import DataError, DynidWarning, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import report
@@ -351,44 +351,6 @@ class Recordings(TorqueRoute):
             return labels, f"leave one recording out ({len(self.names)} recordings)"
         labels = np.repeat(block_labels(self.n_samples, folds), n)
         return labels, f"{folds} contiguous time blocks"
-
-    def without(self, left_out: Collection[int]) -> Recordings:
-        """These recordings without those ``left_out`` (indices into :attr:`names`): their
-        pieces, names, cuts, gaps, starts, counts and digests gone, the others' recording
-        indices renumbered in order, the samples as read (:attr:`n_recorded`) theirs; the
-        standstill bands, read from every recording, kept (the structure chosen holds them).
-
-        Raises
-        ------
-        OptionError
-            An index out of range, or every recording left out.
-        """
-        gone = set(left_out)
-        if not gone <= set(range(len(self.names))) or len(gone) >= len(self.names):
-            raise OptionError(
-                f"leaves out recordings {sorted(gone)} of {len(self.names)}: each must be "
-                "one of them, and one must stay"
-            )
-        kept = [r for r in range(len(self.names)) if r not in gone]
-        new = {r: k for k, r in enumerate(kept)}
-        mine = [(p, new[r]) for p, r in zip(self.pieces, self.recording, strict=True) if r in new]
-
-        def each(values: Sequence[Any]) -> tuple[Any, ...]:
-            return tuple(values[r] for r in kept if r < len(values))
-
-        counts = each(self.counts)
-        return dataclasses.replace(
-            self,
-            pieces=tuple(p for p, _ in mine),
-            recording=tuple(r for _, r in mine),
-            names=each(self.names),
-            cuts=each(self.cuts),
-            gaps=each(self.gaps),
-            starts=each(self.starts),
-            n_recorded=sum(c.recorded for c in counts) if len(counts) == len(kept) else 0,
-            counts=counts,
-            digests=each(self.digests),
-        )
 
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
