@@ -133,3 +133,29 @@ def test_data_recorded_as_written_read_snapped_names_the_rounding(ur5_files):
     T[2, 0, 3] += 5e-3
     other = {"kinematics": {"T_parent_joint": T.tolist()}}
     assert "--snap-angles" not in recorded_robot_mismatch(written, other)
+
+
+def test_export_into_the_rounded_template_names_the_rounding_once(
+    ur5_files, tmp_path, capsys, monkeypatch
+):
+    """Exported into the rounded file as template, whose joints' friction is replaced: the
+    rounding is named once (the robot read), not a second time for the template read back
+    for its joint names; the written elbow keeps its rounded angle (the template's text) and
+    its inertials are the robot's."""
+    rounded, _ = ur5_files
+    text = open(rounded).read()
+    template = tmp_path / "vendor.urdf"  # a vendor's friction, which --no-friction removes
+    template.write_text(text.replace('damping="0.0" friction="0.0"', 'damping="2" friction="1"'))
+    root = logging.getLogger()
+    monkeypatch.setattr(root, "handlers", [])
+    monkeypatch.setattr(root, "level", root.level)
+    out = tmp_path / "out.urdf"
+    chain = ["--base", "base_link", "--tip", "tool0"]
+    args = ["export", "--params", rounded, *chain, "--urdf-template", str(template)]
+    args += ["--no-friction", "--out", str(out)]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert err.count("rounded near multiples of pi/2") == 1
+    assert 'rpy="3.1416 0 0"' in out.read_text()
+    back = load_urdf(str(out), tip_link="tool0")
+    np.testing.assert_allclose(back.phi, load_urdf(rounded, tip_link="tool0").phi, atol=1e-9)

@@ -293,7 +293,9 @@ def save_urdf(
         if template_dynamics:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", DynidWarning)  # the template's own
-                chain = robot_from_urdf_string(original, base, tip)
+                chain = robot_from_urdf_string(  # read for its joint names alone
+                    original, base, tip, source=f"URDF template {tpath.name!r}", note_angles=False
+                )
             text = patch_urdf_dynamics(text, list(chain.joint_names), dynamics)
     write_text(path, with_caveat(text, caveat, xml=True))
     return path
@@ -469,7 +471,7 @@ def _template_friction(options: ExportOptions) -> Robot | None:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DynidWarning)
-            return load_urdf(options.template, options.base, options.tip)
+            return load_urdf(options.template, options.base, options.tip, note_angles=False)
     except ModelError:
         return None
 
