@@ -138,3 +138,26 @@ def test_a_per_joint_structure_and_its_every_joint_structure_read_apart():
     rows = [line[4:].split("  ")[0].strip() for line in lines[2:] if line.startswith("  ")]
     assert rows == [full, f"{full}, per joint"], lines
     assert lines[-1].endswith("  fo1 fo3"), lines
+
+
+def test_skipped_shapes_of_one_law_show_their_best_and_are_counted():
+    """Seven Stribeck velocities of one law, all skipped (their bump below zero), beside
+    the chosen law: one row marked x (the lowest held-out error of them), and the line
+    below counts the six others as marked x, so that the note's count of skipped
+    candidates is accounted for (an iiwa's table showed 37 x rows of 57)."""
+    row = {"n_params": 71, "train_error_percent": 1.2, "heldout_se_percent": 0.01}
+    chosen = "links + viscous + smooth:3 + offset"
+    speeds = (0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2)
+    held = (1.28, 1.22, 1.17, 1.16, 1.17, 1.19, 1.21)
+    skipped = [
+        row | {"name": f"links + viscous + smooth:3 + stribeck:{v} + offset",
+               "heldout_error_percent": h, "negative_bump": ["fsp1"]}
+        for v, h in zip(speeds, held, strict=True)
+    ]  # fmt: skip
+    cands = [row | {"name": chosen, "heldout_error_percent": 1.23}, *skipped]
+    note = "7 candidate(s) marked x skipped: their Stribeck bump is below zero"
+    sel = {"validation": "4 recordings", "chosen": chosen, "rule": "rule", "candidates": cands}
+    lines = selection_lines(sel | {"notes": [note]})
+    marks = {line[4:].split("  ")[0].strip(): line[2] for line in lines[2:] if line[2] in "*x "}
+    assert marks == {chosen: "*", skipped[3]["name"]: "x"}, lines
+    assert any("(6 more candidate(s)" in line and "6 of them marked x" in line for line in lines)

@@ -422,13 +422,16 @@ def test_a_fast_motor_is_not_taken_for_a_wrapped_joint():
     np.testing.assert_allclose(back.q[:, 0] - back.q[0, 0], q[:, 0] - q[0, 0], atol=1e-9)
 
 
-def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(panda, tmp_path):
+def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(
+    panda, tmp_path, capsys
+):
     """An arm whose friction is a sharp Coulomb law with a Stribeck bump (``fs = 1.8 fc``
     at 0.05 rad/s) on the true velocities, logged with 2e-3 rad/s of velocity noise: the
     default identification chooses the Stribeck law on the smooth sign at 0.05 rad/s (the
     banded sign switches the bump off where the measured velocity crosses zero, right
     where it is largest), and it predicts a recording it never saw closer to that
-    recording's noise floor (the true model's error) than the banded Stribeck law does."""
+    recording's noise floor (the true model's error) than the banded Stribeck law does.
+    The summary says the bump's velocity, chosen or given, is held fixed by its stds."""
     fc = np.linspace(0.8, 0.3, 7)
     P = np.column_stack([VISCOUS, fc, 1.8 * fc, np.full(7, 0.05), np.zeros(7)])
     truth = LawFriction(LAWS["stribeck"], P)  # no band: the sharp sign of the true velocity
@@ -447,6 +450,9 @@ def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(panda,
                          "--no-figures"] + extra) == 0  # fmt: skip
             assert main(["validate", "--model", str(out / "identification.json"), "--data",
                          files[3], "--out", str(out / "val"), "--no-figures"]) == 0  # fmt: skip
+        said = capsys.readouterr().out
+        how = "as given" if extra else "chosen on held-out data"
+        assert f"vst = 0.05 rad/s {how}; the std % hold the Stribeck velocity" in said, said
         errors[tag] = json.loads((out / "val" / "validation.json").read_text())
     chosen = json.loads((tmp_path / "default" / "identification.json").read_text())
     assert "smooth:0.3 + stribeck:0.05" in chosen["metadata"]["selection"]["chosen"]

@@ -190,6 +190,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
                 "parameter (listed above); the data give the sum, not this coefficient alone"
             )
         out += _scales_lines(scales, model)
+        out += _shape_line(t.term, model)
         out += _rest_line(t, model)
         out += _negative_viscous_line(t)
         mine = [lab for lab in t.labels if lab in model.info.combined]
@@ -320,6 +321,25 @@ def _scales_lines(scales: dict[str, tuple[float, ...]], model: IdentifiedModel) 
             + (" per joint j" if each else "")
         )
     return out
+
+
+def _shape_line(term: Any, model: IdentifiedModel) -> list[str]:
+    """What ``fsp`` of the friction table means (a Stribeck part), with its Stribeck
+    velocity, and that the stds take the law's shape as given: the velocity and the smooth
+    widths are given (``--terms``) or chosen on held-out data from a grid, not fitted with
+    the coefficients."""
+    parts = getattr(term, "parts", ())
+    if "stribeck" not in parts:
+        return []
+    given = model.info.selection is None  # the structure given (--terms), not chosen
+    shape = "the Stribeck velocity" + (" and the widths" if "smooth" in parts else "")
+    return [
+        f"  fsp: the Stribeck bump fsp exp(-(dq / vst)^2) times the Coulomb part's sign, vst = "
+        f"{float(term.vst):.3g} rad/s "
+        + ("as given" if given else "chosen on held-out data")
+        + f"; the std % hold {shape} fixed at these values (a vst a few % off moves fsp by "
+        "more than its std)"
+    ]
 
 
 def _coefficient(value: float, std: float, kept: bool, holder: str) -> str:
