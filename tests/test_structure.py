@@ -422,9 +422,7 @@ def test_a_fast_motor_is_not_taken_for_a_wrapped_joint():
     np.testing.assert_allclose(back.q[:, 0] - back.q[0, 0], q[:, 0] - q[0, 0], atol=1e-9)
 
 
-def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(
-    panda, tmp_path, capsys
-):
+def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(panda, tmp_path, capsys):
     """An arm whose friction is a sharp Coulomb law with a Stribeck bump (``fs = 1.8 fc``
     at 0.05 rad/s) on the true velocities, logged with 2e-3 rad/s of velocity noise: the
     default identification chooses the Stribeck law on the smooth sign at 0.05 rad/s (the
