@@ -414,7 +414,8 @@ def validate_files(
     # explains: what the residual follows is not diagnosed (a current log's gains are)
     current = not beyond and placed is not None and placed.effort == "current"
     verdict, springs, gains, tilt = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=not beyond and not opposite,
+        model, verdict, val, rec.logs, noise, names,
+        dependence=not beyond and not opposite and sign_map is None,
         held=_terms_held(model, placed, label), gains_too=current,
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
