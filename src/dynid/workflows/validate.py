@@ -208,10 +208,12 @@ class ValidateResult:
         Each joint's error over its noise as the verdict weighed it (each sample against
         its own noise), the numbers its reason gives; None: not known.
     sign_map : str, optional
-        Where the model's recorded sign map (``--units tau3=-1``) looks wrong for a
-        recording, the finding (naming the file, the joints and the ``--units`` that
-        overrides it; :func:`~dynid.workflows.recordings.recorded_sign_map_findings`),
-        also the start of ``verdict``'s reason; None otherwise.
+        Where the torque signs the applied ``--units`` negate (the model's recorded ones,
+        ``tau=-1`` or ``tau3=-1``, or those given) look wrong for a recording, the
+        finding (naming the file, the joints and the ``--units`` that read it right given
+        those applied: ``tau=1`` for a file already in dynid's sign;
+        :func:`~dynid.workflows.recordings.recorded_sign_map_findings`), also the start of
+        ``verdict``'s reason; None otherwise.
     opposite_sign : tuple of (str, str)
         Per recording whose torques read with the opposite sign to the model's on some
         joints or on all, its name and the finding (naming the joints and the
