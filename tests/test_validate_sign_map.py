@@ -134,7 +134,9 @@ def _hint(text):
 
 
 @pytest.mark.parametrize("given", [(), ("--units", "tau=-1")], ids=["recorded", "given"])
-def test_file_already_in_dynids_sign_gets_the_units_that_read_it(negated_model, tmp_path, given):
+def test_file_already_in_dynids_sign_gets_the_units_that_read_it(
+    negated_model, tmp_path, capsys, given
+):
     """Regression: a file already in dynid's sign, read with the model's recorded (or the
     given) --units tau=-1, was judged "unusable, 200 %" with the hint --units tau=-1, the
     flip applied, and no sign_map. The finding says the file looks already in dynid's
@@ -147,6 +149,7 @@ def test_file_already_in_dynids_sign_gets_the_units_that_read_it(negated_model, 
     assert doc["verdict"]["reason"].startswith("b.csv: the file looks already")
     assert ("given" if given else "recorded") + " sign map looks wrong" in box
     assert "springs" not in doc  # the residual of a sign is not diagnosed
+    assert "its torque columns negated" not in capsys.readouterr().err  # the vague hint
     fixed, _ = _validate(negated_model, "b.csv", tmp_path / "w", "--units", _hint(said))
     assert "sign_map" not in fixed and fixed["verdict"]["level"] == "good"
     assert max(fixed["without_friction"]["rms"]) < 2 * 0.005
@@ -184,3 +187,21 @@ def test_units_negating_writes_the_fewest_entries():
     assert units_negating("q=deg,tau=-1", [], 6) == "q=deg,tau=1"
     assert units_negating("tau=-1", [0, 1, 3, 4, 5], 6) == "tau=-1,tau3=-1"
     assert units_negating("tau=mNm,tau3=-1,b.csv:tau=-1", [1], 6) == "tau=mNm,tau2=-1"
+
+
+def test_observe_refuses_a_file_already_in_dynids_sign_with_the_units_that_read_it(
+    negated_model, tmp_path, capsys
+):
+    """observe --calibrate on b.csv (already in dynid's sign, the model's recorded
+    --units tau=-1): refused naming the file once, with --units tau=1; following it, the
+    calibration runs."""
+    d = negated_model
+    args = ["observe", "--model", str(d / "id" / "identification.json"), "--calibrate"]
+    args += ["--data", str(d / "b.csv")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        assert main([*args, "--out", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err
+        assert "b.csv: the file looks already in dynid's sign" in err
+        assert "b.csv: b.csv" not in err and _hint(err) == "tau=1"
+        assert main([*args, "--units", _hint(err), "--out", str(tmp_path / "p")]) == 0

@@ -763,7 +763,8 @@ def check_signs(
             raise DataError(few, file=name)
     for f in _sign_findings(rec, robot, among=among):
         wrong = recorded_sign_map_findings(rec, robot, recorded, units).get(f.name)
-        raise DataError(wrong or f.text, file=f.name)
+        said = f.text if wrong is None else wrong.removeprefix(f"{f.name}: ")
+        raise DataError(said, file=f.name)  # (the finding named the file: once)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:

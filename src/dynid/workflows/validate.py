@@ -103,6 +103,10 @@ __all__ = ["ValidateOptions", "ValidateResult", "identification_beside", "valida
 
 _log = logging.getLogger(__name__)
 
+#: The validation's own sign warning (:mod:`dynid.friction.validation`), which names no
+#: joint and no ``--units``: left out where the sign findings were said.
+_VAGUE_SIGN = r"the measured torques are anti-correlated with the model's \(correlation"
+
 
 @dataclass(frozen=True, slots=True)
 class ValidateOptions:
@@ -397,10 +401,13 @@ def validate_files(
     cut, gap, lag = _prepared_as(opt, model, own, rec.logs)
 
     def run(fr: FrictionModel | FrictionSum | None) -> RecordingsValidation:
-        return validate_recordings(
-            model, rec.logs, rec.names, friction=fr, cutoff_hz=cut, max_gap_s=gap, drive=drive,
-            torque_delay_s=lag,
-        )  # fmt: skip
+        with warnings.catch_warnings():
+            if sign_map is not None or opposite:  # said with the joints and the --units
+                warnings.filterwarnings("ignore", _VAGUE_SIGN, DynidWarning)
+            return validate_recordings(
+                model, rec.logs, rec.names, friction=fr, cutoff_hz=cut, max_gap_s=gap,
+                drive=drive, torque_delay_s=lag,
+            )  # fmt: skip
 
     val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
     val = _banded(run, friction) if val is None else val  # friction as observe evaluates it
