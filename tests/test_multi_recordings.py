@@ -9,6 +9,7 @@ concatenated per-sample errors, and the friction the logs were simulated with.
 from __future__ import annotations
 
 import json
+import re
 import warnings
 
 import numpy as np
@@ -345,7 +346,7 @@ def loaded_files(tmp_path_factory):
 def test_a_load_is_identified_from_several_recordings_with_gaps(loaded_files, tmp_path, capsys):
     """Two recordings of the loaded arm, cut by gaps into four pieces, each filtered on
     its own: the mass and the CoM come back within four reported standard deviations;
-    dynid payload prints the pieces of each file."""
+    dynid payload prints the pieces of each file, and where each was cut."""
     arm, d = loaded_files
     paths = [d / "load41.csv", d / "load42.csv"]
     res = identify_payload_files(arm, paths)
@@ -359,7 +360,12 @@ def test_a_load_is_identified_from_several_recordings_with_gaps(loaded_files, tm
     assert abs(bridged.mass - LOAD_MASS) > 5 * abs(est.mass - LOAD_MASS)
     argv = ["payload", "--robot", "panda", "--data", *map(str, paths), "--out", str(tmp_path)]
     assert main(argv) == 0
-    assert "load41.csv: 2 pieces" in capsys.readouterr().out
+    out = capsys.readouterr().out  # the gap named as identify names it: its stamp, length
+    assert re.search(
+        r"load41\.csv: 2 pieces, \d+ samples, cut at the gap\(s\) after "
+        r"t = 3\.000 s \(0\.5 s long\)",
+        out,
+    )
 
 
 def test_payload_static_data_stay_one_file(tmp_path):

@@ -9,7 +9,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .._times import offset_text, stamp_text
 from ..feasibility.constraints import principal_moments
 from ..feasibility.convex import ConsistentResult
 from ..feasibility.determined import PRIOR, SUM
@@ -23,6 +22,7 @@ from ..identification.dissipation import SIGNIFICANCE, negative_viscous
 from ..identification.info import IdentificationInfo, LogInfo
 from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
+from ..identification.pieces import gaps_text
 from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints, own_rotors
 from ..io.observer_files import log_labels
 from ..observer.calibration_check import CalibrationCheck
@@ -382,16 +382,8 @@ def _gaps(rec: Any) -> str:
     """``, cut at the gap(s) after t = 86412.300 s (11.3 s into rec1.csv; 0.4 s long)``
     (empty for a record without gaps): the stamp as in the file, its offset from the
     recording's start when that is not 0."""
-    gaps = rec.get("gaps") or []
-    if not gaps:
-        return ""
-    t0, name = rec.get("start_s"), rec.get("file")
-    said = []
-    for t, length in gaps[:4]:
-        into = offset_text([t - (t0 or 0.0)], t0, name)
-        said.append(f"t = {stamp_text(t)} s ({into + '; ' if into else ''}{length:.3g} s long)")
-    more = f" and {len(gaps) - 4} more" if len(gaps) > 4 else ""
-    return f", cut at the gap(s) after {', '.join(said)}{more}"
+    cut = gaps_text(rec.get("gaps") or (), rec.get("start_s"), rec.get("file"))
+    return f", {cut}" if cut else ""
 
 
 def _decimations(recordings: Any) -> tuple[int, ...]:

@@ -24,17 +24,25 @@ from __future__ import annotations
 
 import itertools
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .._times import said_times, stamp_text
+from .._times import offset_text, said_times, stamp_text
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .angle_time_units import time_unit_finding
-from .log import DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap, with_derived_velocities
+from .log import (
+    DEFAULT_CUTOFF_HZ,
+    LogCleaning,
+    TorqueLog,
+    default_max_gap,
+    jitter_text,
+    with_derived_velocities,
+)
 from .sanity import too_few_samples
 
 __all__ = [
@@ -44,6 +52,9 @@ __all__ = [
     "check_below_nyquist",
     "check_samples_and_time",
     "gaps_between",
+    "gaps_text",
+    "recording_line",
+    "timing_record",
     "joined",
     "nearest_turns",
     "recording_pieces",
@@ -118,6 +129,58 @@ def gaps_between(pieces: Sequence[TorqueLog]) -> tuple[tuple[float, float], ...]
     return tuple(
         (float(a.t[-1]), float(b.t[0] - a.t[-1])) for a, b in zip(pieces, pieces[1:], strict=False)
     )
+
+
+def gaps_text(gaps: Sequence[Sequence[float]], t0: float | None, name: str | None) -> str:
+    """``cut at the gap(s) after t = 86412.300 s (11.3 s into rec1.csv; 0.4 s long)``: the
+    gaps a recording was cut at (``[t_before, length]`` [s] each, :func:`gaps_between`),
+    the first four, each stamp as in the file with its offset from the recording's first
+    stamp ``t0`` [s] (when that is not 0); empty without gaps. How ``identify``,
+    ``validate``, ``friction`` and ``payload`` say where a recording was cut."""
+    if not gaps:
+        return ""
+    said = []
+    for t, length in gaps[:4]:
+        into = offset_text([t - (t0 or 0.0)], t0, name)
+        said.append(f"t = {stamp_text(t)} s ({into + '; ' if into else ''}{length:.3g} s long)")
+    more = f" and {len(gaps) - 4} more" if len(gaps) > 4 else ""
+    return f"cut at the gap(s) after {', '.join(said)}{more}"
+
+
+def timing_record(
+    gaps: Sequence[Sequence[float]], start_s: float | None, cleaning: LogCleaning
+) -> dict[str, Any]:
+    """What a recording's record (``recordings[]`` of a result file) keeps of its time
+    stamps: the ``gaps`` it was cut at (``[t_before, length]`` [s] each,
+    :func:`gaps_between`) with ``start_s``, its first stamp [s] (when known); and ``stamp_jitter_s``
+    with ``period_s`` [s] where its stamps are jittered (its reader's ``cleaning``, said
+    as :func:`~dynid.identification.log.jitter_text` says it). Empty for a recording of
+    uniform stamps without gaps."""
+    out: dict[str, Any] = {}
+    if gaps:
+        out["gaps"] = [[float(t), float(length)] for t, length in gaps]
+        if start_s is not None:
+            out["start_s"] = float(start_s)
+    if jitter_text(cleaning.stamp_jitter_s, cleaning.period_s) is not None:
+        out["stamp_jitter_s"] = float(cleaning.stamp_jitter_s)
+        out["period_s"] = float(cleaning.period_s)
+    return out
+
+
+def recording_line(rec: Mapping[str, Any]) -> str:
+    """``a.csv: 2 pieces, 3000 samples, cut at the gap(s) after t = ... (7 s into a.csv;
+    0.3 s long); stamps jittered, std 0.04 ms at a 1 ms period``: a recording's record
+    (``file``, ``pieces``, ``samples``, and :func:`timing_record`'s keys when there),
+    its gaps as ``identify`` says them (:func:`gaps_text`) and its stamps' jitter
+    (:func:`~dynid.identification.log.jitter_text`)."""
+    k = rec["pieces"]
+    line = f"{rec['file']}: {k} piece{'s' if k != 1 else ''}, {rec['samples']} samples"
+    if cut := gaps_text(rec.get("gaps") or (), rec.get("start_s"), rec.get("file")):
+        line += f", {cut}"
+    jitter = rec.get("stamp_jitter_s")
+    if jitter is not None and (said := jitter_text(jitter, rec.get("period_s", np.nan))):
+        line += f"; {said}"
+    return line
 
 
 def wrappable(robot: Robot, drive: Drive | None = None) -> NDArray[np.bool_]:

@@ -66,6 +66,7 @@ from .pieces import (
     recording_pieces,
     skipped_piece,
     split_at_gaps,
+    timing_record,
     unwrapped,
     wrappable,
     wrapped_finding,
@@ -369,10 +370,9 @@ class Recordings(TorqueRoute):
                 "duration_s": float(sum(p.log.duration for p in mine)),
                 "decimate": max(p.decimate for p in mine),
             }
-            if r < len(self.gaps) and self.gaps[r]:
-                rec["gaps"] = [[t, length] for t, length in self.gaps[r]]
-                if r < len(self.starts):
-                    rec["start_s"] = self.starts[r]
+            gaps = self.gaps[r] if r < len(self.gaps) else ()
+            start = self.starts[r] if r < len(self.starts) else None
+            rec.update(timing_record(gaps, start, mine[0].cleaning))
             if self.counts:
                 rec.update(self.counts[r].as_dict())
             if r < len(self.digests):

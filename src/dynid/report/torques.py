@@ -144,9 +144,11 @@ def validate_answer(run: RunFiles) -> Answer | None:
             f"{head[0].lower()}{head[1:]}"
         )
     if isinstance(doc.get("sign_map"), str):  # the likelier cause, said before the error
+        whose = "given" if "the sign map given" in doc["sign_map"] else "model's recorded"
         head = (
-            "The model's recorded sign map looks wrong for this file (--units overrides it; "
-            f"below); as read: {head[0].lower()}{head[1:]}"
+            f"The {whose} sign map looks wrong for this file (--units "
+            f"{'reads it right' if whose == 'given' else 'overrides it'}; below); as read: "
+            f"{head[0].lower()}{head[1:]}"
         )
     figs, shown = _figures(
         run,

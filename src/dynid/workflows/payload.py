@@ -37,6 +37,7 @@ from ..feasibility.payload import (
 from ..feasibility.payload_arm import ArmFriction
 from ..feasibility.payload_friction import friction_structure
 from ..identification.model import IdentifiedModel
+from ..identification.pieces import recording_line
 from ..identification.spikes import SPIKES_BEFORE_FIT
 from ..identification.structure import Structure
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
@@ -110,12 +111,10 @@ class PayloadFileResult:
         return dataclasses.replace(plan, robot=self.robot_with_load(plan.robot))
 
     def describe(self) -> str:
-        """``"a.csv: 2 pieces, 3000 samples; ..."`` (empty for static data)."""
-        return "; ".join(
-            f"{r['file']}: {r['pieces']} piece{'s' if r['pieces'] != 1 else ''}, "
-            f"{r['samples']} samples"
-            for r in self.recordings
-        )
+        """``"a.csv: 2 pieces, 3000 samples, cut at the gap(s) after ..."``, a line per
+        recording with its gaps and its stamps' jitter as ``identify`` says them
+        (:func:`~dynid.identification.pieces.recording_line`; empty for static data)."""
+        return "\n".join(recording_line(r) for r in self.recordings)
 
 
 def identify_payload_files(

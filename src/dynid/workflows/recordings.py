@@ -74,7 +74,7 @@ from ..identification.log import (
     velocity_note,
     with_derived_velocities,
 )
-from ..identification.model_sign import sign_confirmed
+from ..identification.model_sign import every_joint_entry, sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
 from ..identification.recorded_signs import SignFinding, recording_sign_findings
 from ..identification.sanity import too_few_samples, torque_unit_finding
@@ -87,6 +87,7 @@ from ..identification.unit_mix import (
 )
 from ..identification.velocity_noise import moving_joints
 from ..io.columns import CURRENT_UNITS, LEFT_OUT, ColumnMap, parse_column_map
+from ..io.sign_entries import tau_negated, units_negating
 from ..io.torque_log import declared_tau_unit
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -622,61 +623,112 @@ def warn_signs(
 def recorded_sign_map_findings(
     rec: Recorded, robot: Robot, recorded: Any, units: str | None
 ) -> dict[str, str]:
-    """Per recording (by name), the finding that the sign flips of the model's recorded
-    ``--units`` (``tau3=-1``, applied because no ``units`` were given) look wrong for it:
-    a flipped joint whose torques the robot's rigid-body torques confirm as the file holds
-    them and not as read (:func:`~dynid.identification.model_sign.sign_confirmed`). Said
-    first, naming the joints and the ``--units`` that reads the file without the flips;
-    the verdict judges the torques as read. Empty without such a recording.
+    """Per recording (by name), the finding that the torque signs the applied ``--units``
+    negate look wrong for it: the model's recorded ones (``tau=-1``, ``tau3=-1``, applied
+    because no ``units`` were given) or ``units`` as given. A negated joint whose torques
+    the robot's rigid-body torques confirm as the file holds them and not as read
+    (:func:`~dynid.identification.model_sign.sign_confirmed`): a file already in dynid's
+    sign read with the model's ``tau=-1``. Said first, naming the joints and the
+    ``--units`` that reads the file right given those applied (``tau=1``; of that file
+    alone, ``b.csv:tau=-1`` beside the applied ones, when the other recordings read
+    right), where the generic sign check would ask for the very flip applied; the verdict
+    judges the torques as read. Empty without such a recording.
 
     Parameters
     ----------
     rec : Recorded
-        The recordings as read (with the recorded map).
+        The recordings as read (with the applied map).
     robot : Robot
         The robot whose torques confirm a sign (an identified model's equivalent links).
     recorded : mapping, optional
         The model's ``info.column_map`` (``columns``, ``units``).
     units : str, optional
-        ``--units`` as given: when given, the recorded map is not used and not judged.
+        ``--units`` as given: it replaces the recorded map, and is judged in its place.
     """
-    said = None if recorded is None or units is not None else recorded.get("units")
+    said = units if units is not None else None if recorded is None else recorded.get("units")
     if not isinstance(said, str) or not said.strip():
         return {}
     try:
-        flips = parse_column_map(None, said).flips.get("tau", ())
+        cmap = parse_column_map(None, said)
     except DataError:  # not a plain --units text: nothing to judge
         return {}
-    out: dict[str, str] = {}
+    found: dict[str, tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]] = {}
     for name, log in zip(rec.names, rec.logs, strict=True):
-        if not flips or too_few_samples(log) is not None:
+        negated = tau_negated(cmap.for_file(name), log.tau.shape[1])
+        if not negated or too_few_samples(log) is not None:
             continue
         sign = np.ones(log.tau.shape[1])
-        sign[[k for k in flips if k < sign.size]] = -1.0
+        sign[list(negated)] = -1.0
         held = dataclasses.replace(log, tau=log.tau * sign)  # as the file holds them
         as_read = sign_confirmed(robot, [_joint_side(log, rec.drive)])
         as_held = sign_confirmed(robot, [_joint_side(held, rec.drive)])
-        wrong = [k for k in flips if k < robot.n and as_held[k] and not as_read[k]]
+        ks = [k for k in negated if k < robot.n]
+        wrong = tuple(k for k in ks if as_held[k] and not as_read[k])
         if wrong:
-            out[name] = _sign_map_finding(name, said, wrong, robot.joint_names)
-    return out
+            found[name] = (negated, wrong, tuple(k for k in ks if as_read[k]))
+    alike = len(set(found.values())) == 1 and len(found) == len(rec.names)
+    return {
+        name: _sign_map_finding(
+            _SignMap(name, said, units is None, robot.joint_names, alike or len(rec.names) == 1),
+            *f,
+        )
+        for name, f in found.items()
+    }
 
 
-def _sign_map_finding(name: str, units: str, wrong: list[int], names: Sequence[str]) -> str:
-    """The words of :func:`recorded_sign_map_findings` for the recording ``name``."""
-    entries = [f"tau{k + 1}=-1" for k in wrong]
-    kept = [
-        e.strip()
-        for e in units.split(",")
-        if e.strip() and e.replace(" ", "").split("=")[0] not in {x[:-3] for x in entries}
-    ]
-    joints = ", ".join(f"{names[k]} (tau{k + 1})" for k in wrong)
-    return (
-        f"{name}: the model's recorded sign map (--units {units}) looks wrong for this "
-        f"file: the torques of {joints} match the model's as the file holds them and are "
-        f"opposite once flipped, and are judged flipped; hint: --units "
-        f"{','.join(kept) or 'tau=Nm'} reads the file without {', '.join(entries)} (a "
-        "--units given replaces the recorded map)"
+@dataclass(frozen=True, slots=True)
+class _SignMap:
+    """Whose sign map a finding judges (:func:`recorded_sign_map_findings`): the file's
+    ``name``, the applied ``units``, whether they are the model's ``recorded`` ones, the
+    robot's joint ``names``, and whether the hint may read every file (``every``: one
+    recording, or every one found alike) or names this file's own entry."""
+
+    name: str
+    units: str
+    recorded: bool
+    names: Sequence[str]
+    every: bool
+
+
+def _sign_map_finding(
+    m: _SignMap, negated: tuple[int, ...], wrong: tuple[int, ...], right: tuple[int, ...]
+) -> str:
+    """The words of :func:`recorded_sign_map_findings` for one recording: the torques of
+    ``negated`` joints read negated, ``wrong`` of them confirmed as the file holds them,
+    ``right`` as read."""
+    whole = not right and len(negated) == len(m.names)  # the file in dynid's sign throughout
+    undo = negated if whole else wrong
+    hint = units_negating(m.units, [k for k in negated if k not in undo], len(m.names))
+    alone = ""  # the hint reads every file; with others that read right, this one's own
+    if not m.every and whole and m.name not in m.units:
+        hint = f"{m.units},{every_joint_entry(m.name)}"
+    elif not m.every:
+        alone = " (validated on its own: they read every file given)"
+    joints = ", ".join(f"{m.names[k]} (tau{k + 1})" for k in wrong)
+    whose = "the model's recorded sign map" if m.recorded else "the sign map given"
+    untold = [k for k in negated if k not in wrong and k not in right]
+    if whole:
+        head = (
+            f"the file looks already in dynid's sign: {whose} (--units {m.units}) negates "
+            f"every joint's torques, and those of {joints} match the model's as the file "
+            "holds them and are opposite once negated (judged negated"
+            + (
+                f"; the sign of {', '.join(m.names[k] for k in untold)}, whose torques the "
+                "model's do not explain, is not told by this check)"
+                if untold
+                else ")"
+            )
+        )
+        reads = "as it holds every joint's torques"
+    else:
+        head = (
+            f"{whose} (--units {m.units}) looks wrong for this file: the torques of {joints} "
+            "match the model's as the file holds them and are opposite once negated, and "
+            "are judged negated"
+        )
+        reads = "without " + ", ".join(f"tau{k + 1}=-1" for k in undo)
+    return f"{m.name}: {head}; hint: --units {hint} reads the file {reads}{alone}" + (
+        " (a --units given replaces the recorded map)" if m.recorded else ""
     )
 
 
@@ -711,7 +763,8 @@ def check_signs(
             raise DataError(few, file=name)
     for f in _sign_findings(rec, robot, among=among):
         wrong = recorded_sign_map_findings(rec, robot, recorded, units).get(f.name)
-        raise DataError(wrong or f.text, file=f.name)
+        said = f.text if wrong is None else wrong.removeprefix(f"{f.name}: ")
+        raise DataError(said, file=f.name)  # (the finding named the file: once)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:

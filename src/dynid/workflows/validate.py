@@ -103,6 +103,10 @@ __all__ = ["ValidateOptions", "ValidateResult", "identification_beside", "valida
 
 _log = logging.getLogger(__name__)
 
+#: The validation's own sign warning (:mod:`dynid.friction.validation`), which names no
+#: joint and no ``--units``: left out where the sign findings were said.
+_VAGUE_SIGN = r"the measured torques are anti-correlated with the model's \(correlation"
+
 
 @dataclass(frozen=True, slots=True)
 class ValidateOptions:
@@ -208,10 +212,12 @@ class ValidateResult:
         Each joint's error over its noise as the verdict weighed it (each sample against
         its own noise), the numbers its reason gives; None: not known.
     sign_map : str, optional
-        Where the model's recorded sign map (``--units tau3=-1``) looks wrong for a
-        recording, the finding (naming the file, the joints and the ``--units`` that
-        overrides it; :func:`~dynid.workflows.recordings.recorded_sign_map_findings`),
-        also the start of ``verdict``'s reason; None otherwise.
+        Where the torque signs the applied ``--units`` negate (the model's recorded ones,
+        ``tau=-1`` or ``tau3=-1``, or those given) look wrong for a recording, the
+        finding (naming the file, the joints and the ``--units`` that read it right given
+        those applied: ``tau=1`` for a file already in dynid's sign;
+        :func:`~dynid.workflows.recordings.recorded_sign_map_findings`), also the start of
+        ``verdict``'s reason; None otherwise.
     opposite_sign : tuple of (str, str)
         Per recording whose torques read with the opposite sign to the model's on some
         joints or on all, its name and the finding (naming the joints and the
@@ -395,10 +401,13 @@ def validate_files(
     cut, gap, lag = _prepared_as(opt, model, own, rec.logs)
 
     def run(fr: FrictionModel | FrictionSum | None) -> RecordingsValidation:
-        return validate_recordings(
-            model, rec.logs, rec.names, friction=fr, cutoff_hz=cut, max_gap_s=gap, drive=drive,
-            torque_delay_s=lag,
-        )  # fmt: skip
+        with warnings.catch_warnings():
+            if sign_map is not None or opposite:  # said with the joints and the --units
+                warnings.filterwarnings("ignore", _VAGUE_SIGN, DynidWarning)
+            return validate_recordings(
+                model, rec.logs, rec.names, friction=fr, cutoff_hz=cut, max_gap_s=gap,
+                drive=drive, torque_delay_s=lag,
+            )  # fmt: skip
 
     val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
     val = _banded(run, friction) if val is None else val  # friction as observe evaluates it
@@ -414,7 +423,8 @@ def validate_files(
     # explains: what the residual follows is not diagnosed (a current log's gains are)
     current = not beyond and placed is not None and placed.effort == "current"
     verdict, springs, gains, tilt = _with_hints(
-        model, verdict, val, rec.logs, noise, names, dependence=not beyond and not opposite,
+        model, verdict, val, rec.logs, noise, names,
+        dependence=not beyond and not opposite and sign_map is None,
         held=_terms_held(model, placed, label), gains_too=current,
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)

@@ -1,0 +1,60 @@
+"""The torque signs a ``--units`` text reads a file with, and the ``--units`` text that
+reads it with others: a hint for a file whose torques the applied sign map reads the wrong
+way (``tau=-1`` applied to a file already in dynid's sign: ``tau=1``).
+
+A file's torques on joint ``k`` are read negated when the ``tau`` factor is negative
+(``tau=-1``) or when a single joint's entry flips it (``tau3=-1``, or the file's own
+``rec2.csv:tau3=-1``), not both (:class:`~dynid.io.columns.ColumnMap`: the flips act
+after the factor). Joints are counted from 0 in the code, from 1 in the entries.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from .columns import ColumnMap
+
+__all__ = ["tau_negated", "units_negating"]
+
+
+def tau_negated(cmap: ColumnMap, n: int) -> tuple[int, ...]:
+    """The joints (from 0, of ``n`` torque columns) whose torques ``cmap`` reads negated:
+    every joint with a negative ``tau`` factor, the flipped joints' (``tau3=-1``) the other
+    way. ``cmap`` is the map a file is read with (:meth:`ColumnMap.for_file`)."""
+    whole = cmap.factor("tau") < 0.0
+    flips = set(cmap.flips.get("tau", ()))
+    return tuple(k for k in range(n) if whole != (k in flips))
+
+
+def units_negating(units: str, joints: Iterable[int], n: int) -> str:
+    """The ``--units`` text that reads a file as ``units`` does, with exactly the torques
+    of ``joints`` (from 0, of ``n``) negated: every entry of ``units`` that is no torque
+    sign kept (``q=deg``, the torques' unit: ``tau=-0.001`` as ``tau=0.001``), the torque
+    signs (``tau=-1``'s sign, ``tau3=-1``, a file's own ``rec2.csv:tau=-1``) replaced by
+    the fewest entries: one per joint of ``joints`` (``tau2=-1``), or, when they are more
+    than half the joints and the torques' unit is a number, the factor negated and one
+    entry per joint not negated (``tau=-1,tau3=-1``); ``tau=Nm`` when nothing is left.
+
+    ``units_negating("q=deg,tau=-1", [], 6)`` is ``"q=deg,tau=1"``; ``units_negating(
+    "tau3=-1", [], 6)`` is ``"tau=Nm"``.
+    """
+    negated = sorted(set(joints))
+    kept, unit = [], "1"
+    for entry in units.split(","):
+        key, _, value = entry.partition("=")
+        key, value = key.strip(), value.strip()
+        if not key or ":" in key or (key.startswith("tau") and key[3:].isdigit()):
+            continue  # a file's own entry, or a joint's torque sign
+        if key == "tau":
+            unit = value.removeprefix("-").strip()  # its sign left to the entries below
+            continue
+        kept.append(f"{key}={value}")
+    numeric = unit[:1].isdigit() or unit[:1] == "."
+    if numeric and 2 * len(negated) > n:
+        kept.append(f"tau=-{unit}")
+        kept += [f"tau{k + 1}=-1" for k in range(n) if k not in negated]
+    else:
+        kept += ([f"tau={unit}"] if unit != "1" or "tau=" in units else []) + [
+            f"tau{k + 1}=-1" for k in negated
+        ]
+    return ",".join(kept) or "tau=Nm"
