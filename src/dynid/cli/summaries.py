@@ -945,8 +945,9 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if at_rest:
         rows.append(
             "at rest: a contact on a joint standing still inside its standstill band "
-            "goes undetected below this (the largest static friction the law may hold, "
-            "plus the contact level while moving)"
+            "goes undetected below this (the largest static friction the law may hold, or "
+            "the level calibrated at the calibration's rests where smaller, plus the "
+            "contact level while moving)"
         )
     if th.uses_uncertainty and th.noise is not None:
         rows.append(uncertainty_words(th.k_sigma, th.noise, th.margin))

@@ -284,28 +284,33 @@ def standstill_rest_blocks(
     derived: bool = False,
     rest: RestMargin | None = None,
 ) -> Iterator[tuple[int, NDArray[np.float64] | None, NDArray[np.float64]]]:
-    """:func:`standstill_blocks` with every block's seconds at rest: ``(first sample,
-    margin (m, n) [N m] or None where it is zero so far, seconds each joint has been at
-    rest (m, n) [s], NaN moving)`` (:func:`~dynid.observer.rest_margin.at_rest`,
-    :class:`~dynid.observer.rest_margin.RestClock`). With ``rest``, the margin of a joint
-    at a settled rest (at rest for ``rest.settle_s`` or longer) is ``min(its Coulomb
-    bound, its calibrated rest level)`` before the lag
-    (:mod:`dynid.observer.rest_margin`)."""
+    """:func:`standstill_blocks` with the settled part of every joint's rests: ``(first
+    sample, margin (m, n) [N m] or None where it is zero so far, seconds into the settled
+    part of a rest (m, n) [s], NaN elsewhere)`` (:func:`~dynid.observer.rest_margin.at_rest`,
+    :class:`~dynid.observer.rest_margin.RestClock`: at rest for ``settle_s`` or longer
+    already and still for ``settle_s`` or longer, the velocities read that far ahead). With
+    ``rest``, the margin of a joint in the settled part of a rest is ``min(its Coulomb
+    bound, its calibrated rest level)`` before the lag (:mod:`dynid.observer.rest_margin`);
+    ``settle_s`` is ``rest``'s, else
+    :func:`~dynid.observer.rest_margin.settle_seconds` of the gains.
+    """
     N, n = dq.shape
     size = _MARGIN_BLOCK if block is None else int(block)
     if bands is None and model.friction is not None:
         bands = velocity_bands(model.friction, dq)
     gains = options.gains(n)
-    clock = RestClock(n)
+    clock = RestClock(n, settle_seconds(gains) if rest is None else rest.settle_s)
     prev: tuple[float, NDArray[np.float64], NDArray[np.float64]] | None = None
     for a in range(0, N, size):
         b = min(a + size, N)
+        e = min(N, int(np.searchsorted(t, t[b - 1] + clock.settle_s, "right")) + 1)
         w = standstill_margin(model.friction, dq[a:b], bands, derived=derived)
-        dwell = clock.dwell(t[a:b], at_rest(model.friction, dq[a:b], bands))
+        mask = at_rest(model.friction, dq[a:e], bands)  # read settle_s ahead
+        settled = clock.settled(t[a:e], mask, b - a)
         if rest is not None:
-            w = np.where(dwell >= rest.settle_s, rest.at_rest(w), w)
+            w = np.where(np.isfinite(settled), rest.at_rest(w), w)
         if prev is None and not np.any(w):
-            yield a, None, dwell  # zero so far: its lag is zero too
+            yield a, None, settled  # zero so far: its lag is zero too
             continue
         if prev is None:  # the first nonzero block: the lag of zeros before it is zero
             c = max(a - 1, 0)
@@ -317,7 +322,7 @@ def standstill_rest_blocks(
                                 gains, options.rule)[1:]  # fmt: skip
             y += y0 * np.exp(-gains * (t[a:b, None] - t0))
         prev = (float(t[b - 1]), w[-1].copy(), y[-1].copy())
-        yield a, y, dwell
+        yield a, y, settled
 
 
 #: Samples of the standstill margin computed at a time (about ten temporaries of a block).
@@ -353,9 +358,9 @@ def calibrate(
         :func:`standstill_series` of the same samples: left out of the residual read here
         and added to the thresholds at detection.
     rest : iterable of array_like, shape (N_i, n), optional
-        With ``standstill``: seconds at rest (NaN moving, :func:`standstill_rest_blocks`):
-        the margin at settled rests calibrated there (:mod:`dynid.observer.rest_margin`);
-        without it the Coulomb level stays at every rest.
+        With ``standstill``: seconds into settled rests (NaN elsewhere,
+        :func:`standstill_rest_blocks`): the margin there calibrated on them
+        (:mod:`dynid.observer.rest_margin`); without, the Coulomb level stays.
     margin : float
         Factor over the calibration residuals (>= 1).
     quantile : float

@@ -12,7 +12,11 @@ A joint is *at rest* where every motor that moves it lies inside its friction's 
 band (a smooth sign's width, the velocity noise band where wider: :func:`at_rest`); its rest has
 *settled* once it has lasted :data:`SETTLE_TIME_CONSTANTS` time constants of the observer's
 lag (``5 / K_O``: 0.1 s at ``K_O = 50`` 1/s), when what the residual shows is what the arm
-holds, not the lag of the motion before. The calibration reads the residual of every joint
+holds, not the lag of the motion before; and it stays settled until that long before the
+joint leaves the band (the velocities read that far ahead, as a controller knows when its
+own motion starts): at the start of a motion, still inside the band, the friction breaks
+away anywhere in ``[-f_c, f_c]`` whatever the arm holds at rest, and the Coulomb level is
+back in place by then. The calibration reads the residual of every joint
 at its settled rests (:class:`RestTally`): its largest value beyond what the threshold
 already covers (``|r|`` less ``k sigma``), times the thresholds' own safety margin, less
 the level the threshold has there without the standstill margin (the noise floor ``nu``, or
@@ -97,28 +101,41 @@ def at_rest(
 
 
 class RestClock:
-    """Seconds each joint has been at rest, carried from block to block of one piece."""
+    """The settled part of each joint's rests (module docstring), carried from block to
+    block of one piece: at rest for ``settle_s`` seconds or more already, and for
+    ``settle_s`` seconds or more still (or to the piece's end)."""
 
-    def __init__(self, n: int) -> None:
+    def __init__(self, n: int, settle_s: float) -> None:
+        self.settle_s = settle_s
         self._since = np.full(n, np.nan)  # time the current rest began, NaN: moving
 
-    def dwell(self, t: NDArray[np.float64], rest: NDArray[np.bool_]) -> NDArray[np.float64]:
-        """Seconds at rest (m, n) [s] at the times ``t`` (m,) [s] of a block with the rest
-        mask ``rest`` (m, n) (:func:`at_rest`); NaN where moving."""
-        m, n = rest.shape
+    def settled(
+        self, t: NDArray[np.float64], rest: NDArray[np.bool_], m: int
+    ) -> NDArray[np.float64]:
+        """Seconds [s] (m, n) into the settled part of the rest at the first ``m`` of the
+        times ``t`` (w,) [s], NaN outside it, from the rest mask ``rest`` (w, n)
+        (:func:`at_rest`) of a window reaching ``settle_s`` past the block, or to the
+        piece's end (a rest that reaches it does not end)."""
+        w, n = rest.shape
         out = np.full((m, n), np.nan)
+        k = np.arange(w)
         for j in range(n):
             x = rest[:, j]
-            if not x.any():
+            if not x[:m].any():
                 self._since[j] = np.nan
                 continue
             start = x & ~np.concatenate([[False], x[:-1]])
-            run = np.maximum.accumulate(np.where(start, np.arange(m), 0))  # its rest's start
+            run = np.maximum.accumulate(np.where(start, k, 0))[:m]  # its rest's first sample
             begin = t[run]
             if x[0] and np.isfinite(self._since[j]):  # a rest carried from the last block
                 begin[run == 0] = self._since[j]
-            out[x, j] = t[x] - begin[x]
-            self._since[j] = begin[-1] if x[-1] else np.nan
+            out_next = np.minimum.accumulate(np.where(x, w, k)[::-1])[::-1][:m]  # moving again
+            # no end in the window: settle_s or more ahead, or none before the piece's end
+            end = np.where(out_next < w, t[np.minimum(out_next, w - 1)], np.inf)
+            into = t[:m] - begin - self.settle_s
+            keep = x[:m] & (into >= 0.0) & (end - t[:m] >= self.settle_s)
+            out[keep, j] = into[keep]
+            self._since[j] = begin[-1] if x[m - 1] else np.nan
         return out
 
 
@@ -139,24 +156,27 @@ class RestTally:
     def add(
         self,
         r: NDArray[np.float64],
-        dwell: NDArray[np.float64],
+        settled: NDArray[np.float64],
         std: NDArray[np.float64] | None = None,
     ) -> None:
-        """One block: residual ``r`` (m, n) [N m], seconds at rest ``dwell`` (m, n) [s]
-        (:class:`RestClock`; NaN moving), the residual's std ``std`` (m, n) [N m]."""
+        """One block: residual ``r`` (m, n) [N m], seconds into the settled part of a rest
+        ``settled`` (m, n) [s] (:class:`RestClock`; NaN elsewhere), the residual's std
+        ``std`` (m, n) [N m]. A rest counts once its settled part reaches
+        :data:`MIN_REST_S`."""
         a = np.abs(r)
-        settled = (dwell >= self.settle_s) & np.isfinite(a)
-        long = self.settle_s + MIN_REST_S
-        before = np.concatenate([self._prev[None], dwell[:-1]])
+        inside = np.isfinite(settled) & np.isfinite(a)
+        before = np.concatenate([self._prev[None], settled[:-1]])
         with np.errstate(invalid="ignore"):
-            self.rests += np.count_nonzero((dwell >= long) & ~(before >= long), axis=0)
-        if dwell.shape[0]:
-            self._prev = dwell[-1].copy()
-        x = np.where(settled, a, 0.0)
-        e = x if std is None else np.where(settled, np.clip(a - self.k_sigma * std, 0.0, None), 0.0)
+            self.rests += np.count_nonzero(
+                (settled >= MIN_REST_S) & ~(before >= MIN_REST_S), axis=0
+            )
+        if settled.shape[0]:
+            self._prev = settled[-1].copy()
+        x = np.where(inside, a, 0.0)
+        e = x if std is None else np.where(inside, np.clip(a - self.k_sigma * std, 0.0, None), 0.0)
         if self.quantile < 1.0:
-            self._kept.append(np.where(settled, a, np.nan))
-            self._kept_excess.append(np.where(settled, e, np.nan))
+            self._kept.append(np.where(inside, a, np.nan))
+            self._kept_excess.append(np.where(inside, e, np.nan))
         elif x.shape[0]:
             np.maximum(self._top, x.max(axis=0), out=self._top)
             np.maximum(self._top_excess, e.max(axis=0), out=self._top_excess)

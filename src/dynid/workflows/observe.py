@@ -834,14 +834,14 @@ def _calibrated(
 
     std = beside(_std) if wants_std else None
     margins = beside(lambda x: _margin(x, model.n)) if wants_margin else None
-    dwell = beside(lambda x: _dwell(x, model.n)) if wants_margin else None
+    settled = beside(lambda x: _settled(x, model.n)) if wants_margin else None
     r = residuals()
     th = calibrate(
         r,
         options,
         std=std,
         standstill=margins,
-        rest=dwell,
+        rest=settled,
         margin=opts.margin,
         quantile=opts.quantile,
         collision_factor=opts.collision_factor,
@@ -950,8 +950,8 @@ def _margin(x: ObservedBlock, n: int) -> NDArray[np.float64]:
     return np.zeros((x.r.shape[0], n)) if x.margin is None else x.margin
 
 
-def _dwell(x: ObservedBlock, n: int) -> NDArray[np.float64]:
-    return np.full((x.r.shape[0], n), np.nan) if x.dwell is None else x.dwell
+def _settled(x: ObservedBlock, n: int) -> NDArray[np.float64]:
+    return np.full((x.r.shape[0], n), np.nan) if x.settled is None else x.settled
 
 
 def _observation(

@@ -75,7 +75,7 @@ class ObservedBlock:
     """The residual of samples ``[a, a + len(r))`` of a log, their std and margin, the
     friction the observer evaluated there (the model's, or the model's banded for the
     velocity noise: :func:`~dynid.observer.friction.banded_if_narrow`) and, with the
-    margin, the seconds each joint has been at rest (NaN moving;
+    margin, the seconds into the settled part of each joint's rest (NaN elsewhere;
     :mod:`dynid.observer.rest_margin`)."""
 
     a: int
@@ -83,7 +83,7 @@ class ObservedBlock:
     std: NDArray[np.float64] | None
     margin: NDArray[np.float64] | None
     friction: FrictionModel | FrictionSum | None = None
-    dwell: NDArray[np.float64] | None = None
+    settled: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -158,8 +158,8 @@ def observed_blocks(
     """The residual of every observed span, :data:`OBSERVE_BLOCK` samples at a time (one
     observer per piece, its state carried from block to block), with the std and the
     standstill margin of the same samples (``rest``: the thresholds' margin calibrated at
-    rests, :attr:`~dynid.observer.thresholds.Thresholds.rest`) and the seconds at rest
-    (errors name the file)."""
+    rests, :attr:`~dynid.observer.thresholds.Thresholds.rest`) and the settled part of
+    the rests (errors name the file)."""
     t, q, tau, dq = prep.log.t, prep.log.q, prep.log.tau, prep.dq
     with about_file(prep.path.name):
         for a, b in prep.spans:
@@ -181,14 +181,14 @@ def observed_blocks(
             for c in range(a, b, OBSERVE_BLOCK):
                 d = min(c + OBSERVE_BLOCK, b)
                 report(f"observing {prep.path.name}: sample {d:,} of {t.shape[0]:,}")
-                _, m, dwell = next(margins, (c, None, None))
+                _, m, settled = next(margins, (c, None, None))
                 yield ObservedBlock(
                     c,
                     obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d]),
                     next(stds) if wants_std else None,
                     m,
                     here.friction,
-                    dwell,
+                    settled,
                 )
 
 
