@@ -11,8 +11,10 @@ whose margin was 0.6 N m, missed).
 A joint is *at rest* where every motor that moves it lies inside its friction's standstill
 band (a smooth sign's width, the velocity noise band where wider: :func:`at_rest`); its rest has
 *settled* once it has lasted :data:`SETTLE_TIME_CONSTANTS` time constants of the observer's
-lag (``5 / K_O``: 0.1 s at ``K_O = 50`` 1/s), when what the residual shows is what the arm
-holds, not the lag of the motion before; and it stays settled until that long before the
+lag (``10 / K_O``: 0.2 s at ``K_O = 50`` 1/s), when what the residual shows is what the arm
+holds, not the lag of the motion before (a joint creeping inside its band for longer reads
+as a rest: what its friction does there raises the calibrated level, towards the Coulomb
+level); and it stays settled until that long before the
 joint leaves the band (the velocities read that far ahead, as a controller knows when its
 own motion starts): at the start of a motion, still inside the band, the friction breaks
 away anywhere in ``[-f_c, f_c]`` whatever the arm holds at rest, and the Coulomb level is
@@ -57,8 +59,11 @@ MIN_RESTS = 10
 #: Seconds a rest must stay settled to count (:data:`MIN_RESTS`).
 MIN_REST_S = 0.5
 #: Time constants ``1 / K_O`` of the observer's lag after a joint enters its standstill
-#: band before its rest is settled (``exp(-5)``: 0.7 % of the motion's residual left).
-SETTLE_TIME_CONSTANTS = 5.0
+#: band before its rest is settled: the last of a motion creeps inside the band for up to
+#: half of it (a quintic stop of 0.8 s moving a joint 0.01 rad: 0.13 s at 0.01 rad/s), its
+#: friction anywhere in ``[-f_c, f_c]``, and ``exp(-5)`` (0.7 %) of that is left after the
+#: other half.
+SETTLE_TIME_CONSTANTS = 10.0
 
 
 def settle_seconds(gains: NDArray[np.float64]) -> float:
