@@ -29,7 +29,12 @@ cannot know, which the residual passes through its lag ``K_O/(s + K_O)``. That l
 positive) is added to both levels of the joint's threshold; the calibration leaves it out
 of the residual it reads (``(|r_j| - m_j)^+``), so one reversal does not raise the
 threshold everywhere. Without it, a model with a band raises contacts at the slow
-reversals of a collision-free motion.
+reversals of a collision-free motion. At a *settled* rest (inside the band for ``10 / K_O``
+already and still) the margin is ``min(f_c, the rest level calibrated at the calibration's
+rests)`` where the calibration logs held enough rests (``rest``, :attr:`Thresholds.rest`:
+:mod:`dynid.observer.rest_margin`): an arm whose friction vanishes at rest shows so there,
+and a push below ``f_c`` at rest is detected; one whose motors hold static friction keeps
+about ``f_c``.
 
 Two levels, as robot controllers have them: ``contact`` (the threshold) and ``collision``
 (``collision_factor`` times it).
