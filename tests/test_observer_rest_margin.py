@@ -221,3 +221,27 @@ def test_a_thresholds_file_without_rest_levels_keeps_the_coulomb_bound(free_at_r
     old = load_thresholds(path)
     assert old.rest is None and old.standstill
     np.testing.assert_allclose(undetected_at_rest(model, old), FC + th.contact, rtol=1e-12)
+
+
+def test_the_settled_rests_and_their_margin_are_the_same_a_block_at_a_time(free_at_rest):
+    """The settled part of a rest is read 0.2 s ahead and carried across blocks: blocks of
+    997 samples give the whole log's margin (to rounding) and settled seconds exactly; a
+    rest is settled from 0.2 s after the joint enters its band (the last of the stop) to
+    0.2 s before it leaves it (the first of the next move), never while moving."""
+    model, th, _ = free_at_rest
+    log, _ = _log(2, 12, held=False)
+    t, dq = np.asarray(log.t), np.asarray(log.dq)
+    whole = list(standstill_rest_blocks(model, t, dq, OPTS, rest=th.rest))
+    parts = list(standstill_rest_blocks(model, t, dq, OPTS, 997, rest=th.rest))
+    assert len(whole) == 1 and len(parts) > 10
+    margin = np.concatenate([y for _, y, _ in parts])
+    settled = np.concatenate([s for _, _, s in parts])
+    np.testing.assert_allclose(margin, whole[0][1], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(settled, whole[0][2])
+    _, which = _moves(2, 12)
+    for k in (0, 5, 10):  # 1.2 s still, inside the band from up to 0.05 s before to after
+        inside = np.isfinite(settled[which == k]).mean(axis=0)
+        assert np.all((inside >= 0.8 / 1.2) & (inside <= 0.9 / 1.2)), inside
+    assert not np.isfinite(settled[which == -1]).any()
+    last = np.isfinite(settled[which == 11]).mean(axis=0)  # to the log's end: no move after
+    assert np.all(last >= 1.0 / 1.2), last  # settled from 0.2 s in to the end
