@@ -245,3 +245,33 @@ def test_the_settled_rests_and_their_margin_are_the_same_a_block_at_a_time(free_
     assert not np.isfinite(settled[which == -1]).any()
     last = np.isfinite(settled[which == 11]).mean(axis=0)  # to the log's end: no move after
     assert np.all(last >= 1.0 / 1.2), last  # settled from 0.2 s in to the end
+
+
+def test_the_calibration_report_says_the_margin_at_rest_per_joint(free_at_rest, tmp_path):
+    """report.html's calibration table gives each joint's margin at rest as the file
+    holds it: its calibrated level and the rests read, or the Coulomb level for too few."""
+    import re
+
+    from dynid.io.observer_files import save_observation
+    from dynid.observer.results import LogObservation, ObserveResult
+    from dynid.report import RunSummary, render_html_report
+
+    model, th, _ = free_at_rest
+    few = dataclasses.replace(
+        th, rest=dataclasses.replace(th.rest, level=np.full(7, np.nan), rests=np.full(7, 3))
+    )
+    log = LogObservation(Path("cal.csv"), np.zeros(2), None, None, [], None, None)
+    for name, got in (("many", th), ("few", few)):
+        (path,) = save_observation(
+            tmp_path / name, ObserveResult(model, got, (log,)), joints=list("abcdefg"),
+            calibrating=True,
+        )  # fmt: skip
+        page = re.sub(
+            r"<[^>]+>", " ", render_html_report(RunSummary(command="observe"), {path.name: path})
+        )
+        assert "standstill margin at rest" in page
+        if name == "many":
+            level = th.rest.level[1]
+            assert f"min(Coulomb level, {level:.3g} N m): calibrated from 14 rests" in page
+        else:
+            assert page.count("Coulomb level: too few rests (3 of 10)") == 7
