@@ -165,6 +165,8 @@ def test_observe_refuses_thresholds_of_another_joint_count(logs, calibrated, cap
         doc[k] = doc[k][:6]
     doc["observer"]["gain"] = doc["observer"]["gain"][:6]
     doc["uncertainty"]["noise"] = doc["uncertainty"]["noise"][:6]
+    for k in ("level", "rests"):  # the standstill margin at rest, calibrated per joint
+        doc["rule"]["rest_margin"][k] = doc["rule"]["rest_margin"][k][:6]
     (d / "six.json").write_text(json.dumps(doc))
     args = ["observe", "--params", "panda", "--thresholds", str(d / "six.json")]
     assert main([*args, "--data", str(d / "hit.csv"), "--out", str(d / "bad")]) == 2

@@ -27,7 +27,9 @@ from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joint
 from ..io.observer_files import log_labels
 from ..observer.calibration_check import CalibrationCheck
 from ..observer.detection import undetected_at_rest
+from ..observer.friction import standstill_margin
 from ..observer.gain_noise import GainNoise
+from ..observer.rest_margin import rest_margin_lines
 from ..observer.results import LogObservation, ObserveResult, dropped_words, flagged_words
 from ..observer.scoring import score_words
 from ..observer.wrench import estimate_words
@@ -955,11 +957,15 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if at_rest:
         rows.append(
             "at rest: a contact on a joint standing still inside its standstill band "
-            "goes undetected below this (the largest static friction the law may hold, "
-            "plus the contact level while moving)"
+            "goes undetected below this (the largest static friction the law may hold, or "
+            "the level calibrated at the calibration's rests where smaller, plus the "
+            "contact level while moving)"
         )
     if th.uses_uncertainty and th.noise is not None:
         rows.append(uncertainty_words(th.k_sigma, th.noise, th.margin))
+    if calibrating and th.standstill and th.rest is not None:
+        coulomb = standstill_margin(result.model.friction, np.zeros((1, th.n)))[0]
+        rows += rest_margin_lines(th.rest, coulomb, names, th.margin)
     margins = [m for x in result.logs if (m := _margin_peak(x)) is not None]
     if th.standstill and margins and np.any(margins):
         top = np.max(margins, axis=0)

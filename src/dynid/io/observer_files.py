@@ -5,7 +5,12 @@
     {"schema": "dynid-thresholds/1", "dynid_version": ..., "joints": ["joint1", ...],
      "contact": [...], "collision": [...],            # N m per joint
      "rule": {"margin": 1.5, "quantile": 1.0, "collision_factor": 2.0,
-              "standstill_margin": true},     # false or absent: fixed levels only
+              "standstill_margin": true,      # false or absent: fixed levels only
+              "rest_margin": {                # absent: the Coulomb level at every rest
+                  "level": [...],  # N m per joint, the margin at a settled rest is
+                                   # min(Coulomb level, level); null: too few rests
+                  "rests": [...],  # rests counted per joint
+                  "settle_s": s, "min_rests": k, "min_rest_s": s}},
      "uncertainty": null | {"k_sigma": 3.0, "noise": [...]},
      "observer": {"gain": [...], "discretisation": "exact", "rule": "trapezoid"},
      "calibration": {"samples": N, "data": [file names], "model": ...,
@@ -77,7 +82,7 @@ from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import ContactScore
-from ..observer.thresholds import ModelFingerprint
+from ..observer.thresholds import ModelFingerprint, RestMargin
 from ..observer.wrench import FULL, WrenchKind, wrench_rank
 from .atomic import open_atomic
 from .schema import Field, Format, Record, load_document, save_document
@@ -105,6 +110,17 @@ THRESHOLDS_SCHEMA = "dynid-thresholds/1"
 EVENTS_SCHEMA = "dynid-events/1"
 _N, _NM = ("n",), "N m"
 _NUMBER = Field("number", required=True)
+#: ``thresholds.json``'s ``rule.rest_margin``: the standstill margin at settled rests
+#: calibrated from the calibration's rests (:class:`~dynid.observer.thresholds.RestMargin`)
+_REST_MARGIN = Record(
+    {
+        "level": Field("numbers", required=True, shape=_N, low=0.0, unit=_NM, null_items=True),
+        "rests": Field("numbers", required=True, shape=_N, low=0.0),
+        "settle_s": Field("number", required=True, low=0.0, unit="s"),
+        "min_rests": Field("integer", required=True),
+        "min_rest_s": Field("number", required=True, low=0.0, unit="s"),
+    }
+)
 #: ``thresholds.json``: every per-joint list of the same length n
 THRESHOLDS = Format(
     THRESHOLDS_SCHEMA,
@@ -123,6 +139,7 @@ THRESHOLDS = Format(
                         "quantile": _NUMBER,
                         "collision_factor": _NUMBER,
                         "standstill_margin": Field("bool"),
+                        "rest_margin": Field("object", record=_REST_MARGIN),
                     }
                 ),
             ),
@@ -309,6 +326,7 @@ def save_thresholds(
             "quantile": th.quantile,
             "collision_factor": th.collision_factor,
             "standstill_margin": th.standstill,
+            **({} if th.rest is None else {"rest_margin": _rest_margin(th.rest)}),
         },
         "uncertainty": None
         if not th.uses_uncertainty or th.noise is None
@@ -328,6 +346,33 @@ def save_thresholds(
         "units": {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"},
     }
     return save_document(path, THRESHOLDS, doc)
+
+
+def _rest_margin(rest: RestMargin) -> dict[str, Any]:
+    """``rule.rest_margin`` of the thresholds' :class:`RestMargin` (a level not calibrated
+    written null)."""
+    return {
+        "level": [float(v) if np.isfinite(v) else None for v in rest.level],
+        "rests": [int(k) for k in rest.rests],
+        "settle_s": rest.settle_s,
+        "min_rests": rest.min_rests,
+        "min_rest_s": rest.min_rest_s,
+    }
+
+
+def _rest_of(rule: dict[str, Any]) -> RestMargin | None:
+    """The :class:`RestMargin` of ``rule.rest_margin`` (None: absent, a file of an earlier
+    version: the Coulomb level at every rest)."""
+    d = rule.get("rest_margin")
+    if d is None:
+        return None
+    return RestMargin(
+        level=np.array([np.nan if v is None else v for v in d["level"]], dtype=float),
+        rests=np.array(d["rests"], dtype=np.int64),
+        settle_s=float(d["settle_s"]),
+        min_rests=int(d["min_rests"]),
+        min_rest_s=float(d["min_rest_s"]),
+    )
 
 
 def _fingerprint(model: ModelFingerprint | None) -> dict[str, Any]:
@@ -375,6 +420,7 @@ def load_thresholds(path: str | Path) -> Thresholds:
             k_sigma=None if unc is None else float(unc["k_sigma"]),
             noise=None if unc is None else np.array(unc["noise"], dtype=float),
             standstill=bool(rule.get("standstill_margin", False)),
+            rest=_rest_of(rule),
             model=model,
             sample_rate_hz=None if rate is None else float(rate),
             velocities=cal.get("velocities"),

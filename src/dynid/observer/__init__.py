@@ -20,6 +20,8 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
 * :mod:`~dynid.observer.wrench`: the external wrench at a frame by damped least squares;
 * :mod:`~dynid.observer.detection`: thresholds calibrated on collision-free data, the
   model's uncertainty propagated to the residual, the standstill margin;
+* :mod:`~dynid.observer.rest_margin`: the standstill margin at rest calibrated from the
+  calibration's rests (the Coulomb level kept with too few of them);
 * :mod:`~dynid.observer.sign`: measured torques of the opposite sign to the model's,
   read from the residual (a calibration refuses them);
 * :mod:`~dynid.observer.thresholds`: the thresholds and their value at every sample;

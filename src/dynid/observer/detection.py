@@ -29,7 +29,12 @@ cannot know, which the residual passes through its lag ``K_O/(s + K_O)``. That l
 positive) is added to both levels of the joint's threshold; the calibration leaves it out
 of the residual it reads (``(|r_j| - m_j)^+``), so one reversal does not raise the
 threshold everywhere. Without it, a model with a band raises contacts at the slow
-reversals of a collision-free motion.
+reversals of a collision-free motion. At a *settled* rest (inside the band for ``10 / K_O``
+already and still) the margin is ``min(f_c, the rest level calibrated at the calibration's
+rests)`` where the calibration logs held enough rests (``rest``, :attr:`Thresholds.rest`:
+:mod:`dynid.observer.rest_margin`): an arm whose friction vanishes at rest shows so there,
+and a push below ``f_c`` at rest is detected; one whose motors hold static friction keeps
+about ``f_c``.
 
 Two levels, as robot controllers have them: ``contact`` (the threshold) and ``collision``
 (``collision_factor`` times it).
@@ -60,8 +65,9 @@ from .friction import (
 )
 from .model import ObserverModel
 from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_lag
+from .rest_margin import RestClock, RestTally, at_rest, settle_seconds
 from .terms import base_momentum_regressor
-from .thresholds import Thresholds, threshold_series
+from .thresholds import RestMargin, Thresholds, threshold_series
 
 __all__ = [
     "ContactEvent",
@@ -72,6 +78,7 @@ __all__ = [
     "residual_std",
     "residual_std_blocks",
     "standstill_blocks",
+    "standstill_rest_blocks",
     "standstill_series",
     "threshold_series",
     "undetected_at_rest",
@@ -251,6 +258,7 @@ def standstill_blocks(
     *,
     bands: tuple[NDArray[np.float64], ...] | None = None,
     derived: bool = False,
+    rest: RestMargin | None = None,
 ) -> Iterator[tuple[int, NDArray[np.float64]]]:
     """:func:`standstill_series` of one piece ``t`` (N,), ``dq`` (N, n) (validated) a block
     of ``block`` samples (default :data:`_MARGIN_BLOCK`) at a time: ``(first sample, margin
@@ -261,18 +269,54 @@ def standstill_blocks(
     :func:`~dynid.observer.friction.velocity_bands` of ``dq``); ``derived``: ``dq``
     derived from the positions, ``bands`` of
     :func:`~dynid.observer.friction.derived_velocity_bands`
-    (:func:`~dynid.observer.friction.standstill_margin`)."""
+    (:func:`~dynid.observer.friction.standstill_margin`); ``rest``: the calibrated margin
+    at settled rests (:func:`standstill_rest_blocks`)."""
+    for a, y, _ in standstill_rest_blocks(
+        model, t, dq, options, block, bands=bands, derived=derived, rest=rest
+    ):
+        if y is not None:
+            yield a, y
+
+
+def standstill_rest_blocks(
+    model: ObserverModel,
+    t: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    options: ObserverOptions = DEFAULT_OPTIONS,
+    block: int | None = None,
+    *,
+    bands: tuple[NDArray[np.float64], ...] | None = None,
+    derived: bool = False,
+    rest: RestMargin | None = None,
+) -> Iterator[tuple[int, NDArray[np.float64] | None, NDArray[np.float64]]]:
+    """:func:`standstill_blocks` with the settled part of every joint's rests: ``(first
+    sample, margin (m, n) [N m] or None where it is zero so far, seconds into the settled
+    part of a rest (m, n) [s], NaN elsewhere)`` (:func:`~dynid.observer.rest_margin.at_rest`,
+    :class:`~dynid.observer.rest_margin.RestClock`: at rest for ``settle_s`` or longer
+    already and still for ``settle_s`` or longer, the velocities read that far ahead). With
+    ``rest``, the margin of a joint in the settled part of a rest is ``min(its Coulomb
+    bound, its calibrated rest level)`` before the lag (:mod:`dynid.observer.rest_margin`);
+    ``settle_s`` is ``rest``'s, else
+    :func:`~dynid.observer.rest_margin.settle_seconds` of the gains.
+    """
     N, n = dq.shape
     size = _MARGIN_BLOCK if block is None else int(block)
     if bands is None and model.friction is not None:
         bands = velocity_bands(model.friction, dq)
     gains = options.gains(n)
+    clock = RestClock(n, settle_seconds(gains) if rest is None else rest.settle_s)
     prev: tuple[float, NDArray[np.float64], NDArray[np.float64]] | None = None
     for a in range(0, N, size):
         b = min(a + size, N)
+        e = min(N, int(np.searchsorted(t, t[b - 1] + clock.settle_s, "right")) + 1)
         w = standstill_margin(model.friction, dq[a:b], bands, derived=derived)
+        mask = at_rest(model.friction, dq[a:e], bands)  # read settle_s ahead
+        settled = clock.settled(t[a:e], mask, b - a)
+        if rest is not None:
+            w = np.where(np.isfinite(settled), rest.at_rest(w), w)
         if prev is None and not np.any(w):
-            continue  # zero so far: its lag is zero too
+            yield a, None, settled  # zero so far: its lag is zero too
+            continue
         if prev is None:  # the first nonzero block: the lag of zeros before it is zero
             c = max(a - 1, 0)
             x = np.concatenate([np.zeros((a - c, n)), w])
@@ -283,7 +327,7 @@ def standstill_blocks(
                                 gains, options.rule)[1:]  # fmt: skip
             y += y0 * np.exp(-gains * (t[a:b, None] - t0))
         prev = (float(t[b - 1]), w[-1].copy(), y[-1].copy())
-        yield a, y
+        yield a, y, settled
 
 
 #: Samples of the standstill margin computed at a time (about ten temporaries of a block).
@@ -296,6 +340,7 @@ def calibrate(
     *,
     std: Iterable[ArrayLike] | None = None,
     standstill: Iterable[ArrayLike] | None = None,
+    rest: Iterable[ArrayLike] | None = None,
     margin: float = 1.5,
     quantile: float = 1.0,
     collision_factor: float = 2.0,
@@ -317,6 +362,10 @@ def calibrate(
     standstill : iterable of array_like, shape (N_i, n), optional
         :func:`standstill_series` of the same samples: left out of the residual read here
         and added to the thresholds at detection.
+    rest : iterable of array_like, shape (N_i, n), optional
+        With ``standstill``: seconds into settled rests (NaN elsewhere,
+        :func:`standstill_rest_blocks`): the margin there calibrated on them
+        (:mod:`dynid.observer.rest_margin`); without, the Coulomb level stays.
     margin : float
         Factor over the calibration residuals (>= 1).
     quantile : float
@@ -341,13 +390,7 @@ def calibrate(
         :data:`MIN_OUTSIDE` samples (or 1 % of them), as on a log at rest: inside its
         standstill band the calibration learns nothing (a threshold of about 0 N m).
     """
-    if not margin >= 1.0 or not 0.0 < quantile <= 1.0 or not collision_factor >= 1.0:
-        raise OptionError(
-            f"margin >= 1, quantile in (0, 1] and collision factor >= 1 are needed; got "
-            f"{margin}, {quantile}, {collision_factor}"
-        )
-    if not k_sigma > 0:
-        raise OptionError(f"k_sigma must be > 0; got {k_sigma}")
+    _check_rule(margin, quantile, collision_factor, k_sigma)
     n_joints: int | None = None
     count, top, top_excess = 0, None, None
     outside = None
@@ -355,6 +398,8 @@ def calibrate(
     kept_excess: list[NDArray[np.float64]] = []
     stds = iter(std) if std is not None else None
     margins = iter(standstill) if standstill is not None else None
+    rests = iter(rest) if rest is not None and standstill is not None else None
+    tally: RestTally | None = None
     for x in residuals:
         R = _checks.as_array("residual", x)
         if R.ndim != 2 or (n_joints is not None and R.shape[1] != n_joints):
@@ -366,10 +411,12 @@ def calibrate(
             A = np.clip(A - W, 0.0, None)
             left = np.count_nonzero(A > 0.0, axis=0)
             outside = left if outside is None else outside + left
-        excess = None
+        excess, S = None, None
         if stds is not None:
             S = _checks.as_exact("std", _next(stds, "std"), R.shape)
             excess = np.clip(A - k_sigma * S, 0.0, None)
+        if rests is not None:
+            tally = _rest_tallied(tally, R, _next(rests, "rest"), S, options, quantile, k_sigma)
         count += A.shape[0]
         if quantile < 1.0:
             kept.append(A)
@@ -405,7 +452,38 @@ def calibrate(
         k_sigma=k_sigma if std is not None else None,
         noise=noise,
         standstill=standstill is not None,
+        rest=None if tally is None else tally.result(margin, contact, noise),
     )
+
+
+def _check_rule(margin: float, quantile: float, collision_factor: float, k_sigma: float) -> None:
+    """The calibration rule's parameters in their ranges (:func:`calibrate`)."""
+    if not margin >= 1.0 or not 0.0 < quantile <= 1.0 or not collision_factor >= 1.0:
+        raise OptionError(
+            f"margin >= 1, quantile in (0, 1] and collision factor >= 1 are needed; got "
+            f"{margin}, {quantile}, {collision_factor}"
+        )
+    if not k_sigma > 0:
+        raise OptionError(f"k_sigma must be > 0; got {k_sigma}")
+
+
+def _rest_tallied(
+    tally: RestTally | None,
+    R: NDArray[np.float64],
+    rest: ArrayLike,
+    S: NDArray[np.float64] | None,
+    options: ObserverOptions,
+    quantile: float,
+    k_sigma: float,
+) -> RestTally:
+    """``tally`` (a new one for the first block) with the block's residual ``R``, its
+    seconds at rest ``rest`` and std ``S`` added
+    (:class:`~dynid.observer.rest_margin.RestTally`)."""
+    n = R.shape[1]
+    if tally is None:
+        tally = RestTally(n, settle_seconds(options.gains(n)), quantile, k_sigma)
+    tally.add(R, _checks.as_exact("rest", rest, R.shape, allow_nonfinite=True), S)
+    return tally
 
 
 def _next(it: Iterator[ArrayLike], name: str) -> ArrayLike:
@@ -444,7 +522,9 @@ def undetected_at_rest(
 ) -> NDArray[np.float64]:
     """Per joint (n,) [N m]: the contact torque below which a contact on a joint at rest
     inside its standstill band goes undetected, its standstill margin at rest (the
-    largest static friction the law can hold without a motion) plus its contact level
+    largest static friction the law can hold without a motion, or the level calibrated
+    from the calibration's rests where smaller: :attr:`Thresholds.rest`) plus its contact
+    level
     ``contact`` (n,) [N m] (the level while moving,
     :func:`~dynid.observer.calibration_check.detectable`; default: the fixed contact
     threshold); the level alone for thresholds without the margin."""
@@ -452,4 +532,6 @@ def undetected_at_rest(
     if not thresholds.standstill:
         return level
     rest = standstill_margin(model.friction, np.zeros((1, model.n)))[0]
+    if thresholds.rest is not None:  # calibrated from the calibration's rests
+        rest = thresholds.rest.at_rest(rest)
     return np.asarray(level + rest)

@@ -30,6 +30,7 @@ from .residual import ObserverOptions
 __all__ = [
     "RATE_TOLERANCE",
     "ModelFingerprint",
+    "RestMargin",
     "Thresholds",
     "log_rate",
     "rate_mismatch",
@@ -74,6 +75,57 @@ class ModelFingerprint:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class RestMargin:
+    """The standstill margin at settled rests, calibrated from the calibration's rests
+    (:mod:`dynid.observer.rest_margin`); arrays read-only.
+
+    Attributes
+    ----------
+    level : ndarray, shape (n,)
+        The calibrated rest level [N m] per joint: the standstill margin at a settled rest
+        is ``min(Coulomb level, level)``; NaN: too few rests, the Coulomb level kept.
+    rests : ndarray, shape (n,)
+        Separate rests of at least ``min_rest_s`` settled seconds each that the
+        calibration logs held, per joint.
+    settle_s : float
+        Seconds [s] inside the standstill band before a rest is settled (the level applies).
+    min_rests : int
+        Rests a joint needed for its level to be calibrated.
+    min_rest_s : float
+        Settled seconds [s] a rest needed to count.
+    """
+
+    level: NDArray[np.float64]
+    rests: NDArray[np.int64]
+    settle_s: float
+    min_rests: int
+    min_rest_s: float
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.level)[0]
+        level = _checks.as_exact("rest level", self.level, (n,), allow_nonfinite=True)
+        if np.any(np.isinf(level)) or np.any(level < 0):
+            raise DataError(f"thresholds: rest levels must be >= 0 [N m] or null; got {level}")
+        rests = np.asarray(self.rests)
+        if rests.shape != (n,) or np.any(rests < 0):
+            raise DataError(f"thresholds: rests must be {n} counts >= 0; got {rests.tolist()}")
+        if not (np.isfinite(self.settle_s) and self.settle_s >= 0):
+            raise DataError(f"thresholds: settle_s must be >= 0 [s]; got {self.settle_s}")
+        object.__setattr__(self, "level", _checks.frozen(level))
+        object.__setattr__(self, "rests", _checks.frozen(rests.astype(np.int64)))
+
+    @property
+    def calibrated(self) -> NDArray[np.bool_]:
+        """Per joint (n,): a rest level was calibrated (enough rests)."""
+        return np.asarray(np.isfinite(self.level))
+
+    def at_rest(self, coulomb: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The standstill margin (n,) [N m] at a settled rest of joints whose Coulomb
+        bound there is ``coulomb`` (n,) [N m]: the smaller of the two where calibrated."""
+        return np.asarray(np.fmin(coulomb, self.level))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class Thresholds:
     """Per-joint detection thresholds (:mod:`dynid.observer.detection`); arrays read-only.
 
@@ -103,6 +155,10 @@ class Thresholds:
     velocities : {"measured", "derived", "mixed"} or None
         The calibration logs' velocities: columns of the logs, derived from the positions,
         or some of each; None: not recorded (a file of an earlier version).
+    rest : RestMargin or None
+        The standstill margin at settled rests, calibrated from the calibration's rests
+        (:mod:`dynid.observer.rest_margin`); None: the Coulomb level at every rest (a
+        calibration without the rests read, a file of an earlier version).
     """
 
     contact: NDArray[np.float64]
@@ -118,6 +174,7 @@ class Thresholds:
     model: ModelFingerprint | None = None
     sample_rate_hz: float | None = None
     velocities: str | None = None
+    rest: RestMargin | None = None
 
     def __post_init__(self) -> None:
         if self.velocities not in (None, "measured", "derived", "mixed"):
@@ -135,6 +192,10 @@ class Thresholds:
             if np.any(a < 0):
                 raise DataError(f"thresholds: {name} must be >= 0 [N m]; got {a.tolist()}")
             object.__setattr__(self, name, _checks.frozen(a))
+        if self.rest is not None and self.rest.level.shape != (n,):
+            raise DataError(
+                f"thresholds: rest levels for {self.rest.level.shape[0]} joints; {n} here"
+            )
 
     @property
     def n(self) -> int:

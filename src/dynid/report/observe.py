@@ -133,7 +133,30 @@ def _joint_table(doc: dict, cal: dict) -> str:
     rows = [
         [esc(names[j])] + [number(v[j]) if j < len(v) else "" for _, v in columns] for j in range(n)
     ]
-    return table(["joint", *(h for h, _ in columns)], rows, cls="calibration")
+    heads = ["joint", *(h for h, _ in columns)]
+    if (words := _rest_margin_words(doc, n)) is not None:
+        heads.append("standstill margin at rest")
+        rows = [row + [esc(w)] for row, w in zip(rows, words, strict=True)]
+    return table(heads, rows, cls="calibration")
+
+
+def _rest_margin_words(doc: dict, n: int) -> list[str] | None:
+    """Per joint, the standstill margin at a settled rest as ``rule.rest_margin`` holds it
+    (:class:`~dynid.observer.thresholds.RestMargin`): its calibrated level and the rests it
+    was read from, or the Coulomb level for too few rests; None for a file without it."""
+    rule = doc.get("rule")
+    got = rule.get("rest_margin") if isinstance(rule, dict) else None
+    if not isinstance(got, dict):
+        return None
+    level, rests, need = got.get("level"), got.get("rests"), got.get("min_rests")
+    if not (isinstance(level, list) and isinstance(rests, list) and len(level) == len(rests) == n):
+        return None
+    return [
+        f"min(Coulomb level, {v:.3g} N m): calibrated from {k} rests"
+        if is_number(v)
+        else f"Coulomb level: too few rests ({k} of {need})"
+        for v, k in zip(level, rests, strict=True)
+    ]
 
 
 def _read_columns(doc: dict, cal: dict) -> list[tuple[str, Any]]:

@@ -123,7 +123,14 @@ from .observe_detect import (
     detected_log,
     true_torques,
 )
-from .observe_logs import ObservedBlock, PreparedLog, Series, observed_blocks, prepared_log
+from .observe_logs import (
+    ObservedBlock,
+    PreparedLog,
+    Series,
+    margin_series,
+    observed_blocks,
+    prepared_log,
+)
 from .recordings import (
     Recorded,
     check_derived_velocities,
@@ -770,12 +777,15 @@ def _calibrated(
     r_max = np.zeros(model.n)  # the largest |r| of every log
     # a quantile below 1 without the series: its false alarms counted on a second pass
     again: list[PreparedLog] | None = [] if opts.quantile < 1 and not opts.keep_series else None
+    kept: list[PreparedLog] = []  # with the series: their margins again once calibrated
 
     def blocks() -> Iterator[ObservedBlock]:
         for path, log, side in zip(read.paths, read.logs, read.joint_side, strict=True):
             prep = prepared_log(Path(path), log, model, opts.max_gap, side, _delay(opts, model))
             if again is not None:
                 again.append(prep)
+            if opts.keep_series and wants_margin:
+                kept.append(prep)
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
             sign = TorqueSign(model.n)
@@ -824,17 +834,24 @@ def _calibrated(
 
     std = beside(_std) if wants_std else None
     margins = beside(lambda x: _margin(x, model.n)) if wants_margin else None
+    settled = beside(lambda x: _settled(x, model.n)) if wants_margin else None
     r = residuals()
     th = calibrate(
         r,
         options,
         std=std,
         standstill=margins,
+        rest=settled,
         margin=opts.margin,
         quantile=opts.quantile,
         collision_factor=opts.collision_factor,
         k_sigma=opts.k_sigma,
     )
+    if kept and th.rest is not None and np.any(th.rest.calibrated):  # the margins applied
+        logs[:] = [
+            dataclasses.replace(x, standstill=margin_series(p, model, options, th.rest))
+            for x, p in zip(logs, kept, strict=True)
+        ]
     counted = None
     if again is not None:  # the observer again, a block at a time: no series kept
         wants = (wants_std, wants_margin)
@@ -931,6 +948,10 @@ def _std(x: ObservedBlock) -> NDArray[np.float64]:
 
 def _margin(x: ObservedBlock, n: int) -> NDArray[np.float64]:
     return np.zeros((x.r.shape[0], n)) if x.margin is None else x.margin
+
+
+def _settled(x: ObservedBlock, n: int) -> NDArray[np.float64]:
+    return np.full((x.r.shape[0], n), np.nan) if x.settled is None else x.settled
 
 
 def _observation(

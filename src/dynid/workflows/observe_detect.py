@@ -235,7 +235,9 @@ def _detected_once(
         unmodelled.new_log()
     less = LoadTorque(model.robot, carried, options.gains(n)) if carried else None
     with about_file(prep.path.name), table or nullcontext(None) as put:
-        for blk in _less_load(prep, observed_rows(prep, model, options, *wants), less, motion):
+        for blk in _less_load(
+            prep, observed_rows(prep, model, options, *wants, thresholds.rest), less, motion
+        ):
             a, b = blk.a, blk.a + blk.r.shape[0]
             if blk.friction is not None and blk.friction is not model.friction:
                 seen = blk.friction  # banded for the velocity noise (a note says so)
@@ -459,7 +461,7 @@ def counted_events(
     det = EventDetector(thresholds)
     count = 0
     with about_file(prep.path.name):
-        for blk in observed_rows(prep, model, options, *wants):
+        for blk in observed_rows(prep, model, options, *wants, thresholds.rest):
             a, b = blk.a, blk.a + blk.r.shape[0]
             std = blk.std if thresholds.uses_uncertainty else None
             still = blk.margin if thresholds.standstill else None

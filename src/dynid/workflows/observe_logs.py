@@ -29,7 +29,11 @@ from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
 from ..identification.pieces import unwrapped, with_start_turns, wrappable, wrapped_finding
 from ..identification.prepare import states_in_step
-from ..observer.detection import residual_std_blocks, standstill_blocks
+from ..observer.detection import (
+    residual_std_blocks,
+    standstill_blocks,
+    standstill_rest_blocks,
+)
 from ..observer.friction import (
     DERIVED_CUTOFF_HZ,
     banded_if_narrow,
@@ -39,6 +43,7 @@ from ..observer.friction import (
 from ..observer.model import ObserverModel
 from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import MomentumObserver, ObserverOptions
+from ..observer.thresholds import RestMargin
 from ..progress import report
 from ..signals import edge_seconds, filtered_derivative
 
@@ -47,6 +52,7 @@ __all__ = [
     "ObservedBlock",
     "PreparedLog",
     "Series",
+    "margin_series",
     "observed_blocks",
     "observed_rows",
     "prepared_log",
@@ -66,15 +72,18 @@ class PreparedLog:
 
 @dataclass(frozen=True, slots=True)
 class ObservedBlock:
-    """The residual of samples ``[a, a + len(r))`` of a log, their std and margin, and the
+    """The residual of samples ``[a, a + len(r))`` of a log, their std and margin, the
     friction the observer evaluated there (the model's, or the model's banded for the
-    velocity noise: :func:`~dynid.observer.friction.banded_if_narrow`)."""
+    velocity noise: :func:`~dynid.observer.friction.banded_if_narrow`) and, with the
+    margin, the seconds into the settled part of each joint's rest (NaN elsewhere;
+    :mod:`dynid.observer.rest_margin`)."""
 
     a: int
     r: NDArray[np.float64]
     std: NDArray[np.float64] | None
     margin: NDArray[np.float64] | None
     friction: FrictionModel | FrictionSum | None = None
+    settled: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,21 +153,17 @@ def observed_blocks(
     options: ObserverOptions,
     wants_std: bool,
     wants_margin: bool,
+    rest: RestMargin | None = None,
 ) -> Iterator[ObservedBlock]:
     """The residual of every observed span, :data:`OBSERVE_BLOCK` samples at a time (one
     observer per piece, its state carried from block to block), with the std and the
-    standstill margin of the same samples (errors name the file)."""
+    standstill margin of the same samples (``rest``: the thresholds' margin calibrated at
+    rests, :attr:`~dynid.observer.thresholds.Thresholds.rest`) and the settled part of
+    the rests (errors name the file)."""
     t, q, tau, dq = prep.log.t, prep.log.q, prep.log.tau, prep.dq
     with about_file(prep.path.name):
         for a, b in prep.spans:
-            kw = _bands(prep, model, a, b)
-            here = model
-            if model.friction is not None:  # a smooth law narrower than the noise: banded
-                kw.setdefault("bands", velocity_bands(model.friction, dq[a:b]))
-                seen = banded_if_narrow(
-                    model.friction, kw["bands"], derived=kw.get("derived", False)
-                )
-                here = model.with_friction(seen)
+            kw, here = _span_friction(prep, model, a, b)
             obs = MomentumObserver(here, options)
             stds = _rechunked(
                 residual_std_blocks(model, t[a:b], q[a:b], dq[a:b], options)
@@ -167,24 +172,54 @@ def observed_blocks(
                 OBSERVE_BLOCK,
             )
             margins = (
-                standstill_blocks(here, t[a:b], dq[a:b], options, OBSERVE_BLOCK, **kw)
+                standstill_rest_blocks(
+                    here, t[a:b], dq[a:b], options, OBSERVE_BLOCK, rest=rest, **kw
+                )
                 if wants_margin
                 else iter(())
             )
-            pending = next(margins, None)
             for c in range(a, b, OBSERVE_BLOCK):
                 d = min(c + OBSERVE_BLOCK, b)
                 report(f"observing {prep.path.name}: sample {d:,} of {t.shape[0]:,}")
-                m = None
-                if pending is not None and pending[0] == c - a:
-                    m, pending = pending[1], next(margins, None)
+                _, m, settled = next(margins, (c, None, None))
                 yield ObservedBlock(
                     c,
                     obs.run(t[c:d], q[c:d], dq[c:d], tau[c:d]),
                     next(stds) if wants_std else None,
                     m,
                     here.friction,
+                    settled,
                 )
+
+
+def margin_series(
+    prep: PreparedLog, model: ObserverModel, options: ObserverOptions, rest: RestMargin | None
+) -> NDArray[np.float64]:
+    """The standstill margin (N, n) [N m] of a prepared log as :func:`observed_blocks`
+    gives it with the thresholds' margin calibrated at rests ``rest`` (0 where the observer
+    does not run), without running the observer: a calibration's kept series once its
+    rest levels are known."""
+    t, dq = prep.log.t, prep.dq
+    out = np.zeros(dq.shape)
+    for a, b in prep.spans:
+        kw, here = _span_friction(prep, model, a, b)
+        for c, m in standstill_blocks(here, t[a:b], dq[a:b], options, rest=rest, **kw):
+            out[a + c : a + c + m.shape[0]] = m
+    return out
+
+
+def _span_friction(
+    prep: PreparedLog, model: ObserverModel, a: int, b: int
+) -> tuple[dict[str, Any], ObserverModel]:
+    """The velocity bands of samples ``[a, b)`` (:func:`_bands`, else estimated on the
+    velocities) and the model with the friction the observer evaluates there (a smooth
+    law narrower than the noise banded: :func:`~dynid.observer.friction.banded_if_narrow`)."""
+    kw = _bands(prep, model, a, b)
+    if model.friction is None:
+        return kw, model
+    kw.setdefault("bands", velocity_bands(model.friction, prep.dq[a:b]))
+    seen = banded_if_narrow(model.friction, kw["bands"], derived=kw.get("derived", False))
+    return kw, model.with_friction(seen)
 
 
 def observed_rows(
@@ -193,13 +228,14 @@ def observed_rows(
     options: ObserverOptions,
     wants_std: bool,
     wants_margin: bool,
+    rest: RestMargin | None = None,
 ) -> Iterator[ObservedBlock]:
     """:func:`observed_blocks` with the samples the observer does not run on between them
     (NaN residual and std, no margin), at most :data:`OBSERVE_BLOCK` at a time: blocks that
     cover every sample of the log in order (a residual table, the detection)."""
     N, n = prep.log.t.shape[0], prep.log.q.shape[1]
     done = 0
-    for blk in observed_blocks(prep, model, options, wants_std, wants_margin):
+    for blk in observed_blocks(prep, model, options, wants_std, wants_margin, rest):
         yield from _unobserved(done, blk.a, n, wants_std)
         yield blk
         done = blk.a + blk.r.shape[0]
