@@ -101,6 +101,7 @@ from ..exceptions import (
 )
 from ..friction.fit import model_drive
 from ..identification.data import StaticDataset
+from ..identification.gravity_scale import recorded_scale
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.recordings import Recordings, prepare_recordings
@@ -126,7 +127,13 @@ from .payload_difference import (
     loaded_floor_rms,
     piece_states,
 )
-from .payload_doubts import doubts_about, inertia_doubts, misfit_doubts, undetermined_inertia
+from .payload_doubts import (
+    doubts_about,
+    inertia_doubts,
+    misfit_doubts,
+    model_scale_doubts,
+    undetermined_inertia,
+)
 from .payload_fit import (
     HELD_OUT_BLOCKS,
     block_jackknife_covariance,
@@ -471,7 +478,10 @@ def identify_payload(
     fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
     scaled = None if described is None else scale
-    return _estimate(*fit, kin, frame, route, notes, record, differenced, scaled, d, *judging)
+    recorded = recorded_scale(inner) if isinstance(inner, IdentifiedModel) else None
+    return _estimate(
+        *fit, kin, frame, route, notes, record, differenced, scaled, d, *judging, recorded
+    )
 
 
 #: One data set: static data or one recording.
@@ -565,6 +575,7 @@ def _estimate(
     against: _Unloaded | None = None,
     floor: _Floor | None = None,
     spread: NDArray[np.float64] | None = None,
+    recorded: tuple[float, str] | None = None,
 ) -> PayloadEstimate:
     """The load's estimate from its rows: least squares, consistency, doubts (warned);
     ``difference``: the arm was identified from unloaded data (its hint differs);
@@ -573,7 +584,9 @@ def _estimate(
     ``against``: the arm's residual on recordings without the load, the misfit then
     judged on the difference at matched states (:func:`_judged`); ``floor``: the noises
     the residual is judged against (None: the torque noise alone); ``spread``: the
-    covariance the identified arm's parameters put into the load's, added (None: none)."""
+    covariance the identified arm's parameters put into the load's, added (None: none);
+    ``recorded``: the identified arm's recorded gravity scale
+    (:func:`~dynid.feasibility.payload_doubts.model_scale_doubts`)."""
     n, k = kin.n, kin.frame(frame).link
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
@@ -616,7 +629,7 @@ def _estimate(
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
     doubts = misfit + doubts_about(kin, frame, m, sm_noise, c, misfit=bool(misfit))
-    doubts += scale_doubts(scale, m, drive, floor_rms)
+    doubts += scale_doubts(scale, m, drive, floor_rms) + model_scale_doubts(recorded, m)
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()
     at_bound = active and p == 10 and not doubts  # the bound, not the data, set it
     every = tuple(f"I{name}" for name in INERTIA_ORDER)

@@ -6,7 +6,10 @@
 * a CoM farther from the frame than the arm is long (:func:`arm_length`): no load the arm
   carries reaches past its own base;
 * measured torques of another scale than the arm description's
-  (:func:`~dynid.feasibility.payload_scale.scale_doubts`): the load carries the factor.
+  (:func:`~dynid.feasibility.payload_scale.scale_doubts`): the load carries the factor;
+* an identified arm whose identification recorded its gravity torques one factor off the
+  description's (:func:`model_scale_doubts`: torque constants given at the motors, a gear
+  ratio off): the efforts are read through the same drive, and the load carries the factor.
 
 Such an estimate is not handed to a controller (``payload.json`` leaves libfranka's
 ``setLoad`` values out).
@@ -63,6 +66,28 @@ MIN_INERTIA_SIGMAS = 3.0
 #: The moment that bounds each product of inertia, ``|I_ab| <= I_cc / 2`` (indices into
 #: ``xx xy xz yy yz zz``); a moment is judged against itself.
 _BOUND = {"xx": 0, "xy": 5, "xz": 3, "yy": 3, "yz": 0, "zz": 5}
+
+
+def model_scale_doubts(recorded: tuple[float, str] | None, mass: float) -> tuple[str, ...]:
+    """The doubt of a load weighed through an identified arm whose identification recorded
+    its gravity torques ``recorded[0]`` times the robot description's on every loaded
+    joint (:func:`~dynid.identification.gravity_scale.recorded_scale`; ``recorded[1]`` its
+    finding), with the load's ``mass`` [kg]: the logs are read through the same drive, so
+    the load's torques carry the factor as the arm's masses do (a UR5 read through its
+    motors' torque constants, 101 times too small at the joints: 0.0121 kg for 1.2 kg).
+    Empty without a record."""
+    if recorded is None:
+        return ()
+    factor = recorded[0]
+    return (
+        f"the arm's model records that its gravity torques are {factor:.3g} times the robot "
+        "description's on every joint gravity loads (identify's warning: the drive file's "
+        f"torque_constant or gear_ratio looks off by that factor; multiply it by "
+        f"{1 / factor:.3g}): the load's torques are read through the same drive and carry "
+        f"the factor: {mass:.4g} kg here, {mass / factor:.4g} kg at the description's scale; "
+        "no setLoad values written; hint: correct the drive file as the model's note says, "
+        "identify again and weigh the load with that model",
+    )
 
 
 def arm_length(robot: Robot) -> float:

@@ -28,7 +28,16 @@ from ..model.robot import Robot
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded
 
-__all__ = ["OFF", "SHAPE", "UNIFORM", "gravity_scale_finding", "gravity_ratios"]
+__all__ = [
+    "GRAVITY_SCALE",
+    "OFF",
+    "SHAPE",
+    "UNIFORM",
+    "gravity_ratios",
+    "gravity_scale_factor",
+    "gravity_scale_finding",
+    "recorded_scale",
+]
 
 #: Relative distance from 1 of the common factor that makes a finding.
 OFF = 0.10
@@ -38,6 +47,22 @@ UNIFORM = 0.05
 SHAPE = 0.98
 #: Configurations used at most (spread over the logs).
 _SAMPLES = 2_000
+#: The key of an identified model's metadata that records the finding (``factor`` [-] and
+#: ``finding``, its sentence), for the commands that read the model.
+GRAVITY_SCALE = "gravity_scale"
+
+
+def recorded_scale(model: IdentifiedModel) -> tuple[float, str] | None:
+    """The factor [-] of ``model``'s gravity torques to its description's and the finding's
+    sentence, as ``identify`` recorded them in its metadata (:data:`GRAVITY_SCALE`), or
+    None: no finding recorded (or a record of another form)."""
+    got = model.info.extra.get(GRAVITY_SCALE)
+    if not isinstance(got, dict):
+        return None
+    factor, said = got.get("factor"), got.get("finding")
+    if not isinstance(factor, int | float) or not isinstance(said, str) or not factor > 0:
+        return None
+    return float(factor), said
 
 
 def gravity_ratios(
@@ -60,17 +85,13 @@ def gravity_ratios(
     return r, c, loaded
 
 
-def gravity_scale_finding(
-    robot: Robot,
-    model: IdentifiedModel,
-    q: Sequence[NDArray[np.float64]],
-    drive: Drive | None = None,
-) -> str | None:
-    """The finding (module docstring) of ``model`` identified from logs at the
-    configurations ``q`` (one (N, n) array per log) of ``robot``, or None: no inertial
-    parameters in the description, fewer than 2 loaded joints, factors that differ between
-    joints or lie within :data:`OFF` of 1. ``drive``: the drive the log was read through (a
-    log of currents: its torque constant is named)."""
+def gravity_scale_factor(
+    robot: Robot, model: IdentifiedModel, q: Sequence[NDArray[np.float64]]
+) -> tuple[float, NDArray[np.float64], NDArray[np.intp]] | None:
+    """The common factor [-] of ``model``'s gravity torques to ``robot``'s description's
+    (module docstring), each joint's (n,) and the loaded joints (indices), at the
+    configurations ``q`` (one (N, n) array [rad] per log); None where
+    :func:`gravity_scale_finding` finds none."""
     if not np.any(robot.phi) or not q:
         return None
     every = np.concatenate([np.asarray(a, dtype=np.float64) for a in q])
@@ -82,6 +103,24 @@ def gravity_scale_finding(
     mean = float(np.mean(r[js]))
     if np.max(np.abs(r[js] - mean)) > UNIFORM * mean or abs(mean - 1.0) < OFF:
         return None
+    return mean, r, js
+
+
+def gravity_scale_finding(
+    robot: Robot,
+    model: IdentifiedModel,
+    q: Sequence[NDArray[np.float64]],
+    drive: Drive | None = None,
+) -> str | None:
+    """The finding (module docstring) of ``model`` identified from logs at the
+    configurations ``q`` (one (N, n) array per log) of ``robot``, or None: no inertial
+    parameters in the description, fewer than 2 loaded joints, factors that differ between
+    joints or lie within :data:`OFF` of 1. ``drive``: the drive the log was read through (a
+    log of currents: its torque constant is named)."""
+    found = gravity_scale_factor(robot, model, q)
+    if found is None:
+        return None
+    mean, r, js = found
     names = ", ".join(robot.joint_names[j] for j in js)
     said = (
         f"the identified gravity torques are {mean:.3g} times the robot description's on "

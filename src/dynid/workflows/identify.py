@@ -53,7 +53,11 @@ from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import ESTIMATORS, EstimatorName
-from ..identification.gravity_scale import gravity_scale_finding
+from ..identification.gravity_scale import (
+    GRAVITY_SCALE,
+    gravity_scale_factor,
+    gravity_scale_finding,
+)
 from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
@@ -580,7 +584,7 @@ def _fit_logs(
         )
         model = dataclasses.replace(model, info=info)
     logs = fitted_logs(model, logs)  # without the recordings found outlying
-    _say_gravity_scale(robot, model, logs, opt.drive, held)
+    model = _say_gravity_scale(robot, model, logs, opt.drive, held)
     if opt.consistent:
         result = _consistent_of(robot, model, held, first, opt, prior)
         return IdentifyResult(model, result, (), held, None, gravity)
@@ -637,17 +641,28 @@ def _say_gravity_scale(
     logs: Sequence[TorqueLog],
     drive: Drive | None,
     held: HeldOutTorques | None = None,
-) -> None:
-    """Warn when ``model``'s gravity torques are one factor off the description's on every
-    loaded joint (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`);
-    not when the held-out verdict names a factor per motor (``held.gains``, which holds
-    the common one too): one judgement of the efforts' scale."""
+) -> IdentifiedModel:
+    """``model``, warned about and recording it when its gravity torques are one factor off
+    the description's on every loaded joint
+    (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`: a note, and
+    ``gravity_scale`` in its metadata, ``factor`` and ``finding``, which ``payload`` reads:
+    a load weighed through the model carries the factor); not when the held-out verdict
+    names a factor per motor (``held.gains``, which holds the common one too): one
+    judgement of the efforts' scale."""
     if held is not None and held.gains is not None and held.gains.named:
-        return
+        return model
     q = [log.q if drive is None else drive.joint_states(log.q)[0] for log in logs]
     found = gravity_scale_finding(robot, model, q, drive)
-    if found is not None:
-        warnings.warn(found, DynidWarning, stacklevel=4)
+    factor = gravity_scale_factor(robot, model, q)
+    if found is None or factor is None:
+        return model
+    warnings.warn(found, DynidWarning, stacklevel=4)
+    info = dataclasses.replace(
+        model.info,
+        notes=(*model.info.notes, found),
+        extra={**model.info.extra, GRAVITY_SCALE: {"factor": factor[0], "finding": found}},
+    )
+    return dataclasses.replace(model, info=info)
 
 
 def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> IdentifiedModel:
