@@ -161,7 +161,7 @@ from .payload_rows import (
     static_load_rows,
     still_joints,
 )
-from .payload_scale import TorqueScale, scale_doubts, torque_scale
+from .payload_scale import TorqueScale, constants_note, scale_doubts, torque_scale
 
 __all__ = [
     "PayloadEstimate",
@@ -628,6 +628,8 @@ def _estimate(
             raise
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
+    if (said := constants_note(drive, m, sm)) is not None:
+        notes.append(said)
     doubts = misfit + doubts_about(kin, frame, m, sm_noise, c, misfit=bool(misfit))
     doubts += scale_doubts(scale, m, drive, floor_rms) + model_scale_doubts(recorded, m)
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()

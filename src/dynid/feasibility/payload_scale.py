@@ -46,6 +46,7 @@ __all__ = [
     "SCALE_OFF",
     "SCALE_SIGMAS",
     "TorqueScale",
+    "constants_note",
     "scale_doubts",
     "scale_mass",
     "torque_scale",
@@ -179,6 +180,25 @@ def torque_scale(
     std = float(np.sqrt(max(cov[0, 0], 0.0)))
     return TorqueScale(
         a, std, mass, std_mass, "loaded" if p else "unloaded", float(fit.residual_rms)
+    )
+
+
+def constants_note(drive: Drive | None, mass: float, std_mass: float) -> str | None:
+    """The note of a load weighed from motor currents (``drive`` logs currents): its mass
+    ``mass`` [kg] and standard deviation ``std_mass`` [kg] hold the torques' noise and the
+    arm's model, not the drive's torque constants, through which every torque is read: a
+    relative error ``e`` of them, common to the joints, makes the load's torques and its
+    mass ``1 + e`` times the true (a UR5's datasheet constants about 2 % off: 1.217 kg
+    +- 0.0036 for 1.2); None for a log of torques."""
+    if drive is None or drive.effort != "current":
+        return None
+    per = 0.01 * mass
+    sigmas = f", {per / std_mass:.2g} std" if std_mass > 0 else ""
+    return (
+        f"the mass's std ({std_mass:.2g} kg) leaves out the error of the drive's "
+        "torque_constant: the load's torques are the currents times it, so a relative error "
+        f"of the constants common to the joints moves the mass by as much ({per:.2g} kg"
+        f"{sigmas}, per 1 %)"
     )
 
 

@@ -512,6 +512,8 @@ def _held_out(
             k = ho.folds if ho is not None and ho.scheme == "blocks" else DEFAULT_FOLDS
             folds = _block_folds(every.log.q.shape[0], k)
         gains = residual_gains(model, every, total, folds)
+        if gains is not None and not above:  # named only clear of 1 over the folds too
+            gains = dataclasses.replace(gains, floor=True)
         if gains is not None and gains.named:  # the gains explain it: no spring, no tilt
             return dataclasses.replace(held, gains=gains)
     if above:
