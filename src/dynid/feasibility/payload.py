@@ -454,10 +454,9 @@ def identify_payload(
     f = kin.frame(frame)
     if f.link == 0:
         raise ModelError(f"frame {frame!r} is on the base; a load there does not move")
-    k = f.link
     static, items, base = _checked_items(data, unloaded, kin)
     notes: list[str] = []
-    A, cols = link_params_from_frame(f.T_link_frame), slice(10 * (k - 1), 10 * k)
+    A, cols = link_params_from_frame(f.T_link_frame), slice(10 * (f.link - 1), 10 * f.link)
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
     judging: _Judging = (None, None, None)  # torque logs: what judges the load's fit
@@ -478,7 +477,7 @@ def identify_payload(
     fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
     scaled = None if described is None else scale
-    recorded = recorded_scale(inner) if isinstance(inner, IdentifiedModel) else None
+    recorded = recorded_scale(inner)  # an identified arm's scale finding: the load carries it
     return _estimate(
         *fit, kin, frame, route, notes, record, differenced, scaled, d, *judging, recorded
     )
@@ -628,8 +627,8 @@ def _estimate(
             raise
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
-    if (said := constants_note(drive, m, sm)) is not None:
-        notes.append(said)
+    if (constants := constants_note(drive, m, sm)) is not None:
+        notes.append(constants)
     doubts = misfit + doubts_about(kin, frame, m, sm_noise, c, misfit=bool(misfit))
     doubts += scale_doubts(scale, m, drive, floor_rms) + model_scale_doubts(recorded, m)
     by_std = undetermined_inertia(I, si) if p == 10 and not doubts else ()

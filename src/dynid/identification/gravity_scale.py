@@ -52,10 +52,12 @@ _SAMPLES = 2_000
 GRAVITY_SCALE = "gravity_scale"
 
 
-def recorded_scale(model: IdentifiedModel) -> tuple[float, str] | None:
+def recorded_scale(model: object) -> tuple[float, str] | None:
     """The factor [-] of ``model``'s gravity torques to its description's and the finding's
     sentence, as ``identify`` recorded them in its metadata (:data:`GRAVITY_SCALE`), or
-    None: no finding recorded (or a record of another form)."""
+    None: not an identified model, no finding recorded (or a record of another form)."""
+    if not isinstance(model, IdentifiedModel):
+        return None
     got = model.info.extra.get(GRAVITY_SCALE)
     if not isinstance(got, dict):
         return None
