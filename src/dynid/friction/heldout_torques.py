@@ -667,7 +667,7 @@ def residual_gains(
     drive = model.drive
     motor = drive is not None and drive.side == "motor"
     K = drive.transmission if motor and drive is not None else None
-    robot = model.robot
+    robot = model.description  # a model read from its file: the description's links
     G = gd = None
     if np.any(robot.phi):
         rest = np.zeros_like(q)

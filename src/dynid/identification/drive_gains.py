@@ -209,7 +209,15 @@ class DriveGains:
         gains leaves at most :data:`EXPLAINED` of its part above the noise (RMS,
         ``sqrt(ratio^2 - 1)``). Both fits are in-sample: the parameters fitted again to
         the log judged take much of a prediction's error (a held-out error 13 x the noise
-        is 1.1 x in-sample), so the error being above the noise is the verdict's to say."""
+        is 1.1 x in-sample), so the error being above the noise is the verdict's to say.
+        At the noise floor (:attr:`floor`) there is no error above the noise to explain:
+        True where the gains fitted lower the in-sample error at all, and each motor is
+        judged by its spread over the folds (a UR5 model fitted to currents through joint
+        2's constant 1.15 times the true one, validated on another recording: 1.0 x the
+        noise in-sample with the constants as logged, 0.66 with the gains fitted, joint 2's
+        0.872 +- 0.021 over the time blocks, the truth 0.870)."""
+        if self.floor:
+            return self.ratio_fitted < self.ratio_fixed
         before = np.sqrt(max(self.ratio_fixed**2 - 1.0, 0.0))
         after = np.sqrt(max(self.ratio_fitted**2 - 1.0, 0.0))
         return before > 0 and after <= EXPLAINED * before

@@ -63,6 +63,7 @@ from ..identification.floor_verdict import (
     prediction_input_noise,
     sensor_variance,
 )
+from ..identification.gravity_scale import recorded_scale
 from ..identification.gravity_tilt import GravityTilt
 from ..identification.log import TorqueLog
 from ..identification.low_speed import with_low_speed_hint
@@ -622,22 +623,29 @@ def _with_hints(
     their place, a gain per motor of the logged efforts that explains the residual,
     :func:`~dynid.friction.heldout_torques.residual_gains`, judged with ``dependence``
     False too where ``gains_too``: a current log, whose factors a sign finding does not
-    explain), the hint of a cut-off too high for derived states, and that of an error at
-    low speed; and the springs, the gains and the tilt fitted (None: not judged)."""
+    explain, and judged at the noise floor too, named there only clear of 1 over the time
+    blocks as well, :attr:`~dynid.identification.drive_gains.DriveGains.floor`), the hint
+    of a cut-off too high for derived states, and that of an error at low speed; and the
+    springs, the gains and the tilt fitted (None: not judged)."""
     terms, inertia = held
     offsets, left_out = offsets_of(model), friction_left_out(model)
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
     springs = tilt = None
-    judged = (dependence or gains_too) and verdict.level != "good"
+    floor = verdict.level == "good"  # a current log's constants judged at the floor too
+    judged = (dependence or gains_too) and (not floor or gains_too)
     whole = joined_validation(val.parts) if judged else None
     gains = None if whole is None else residual_gains(model, whole, noise.total)
+    if gains is not None and floor:  # named only clear of 1 over the time blocks too
+        gains = dataclasses.replace(gains, floor=True)
     said = None if gains is None else gains.sentence()
-    if said is not None:  # the efforts' scale per motor explains it: no spring, no tilt
+    if said is not None and floor:  # at the floor, the factors said
+        verdict = dataclasses.replace(verdict, reason=f"{verdict.reason}; {said}")
+    elif said is not None:  # the efforts' scale per motor explains it: no spring, no tilt
         verdict = with_hint(verdict, said)
     elif dependence:
-        whole = whole if dependence else None
+        whole = None if floor else whole  # springs and a tilt: above the floor only
         springs = None if whole is None else residual_springs(model, whole, noise.total)
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
@@ -804,9 +812,22 @@ def _signs_first(
 
 def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> None:
     """Warn when recordings of the names the model was identified from are validated on:
-    their errors are training errors, not a judgement on data the fit did not see."""
+    their errors are training errors, not a judgement on data the fit did not see; and
+    when the model's identification recorded its gravity torques one factor off the
+    description's (:func:`~dynid.identification.gravity_scale.recorded_scale`): it predicts
+    efforts read through the same drive, its torques at the joints carry the factor."""
     if not isinstance(model, IdentifiedModel):
         return
+    if (scale := recorded_scale(model)) is not None:
+        warnings.warn(
+            f"the model records that its gravity torques are {scale[0]:.3g} times the robot "
+            "description's (identify's warning: the drive file's torque_constant or "
+            f"gear_ratio looks off by that factor; multiply it by {1 / scale[0]:.3g}): it "
+            "predicts efforts read through the same drive, and its torques at the joints "
+            "carry the factor (payload --model withholds setLoad values)",
+            DynidWarning,
+            stacklevel=3,
+        )
     if same := model.info.fitted_on(names):
         warnings.warn(
             f"{', '.join(same)}: the model was identified from recording(s) of "
