@@ -68,21 +68,35 @@ def noisy_currents(panda):
     return _currents(panda, 20.0, 2.0, 3)
 
 
-def _held(panda, log, factors):
-    """identify's held-out prediction of ``log`` read through ``_drive(factors)``."""
+#: Joint 2's constant 1.15 times the true one, joint 4's 0.85 times.
+OFF = [1.0, 1.15, 1.0, 0.85, 1.0, 1.0, 1.0]
+
+
+def _fitted(panda, log, factors):
+    """identify on ``log`` read through ``_drive(factors)``, its terms given (nothing judged
+    first)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         got = identify_logs(panda, log, IdentifyOptions(drive=_drive(factors), terms=TERMS))
     assert got.heldout is not None
-    return got.heldout
+    return got
 
 
-def test_a_constant_15_percent_off_is_named_at_the_noise_floor(panda, noisy_currents):
+@pytest.fixture(scope="module")
+def fits(panda, noisy_currents):
+    """The noisy log fitted through the constants ``OFF`` and ``NEAR``."""
+    return {
+        "off": _fitted(panda, noisy_currents, OFF),
+        "near": _fitted(panda, noisy_currents, NEAR),
+    }
+
+
+def test_a_constant_15_percent_off_is_named_at_the_noise_floor(fits):
     """Joint 2's constant 1.15 times the true one, joint 4's 0.85: the held-out verdict is
     at the floor (it was, and named nothing: the gains were judged above it only); joint
     2's factor is named within 3 std (in-sample and over the folds) of the truth 1 / 1.15
     and the verdict says it."""
-    held = _held(panda, noisy_currents, [1.0, 1.15, 1.0, 0.85, 1.0, 1.0, 1.0])
+    held = fits["off"].heldout
     verdict, gains = held.verdict, held.gains
     assert verdict.level == "good"
     assert gains is not None and gains.floor and 1 in gains.named
@@ -93,34 +107,33 @@ def test_a_constant_15_percent_off_is_named_at_the_noise_floor(panda, noisy_curr
     assert f"multiply it by {gains.factor[1]:.3g}" in verdict.reason
 
 
-@pytest.mark.parametrize(
-    "duration, rate, noise",
-    [(20.0, 200.0, 2.0), (15.0, 100.0, 1.4)],
-    ids=["20s-200Hz", "15s-100Hz"],
-)
-def test_constants_within_2_percent_name_nothing_at_the_floor(
-    panda, request, duration, rate, noise
-):
+@pytest.mark.parametrize("rate", [200.0, 100.0], ids=["20s-200Hz", "15s-100Hz"])
+def test_constants_within_2_percent_name_nothing_at_the_floor(panda, fits, rate):
     """Datasheet constants within 2 % of the true ones: the gains are judged at the floor
-    (recorded) and none is named, the verdict says nothing of them; at 100 Hz, joint 4
-    read 0.857 (std 0.012 in-sample, 0.075 over the folds) and was named, before a factor
-    at the floor had to be clear of 1 over the folds too."""
-    shared = (duration, rate, noise) == (20.0, 200.0, 2.0)
-    log = (
-        request.getfixturevalue("noisy_currents")
-        if shared
-        else _currents(panda, duration, noise, 3, rate)
-    )
-    held = _held(panda, log, NEAR)
+    (recorded) and none is named, the verdict says nothing of them; at 100 Hz (15 s,
+    1.4 N m of noise), joint 4 read 0.857 (std 0.012 in-sample, 0.075 over the folds) and
+    was named, before a factor at the floor had to be clear of 1 over the folds too."""
+    if rate == 200.0:
+        held = fits["near"].heldout
+    else:
+        held = _fitted(panda, _currents(panda, 15.0, 1.4, 3, rate), NEAR).heldout
     assert held.verdict.level == "good" and held.gains is not None
     assert held.gains.named == ()
     assert "torque_constant" not in held.verdict.reason
     assert held.as_dict()["drive_gains"]["named"] == []
 
 
-def test_validate_names_a_constant_15_percent_off_at_the_noise_floor(
-    panda, noisy_currents, tmp_path
-):
+@pytest.fixture(scope="module")
+def other_currents(panda, tmp_path_factory):
+    """Another 20 s current log of the Panda (noise 2 N m), written as a file."""
+    other = tmp_path_factory.mktemp("other") / "other.csv"
+    save_torque_log(other, _currents(panda, 20.0, 2.0, 8))
+    other.write_text(other.read_text().replace("tau [N m]", "tau [A]"))
+    return other
+
+
+@pytest.mark.parametrize("which", ["off", "near"])
+def test_validate_judges_the_constants_at_the_noise_floor(fits, other_currents, which):
     """A model fitted to the currents through joint 2's constant 1.15 times the true one
     and joint 4's 0.85 (its terms given: nothing judged first), validated on another 20 s
     log: the verdict is at the floor and names joint 2's factor within 3 std (in-sample and
@@ -128,24 +141,18 @@ def test_validate_names_a_constant_15_percent_off_at_the_noise_floor(
     were not judged); through constants within 2 %, nothing is named."""
     from dynid.workflows.validate import validate_files
 
-    other = tmp_path / "other.csv"
-    save_torque_log(other, _currents(panda, 20.0, 2.0, 8))
-    other.write_text(other.read_text().replace("tau [N m]", "tau [A]"))
-    for factors, named in (([1.0, 1.15, 1.0, 0.85, 1.0, 1.0, 1.0], True), (NEAR, False)):
-        opt = IdentifyOptions(drive=_drive(factors), terms=TERMS)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DynidWarning)
-            model = identify_logs(panda, noisy_currents, opt).model
-            got = validate_files(model, other)
-        gains = got.gains
-        assert got.verdict.level == "good" and gains is not None and gains.floor
-        if not named:
-            assert gains.named == () and "torque_constant" not in got.verdict.reason
-            continue
-        assert 1 in gains.named and gains.heldout_std is not None
-        std = max(gains.std[1], gains.heldout_std[1])
-        assert std < 0.03 and abs(gains.factor[1] - 1 / 1.15) < 3 * std
-        assert "torque_constant of joint 2 looks" in got.verdict.reason
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        got = validate_files(fits[which].model, other_currents)
+    gains = got.gains
+    assert got.verdict.level == "good" and gains is not None and gains.floor
+    if which == "near":
+        assert gains.named == () and "torque_constant" not in got.verdict.reason
+        return
+    assert 1 in gains.named and gains.heldout_std is not None
+    std = max(gains.std[1], gains.heldout_std[1])
+    assert std < 0.03 and abs(gains.factor[1] - 1 / 1.15) < 3 * std
+    assert "torque_constant of joint 2 looks" in got.verdict.reason
 
 
 def _loaded_files(tmp_path, kt_given):
