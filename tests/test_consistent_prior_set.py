@@ -17,13 +17,15 @@ import warnings
 import numpy as np
 import pytest
 
+from dynid.cli.summaries import format_consistent
 from dynid.exceptions import DynidWarning
 from dynid.feasibility.convex import SDPOptions, retrieve_sdp
 from dynid.feasibility.convex.data_term import coefficient_term
-from dynid.feasibility.determined import DATA, SUM
+from dynid.feasibility.determined import DATA, PRIOR_MARK, SUM
 from dynid.feasibility.prior_share import prior_sensitivity
 from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
+from dynid.io.feasible import feasible_to_dict
 from dynid.model.inertia import inertial_from_phi, phi_from_inertial
 from dynid.regressors.base import base_parameters
 
@@ -129,3 +131,18 @@ def test_determined_record_names_what_the_prior_sets(fits):
     d = det.as_dict()
     assert "m2" in d["set_by_prior"] and "mc2x" not in d["set_by_prior"]
     assert 0.5 < d["prior_share"]["m2"] <= 1.0 and d["prior_share"]["mc2x"] < 0.05
+
+
+def test_summary_and_feasible_json_mark_what_the_prior_sets(fits):
+    res = fits[4]
+    text = format_consistent(res)
+    rows = [ln.split() for ln in text.splitlines() if ln.startswith(("link1 ", "link2 "))]
+    assert len(rows) == 2 and all(r[1].endswith(PRIOR_MARK) for r in rows)  # both masses
+    assert any(
+        ln.startswith(f"{PRIOR_MARK} set by the prior, not measured: ") for ln in text.splitlines()
+    )
+    d = feasible_to_dict(res)
+    assert d["set_by_prior"]["mass"] == [True, True]
+    assert "m2" in d["set_by_prior"]["parameters"]
+    assert "mc2x" not in d["set_by_prior"]["parameters"]
+    assert "set_by_prior" in d["conventions"]

@@ -757,12 +757,12 @@ def _prior_mark_line(r: FeasibleResult) -> list[str]:
     share = (
         ""
         if det.prior_share is None
-        else f" or too little of it (the prior's share above {100 * PRIOR_SHARE:g} %)"
+        else f", or too little of it (the prior's share above {100 * PRIOR_SHARE:g} %)"
     )
     return [
-        f"{PRIOR_MARK} set by the prior: the data give only combinations holding it{share}; "
-        "unmarked: the data determine it (each parameter's prior share: report.json "
-        "determined.prior_share)"
+        f"{PRIOR_MARK} set by the prior, not measured: the data give only combinations "
+        f"holding it (the base parameters){share}; unmarked: the data determine it (each "
+        "standard parameter's prior share: report.json determined.prior_share)"
     ]
 
 
