@@ -11,9 +11,10 @@ from numpy.typing import NDArray
 
 from ..feasibility.constraints import principal_moments
 from ..feasibility.convex import ConsistentResult
-from ..feasibility.determined import PRIOR, SUM
+from ..feasibility.determined import PRIOR, PRIOR_MARK, SUM
 from ..feasibility.heldout import HeldOutJudgement
 from ..feasibility.penalty import RetrievalProgress, RetrievalResult
+from ..feasibility.prior_share import PRIOR_SHARE
 from ..feasibility.result import FeasibleResult
 from ..friction.fit import FrictionFit
 from ..friction.model import friction_parts
@@ -587,13 +588,16 @@ def format_retrieval(result: RetrievalResult) -> str:
     names = r.robot.link_names[1:]
     w = text_width("link", names)
     lines = [
-        f"{'link':<{w}}  {'mass [kg]':>9}  {'CoM [m]':^26}  "
+        f"{'link':<{w}}  {'mass [kg]':>10}  {'CoM [m]':^29}  "
         f"{'principal moments [kg m^2]':^30}  {'triangle':>9}",
     ]
+    mk_m, mk_c = _prior_marks(r)
     for i, name in enumerate(names):
-        c = " ".join(f"{x:+.4f}" for x in r.com[i])
+        c = " ".join(f"{x:+.4f}{mk_c[i, k]}" for k, x in enumerate(r.com[i]))
         m = " ".join(f"{x:.3e}" for x in lam[i])
-        lines.append(f"{name:<{w}}  {r.mass[i]:>9.4f}  {c:^26}  {m:^30}  {tri[i + 1]:>9.2e}")
+        mass = f"{r.mass[i]:.4f}{mk_m[i]}"
+        lines.append(f"{name:<{w}}  {mass:>10}  {c:^29}  {m:^30}  {tri[i + 1]:>9.2e}")
+    lines += _prior_mark_line(r)
     status = "FEASIBLE" if r.feasible else "INFEASIBLE (least-violating solution)"
     lines += [
         f"total mass {float(np.sum(r.mass)):.4f} kg"
@@ -678,15 +682,18 @@ def format_consistent(result: ConsistentResult) -> str:
     names = r.robot.link_names[1:]
     w = text_width("link", names)
     lines = [
-        f"{'link':<{w}}  {'mass [kg]':>9}  {'prior [kg]':>10}  {'CoM [m]':^26}  "
+        f"{'link':<{w}}  {'mass [kg]':>10}  {'prior [kg]':>10}  {'CoM [m]':^29}  "
         f"{'lambda_min(J)/tr(J)':>19}",
     ]
+    mk_m, mk_c = _prior_marks(r)
     for i, name in enumerate(names):
-        c = " ".join(f"{x:+.4f}" for x in r.com[i])
+        c = " ".join(f"{x:+.4f}{mk_c[i, k]}" for k, x in enumerate(r.com[i]))
+        mass = f"{r.mass[i]:.4f}{mk_m[i]}"
         lines.append(
-            f"{name:<{w}}  {r.mass[i]:>9.4f}  {r.prior.mass[i]:>10.4f}  {c:^26}  "
+            f"{name:<{w}}  {mass:>10}  {r.prior.mass[i]:>10.4f}  {c:^29}  "
             f"{r.pseudo_inertia_margin[i]:>19.3e}"
         )
+    lines += _prior_mark_line(r)
     status = "CONSISTENT" if r.feasible else "NOT CONSISTENT WITH THE SPECIFICATION (closest set)"
     over = f"{100 * (r.residual_ratio - 1):.3f} % above the unconstrained fit"
     lines += [
@@ -727,6 +734,36 @@ def format_consistent(result: ConsistentResult) -> str:
     if not r.feasible:
         lines.append(str(r.report))
     return "\n".join(lines)
+
+
+def _prior_marks(r: FeasibleResult) -> tuple[list[str], NDArray[np.str_]]:
+    """Per link, the mark of its mass (n,) and of its CoM components (n, 3):
+    :data:`~dynid.feasibility.determined.PRIOR_MARK` where the prior sets the value
+    (:meth:`~dynid.feasibility.determined.Determined.link_marks`), a space elsewhere (and
+    everywhere without a determination: static data)."""
+    n = r.robot.n
+    det = r.determined
+    if det is None or det.n != n:
+        return [" "] * n, np.full((n, 3), " ")
+    mass, com = det.link_marks()
+    return [PRIOR_MARK if x else " " for x in mass], np.where(com, PRIOR_MARK, " ")
+
+
+def _prior_mark_line(r: FeasibleResult) -> list[str]:
+    """The line under the links' table saying what the mark means (none unmarked)."""
+    det = r.determined
+    if det is None or det.n != r.robot.n or not any(det.by_prior[: 10 * det.n]):
+        return []
+    share = (
+        ""
+        if det.prior_share is None
+        else f", or too little of it (the prior's share above {100 * PRIOR_SHARE:g} %)"
+    )
+    return [
+        f"{PRIOR_MARK} set by the prior, not measured: the data give only combinations "
+        f"holding it (the base parameters){share}; unmarked: the data determine it (each "
+        "standard parameter's prior share: report.json determined.prior_share)"
+    ]
 
 
 def _determined_lines(r: FeasibleResult) -> list[str]:

@@ -21,14 +21,15 @@ Ranks and row spaces come from pivoted QR with ``P``'s columns scaled to unit no
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..identification.model import IdentifiedModel
+from .prior_share import PRIOR_SHARE
 
-__all__ = ["DATA", "PRIOR", "SUM", "Determined", "determined_by_data"]
+__all__ = ["DATA", "PRIOR", "SUM", "Determined", "determined_by_data", "PRIOR_MARK"]
 
 #: The value is a linear function of the coefficients.
 DATA = "data"
@@ -38,6 +39,8 @@ SUM = "sum"
 PRIOR = "prior"
 #: Relative tolerance of the rank and row-space decisions (on unit columns).
 RANK_TOL = 1e-9
+#: The sign beside a value the prior sets, and what it means (under the tables).
+PRIOR_MARK = "~"
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,6 +65,9 @@ class Determined:
         Joints (motors).
     tol : float
         Relative tolerance of the rank and row-space decisions.
+    prior_share : tuple of float or None
+        Per label: the prior's share in the consistent fit's value, 0 (the data's) to 1
+        (the prior's; :mod:`dynid.feasibility.prior_share`); None when not computed.
     """
 
     n_link: int
@@ -71,6 +77,27 @@ class Determined:
     rotor_motor: tuple[int, ...]
     n: int
     tol: float
+    prior_share: tuple[float, ...] | None = None
+
+    def with_share(self, share: NDArray[np.float64] | None) -> Determined:
+        """The same with the prior's share of each label (None leaves it out)."""
+        if share is None:
+            return self
+        return replace(self, prior_share=tuple(float(x) for x in share))
+
+    @property
+    def by_prior(self) -> tuple[bool, ...]:
+        """Per label: the prior sets the value: the data give the parameter only in
+        combinations (``"sum"``) or not at all (``"prior"``), or its prior share is above
+        :data:`~dynid.feasibility.prior_share.PRIOR_SHARE` (poorly excited)."""
+        share = self.prior_share or (0.0,) * len(self.labels)
+        return tuple(s != DATA or x > PRIOR_SHARE for s, x in zip(self.source, share, strict=True))
+
+    def link_marks(self) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """Which links' mass (n,) and CoM components (n, 3) the prior sets: the mass as
+        :attr:`by_prior`; a CoM ``c = (m c) / m`` when its first moment or the mass is."""
+        b = np.array(self.by_prior[: 10 * self.n], dtype=bool).reshape(self.n, 10)
+        return b[:, 0], b[:, 1:4] | b[:, :1]
 
     @property
     def mass_source(self) -> tuple[str, ...]:
@@ -103,13 +130,18 @@ class Determined:
         return f"{links} + {self.n_rotor} rotor inertias (armatures)"
 
     def as_dict(self) -> dict[str, object]:
-        """JSON-ready: the counts, each label's source and the motors' sources."""
+        """JSON-ready: the counts, each label's source, the motors' sources, each label's
+        prior share (None when not computed) and the labels the prior sets."""
         return {
             "link_base_parameters": self.n_link,
             "rotor_inertias": self.n_rotor,
             "source": dict(zip(self.labels, self.source, strict=True)),
             "rotor_source": None if self.rotor_source is None else list(self.rotor_source),
             "tolerance": self.tol,
+            "prior_share": None
+            if self.prior_share is None
+            else dict(zip(self.labels, self.prior_share, strict=True)),
+            "set_by_prior": [lab for lab, b in zip(self.labels, self.by_prior, strict=True) if b],
         }
 
 

@@ -20,6 +20,9 @@ and was not on a torque log; the friction identified with the links in ``linear_
      "drive": null | {dynid-drive/1 record, rotor_inertia: the identified values},
      "combined": {"fv6": "fv6 + 0.0005556*jfv7", ...} (only when friction coefficients
          hold one left out as structurally combined with them),
+     "set_by_prior": {"mass": [true, ...], "com": [[true, false, true], ...],
+         "parameters": ["m2", ...], "prior_share": {"m1": 1.0, ...} | null} (of an
+         identified model's coefficients: which values the prior sets, not the data),
      "spring": {"k": [...], "q0": [...]} (only with a spring term: the stiffnesses
          identified with the links, :mod:`dynid.io.spring_record`),
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
@@ -153,6 +156,7 @@ FEASIBLE = Format(
             "violated": Field("strings"),
             "heldout": Field("object", nullable=True),
             "combined": Field("object"),
+            "set_by_prior": Field("object"),
             "spring": SPRING_FIELD,
         }
     ),
@@ -247,10 +251,41 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
         )
     if result is None:
         return d if seed is None else d | {"seed": seed}
+    marks = prior_marks_record(result)
+    if marks is not None:
+        d["set_by_prior"] = marks
+        conventions["set_by_prior"] = SET_BY_PRIOR
     d["method"] = result.method
     d["relative_residual"] = finite_or_none(result.relative_residual)
     d["seed"] = result.seed
     return d | _judgement(result)
+
+
+#: What ``set_by_prior`` means (``conventions``).
+SET_BY_PRIOR = (
+    "true: the prior sets the value, not the data: the data give only combinations holding "
+    "it (the base parameters), or too little of it (the prior's share above one half); "
+    "a CoM component when its first moment or the link's mass is; parameters: the standard "
+    "parameters so set, prior_share: each one's share of the prior, 0 (the data's) to 1"
+)
+
+
+def prior_marks_record(result: FeasibleResult) -> dict[str, Any] | None:
+    """``set_by_prior`` of ``feasible.json``: per link whether the prior sets its mass and
+    each CoM component, the standard parameters it sets and each one's prior share (None
+    when not computed); None without a determination (static data)."""
+    det = result.determined
+    if det is None or det.n != result.robot.n:
+        return None
+    mass, com = det.link_marks()
+    return {
+        "mass": [bool(x) for x in mass],
+        "com": [[bool(x) for x in row] for row in com],
+        "parameters": [lab for lab, b in zip(det.labels, det.by_prior, strict=True) if b],
+        "prior_share": None
+        if det.prior_share is None
+        else dict(zip(det.labels, det.prior_share, strict=True)),
+    }
 
 
 def _judgement(result: FeasibleResult) -> dict[str, Any]:

@@ -137,6 +137,23 @@ _MASS_SOURCE = _SOURCE | {
 }
 
 
+def _mass_from(det: Any, k: int) -> str:
+    """Where link ``k``'s mass (from 0) comes from: its source, a poorly excited one the
+    prior sets named so, and the prior's share in the value when it was computed."""
+    if not isinstance(det, dict):
+        return "?"
+    lab = f"m{k + 1}"
+    src = (det.get("source") or {}).get(lab, "")
+    shares = det.get("prior_share")
+    share = shares.get(lab) if isinstance(shares, dict) else None
+    text = _MASS_SOURCE.get(src, "?")
+    if src == "data" and lab in (det.get("set_by_prior") or ()):
+        text = "the prior (the data excite it too little)"
+    if is_number(share):
+        text += f"; the prior's share {100 * share:.0f} %"
+    return text
+
+
 def _coefficients_fact(det: Any) -> list[str]:
     """``Coefficients: 43 link base parameters + 5 rotor inertias (armatures)``, the rotors
     the prior gives named."""
@@ -218,11 +235,7 @@ def _links_table(feas: dict, rep: dict) -> str:
                 cell(diag),
                 cell(_at(margin, k)),
             ]
-            + (
-                [esc(_MASS_SOURCE.get(source.get(f"m{k + 1}", ""), "?"))]
-                if isinstance(source, dict)
-                else []
-            )
+            + ([esc(_mass_from(det, k))] if isinstance(source, dict) else [])
         )
     headers = [
         "link",

@@ -331,6 +331,6 @@ def retrieve_files(
     }
     if kind == "model":
         result = with_model_friction(m.from_coefficients(model, **common), model)
-        result = replace(result, determined=determined_by_data(model))
+        result = replace(result, determined=result.determined or determined_by_data(model))
         return Retrieval(result, tuple(notes))
     return Retrieval(m.from_data(robot, data, **common), tuple(notes))

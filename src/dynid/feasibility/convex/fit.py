@@ -26,6 +26,7 @@ fit is returned with the result (``result.identified``) for comparison.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any, Literal
@@ -48,8 +49,9 @@ from ...model.drive import Drive
 from ...model.robot import Robot
 from ...progress import stage
 from ..bounds import Bounds
-from ..determined import determined_by_data
+from ..determined import Determined, determined_by_data
 from ..prior import Prior
+from ..prior_share import prior_share
 from .data_term import DataTerm, coefficient_term
 from .options import SDPOptions
 from .result import ConsistentResult
@@ -88,9 +90,10 @@ def retrieve_sdp(
     >>> data = dynid.acquire_static(dynid.SimulatedController(robot), 100, np.random.default_rng(0))
     >>> res = retrieve_sdp(dynid.identify_static(robot, data), prior=robot)  # doctest: +SKIP
     """
+    term = coefficient_term(model)
     res = solve_consistent(
         model.robot,
-        coefficient_term(model),
+        term,
         prior=prior,
         bounds=bounds,
         total_mass=total_mass,
@@ -98,7 +101,11 @@ def retrieve_sdp(
         constraints=constraints,
         kind="coefficients",
     )
-    res = replace(res, rotor_inertia=_rotor_inertia(model, res.rotor_inertia))
+    res = replace(
+        res,
+        rotor_inertia=_rotor_inertia(model, res.rotor_inertia),
+        determined=determined_with_share(model, term, res),
+    )
     return res if model.drive is None else with_drive(res, model.drive)
 
 
@@ -282,11 +289,28 @@ def consistent_from_identified(
     res = replace(
         res,
         identified=model,
-        determined=determined_by_data(model),
+        determined=determined_with_share(model, term, res),
         rotor_inertia=_rotor_inertia(model, res.rotor_inertia),
         notes=res.notes + combined_notes(model.info.combined),
     )
     return res if model.drive is None else with_drive(res, model.drive)
+
+
+def determined_with_share(
+    model: IdentifiedModel, term: DataTerm, res: ConsistentResult
+) -> Determined:
+    """What the data of ``model`` determine (:func:`~dynid.feasibility.determined.
+    determined_by_data`) with the prior's share in each value of the weighted fit ``res``
+    (:func:`~dynid.feasibility.prior_share.prior_share`; left out for an exact or the
+    closest fit, whose data term is no covariance, and for a term of other columns)."""
+    det = determined_by_data(model)
+    w = float(res.prior_weight)
+    if res.fit != "weighted" or term.exact or not (math.isfinite(w) and w > 0):
+        return det
+    if term.P.shape[1] != len(det.labels):
+        return det
+    share = prior_share(term.P, term.A, res.phi, res.prior.phi, w, objective=res.options.objective)
+    return det.with_share(share)
 
 
 def _rotor_inertia(model: IdentifiedModel, ia: Any) -> Any:
