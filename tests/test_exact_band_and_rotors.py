@@ -24,6 +24,7 @@ from test_exact_data import EXACT_PERCENT, FRICTION, ROTORS, _heldout_percent
 from test_rank_invariance import _drive, _industrial
 
 from dynid.exceptions import DynidWarning
+from dynid.identification.holdout import Normals, block_normals
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
 from dynid.identification.velocity_noise import (
@@ -111,3 +112,26 @@ def test_pieces_noise_reads_exact_columns_rounding_and_noisy_ones_as_before():
     joined = velocity_noise_std(np.concatenate([x1, noisy]), np.concatenate([t1, t2]))
     assert got[1] == joined[1]
     assert np.all(got[[0, 2]] <= np.maximum(smooth_noise_std(x1), smooth_noise_std(x2))[[0, 2]])
+
+
+def test_a_candidate_without_columns_of_the_origin_keeps_its_residual_below_cancellation():
+    """Regression: normal equations restricted to fewer columns than their origin (the
+    largest model's coefficients, an offset of round-off size among them) fell back to
+    ``x G x - 2 b x + c``, whose cancellation reads an exact fit's residual as 1e-8 of
+    ``|y|`` or as 0; taken about the origin without those columns, the residual of a
+    candidate missing a real column matches the rows' own to 1e-6."""
+    rng = np.random.default_rng(32)
+    W = rng.normal(size=(600, 6)) * np.array([1e3, 10.0, 1.0, 1.0, 0.1, 1.0])
+    x_true = np.array([1.0, -2.0, 0.5, 3.0, 1e-6, 0.0])  # a tiny real column 5
+    y = W @ x_true
+    origin = np.linalg.lstsq(W, y, rcond=None)[0]
+    origin[5] = 1e-15  # the unneeded column's coefficient at round-off
+    (whole,) = block_normals(W, y, np.zeros(600, dtype=np.intp), origin)
+    keep = np.array([0, 1, 2, 3])  # without the tiny column and the unneeded one
+    sub = whole.restricted(keep)
+    x = sub.solve()
+    direct = float(np.sum((W[:, keep] @ x - y) ** 2))
+    assert direct > 0
+    assert abs(sub.sse(x) / direct - 1) < 1e-6, (sub.sse(x), direct)
+    plain = Normals(sub.G, sub.b, sub.c, sub.rows)  # no origin: the cancellation
+    assert abs(plain.sse(x) - direct) > 1e3 * abs(sub.sse(x) - direct)

@@ -219,8 +219,11 @@ class Normals:
         """:meth:`restricted` to the columns ``on`` names."""
         G, b = self.G[on.grid], self.b[on.ix]
         x0 = self.origin
-        if x0 is None or np.any(x0[on.left_out]):  # the origin needs a column left out
+        if x0 is None:
             return Normals(G, b, self.c, self.rows)
+        if np.any(x0[on.left_out]):  # the origin moved onto the kept columns, its residual
+            x1 = np.where(on.left_out, 0.0, x0)  # taken about the old one: no cancellation
+            return Normals(G, b, self.c, self.rows, x1[on.ix], self.sse(x1))
         return Normals(G, b, self.c, self.rows, x0[on.ix], self.sse0)
 
     def expanded(self, mask: NDArray[np.bool_]) -> Normals:
