@@ -44,6 +44,7 @@ __all__ = [
     "block_labels",
     "block_normals",
     "cross_validate",
+    "fold_errors_percent",
     "shared_eigen",
 ]
 
@@ -500,4 +501,13 @@ def cross_validate(
         held.folds,
         held.judged_whole.relative_error_percent(x),
         held.heldout_error_percent(xs),
+    )
+
+
+def fold_errors_percent(held: HeldOut, rtol: float = 1e-10) -> tuple[float, ...]:
+    """Each fold's relative held-out error [%], ``100 ||W x_j - y_j|| / ||y_j||`` with
+    ``x_j`` least squares on its training rows (:meth:`Normals.solve` at ``rtol``): the
+    folds :func:`cross_validate` pools."""
+    return tuple(
+        t.relative_error_percent(f.solve(rtol)) for f, t in zip(held.train, held.test, strict=True)
     )
