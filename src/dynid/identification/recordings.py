@@ -175,7 +175,9 @@ class Recordings(TorqueRoute):
     band : ndarray, shape (n,)
         Standstill band [rad/s] per joint (motor, where the drive's friction acts there):
         the velocity noise band of the raw logs
-        (:func:`~dynid.identification.velocity_noise.noise_band`); for velocities derived from the
+        (:func:`~dynid.identification.velocity_noise.noise_band`; of velocities exact to
+        round-off, their rounding: :func:`~dynid.identification.velocity_noise.
+        pieces_noise_std`); for velocities derived from the
         positions, the noise they carry divided by ``band_gain``
         (:mod:`~dynid.identification.derived_band`).
     skipped : tuple of str
