@@ -581,20 +581,25 @@ def _per_recording(
     return tuple(zip(names, here.fold_errors_percent, strict=True))
 
 
-def _per_recording_of(model: IdentifiedModel, selection: Selection) -> Selection:
+def _per_recording_of(
+    model: IdentifiedModel, selection: Selection, gone: tuple[int, ...] = ()
+) -> Selection:
     """``selection`` with each recording's held-out error (:attr:`~.candidates.Selection.
     per_recording`) that of ``model``, the chosen structure's final fit, over its own folds
     (:func:`~.holdout.fold_errors_percent` of its kept columns, as its pooled held-out
-    error): the search's regressor holds every candidate's columns, whose round-off on
-    exact data (1e-6 % about another model's coefficients) the summary printed beside the
-    pooled 3.5e-12 % of the same structure."""
+    error); the recordings ``gone`` (left out of the fit as outlying) keep theirs. The
+    search's regressor holds every candidate's columns, whose round-off on exact data
+    (1e-6 % about another model's coefficients) the summary printed beside the pooled
+    3.5e-12 % of the same structure."""
     held = model.holdout
-    if held is None or held.scheme != "recordings" or held.folds != len(selection.per_recording):
+    fitted = [k for k in range(len(selection.per_recording)) if k not in gone]
+    if held is None or held.scheme != "recordings" or held.folds != len(fitted):
         return selection
     fit = model.joint_fit if model.joint_fit is not None else model.fit
-    folds = fold_errors_percent(held.restricted(np.flatnonzero(fit.kept)))
-    names = [name for name, _ in selection.per_recording]
-    return replace(selection, per_recording=tuple(zip(names, folds, strict=True)))
+    errors = fold_errors_percent(held.restricted(np.flatnonzero(fit.kept)))
+    folds = dict(zip(fitted, errors, strict=True))
+    per = tuple((name, folds.get(k, e)) for k, (name, e) in enumerate(selection.per_recording))
+    return replace(selection, per_recording=per)
 
 
 def _widths_per_joint(
@@ -1087,8 +1092,8 @@ def identify_recordings(
             base=base, max_std_percent=max_std_percent, rtol=rtol,
         )  # fmt: skip
     warn_unphysical(model, terms)
-    if selection is not None and not gone and structure == selection.chosen:
-        selection = _per_recording_of(model, selection)
+    if selection is not None and structure == selection.chosen:
+        selection = _per_recording_of(model, selection, gone)
     heldout = _heldout_record(model, fitted if validation is None else validation)
     combined = _combined(robot, fitted, structure, drive, model.base)
     model = _recorded(model, exact, combined, heldout, structure, selection)
