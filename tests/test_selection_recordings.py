@@ -73,7 +73,8 @@ def test_alike_recordings_each_get_their_held_out_error_and_no_warning(panda, lo
     per = [r["heldout_error_percent"] for r in sel["heldout_per_recording"]]
     # the pooled held-out error is the root of the recordings' mean squares, weighted by
     # their torque energy; recordings of equal length and alike: close to the plain RMS
-    assert per == chosen["heldout_per_fold_percent"]
+    # the final fit's folds (its own base parameters): the search's to round-off
+    assert per == pytest.approx(chosen["heldout_per_fold_percent"], rel=1e-9)
     assert np.sqrt(np.mean(np.square(per))) == pytest.approx(
         chosen["heldout_error_percent"], rel=0.2
     )

@@ -60,7 +60,7 @@ def selection_lines(selection: Any) -> list[str]:
         out.append(
             f"  {mark} {name:<{w}} {c['n_params']:>6} {c['train_error_percent']:>9.4g} "
             f"{c['heldout_error_percent']:>11.4g}"
-            + (f" {c.get('heldout_whitened_percent') or float('nan'):>11.4g}" if white else "")
+            + (f" {_or_nan(c.get('heldout_whitened_percent')):>11.4g}" if white else "")
             + f" {_se_vs_best(c):>10}"
             + (f"  {_compact(dropped.split(' - '))}" if dropped and left else "")
         )
@@ -85,6 +85,11 @@ def selection_lines(selection: Any) -> list[str]:
         )
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
+
+
+def _or_nan(x: float | None) -> float:
+    """``x``, or nan for None (not known; a held-out error of 0 is one)."""
+    return float("nan") if x is None else float(x)
 
 
 def _told_apart(

@@ -72,7 +72,7 @@ from ..identification.candidates import RELATIVE_TIE, paired_fold_se
 from ..identification.dissipation import Violation
 from ..identification.holdout import DEFAULT_FOLDS, block_labels
 from ..identification.input_noise import quantized_noise_std
-from ..identification.structure import ERROR_FLOOR_PERCENT, smooth_width_grid
+from ..identification.structure import smooth_width_grid
 from ..identification.verdict import NOISE_FLOOR_SHARE
 from ..model.drive import Drive
 from .dissipative import law_violations
@@ -82,6 +82,7 @@ from .laws.base import _LinearFit, bounded_lstsq
 from .model import FrictionModel, FrictionSum, friction_parts
 
 __all__ = [
+    "ERROR_FLOOR_PERCENT",
     "FOLDS",
     "OWN",
     "RULE",
@@ -97,6 +98,10 @@ __all__ = [
 
 #: Number of contiguous blocks of the cross-validation (the identification's default).
 FOLDS = DEFAULT_FOLDS
+#: Held-out errors [%] closer than this count as equal: the laws' folds are judged through
+#: normal equations without the fit's coefficients as their origin, whose round-off on
+#: exact data is near 1e-6 %.
+ERROR_FLOOR_PERCENT = 1e-4
 #: Laws whose band is a width chosen on held-out data among
 #: :func:`~dynid.identification.structure.smooth_width_grid`, the grid ``identify``
 #: searches for the same law (the smooth Coulomb ``tanh(dq / w)``).

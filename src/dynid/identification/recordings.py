@@ -86,7 +86,7 @@ from .serial import Serial, serial_of_pieces
 from .spikes import despiked, spike_finding
 from .streaming import streams
 from .trim import common_cutoff, edge_seconds, within_edges
-from .velocity_noise import noise_band, velocity_noise_std
+from .velocity_noise import noise_band, pieces_noise_std
 
 __all__ = [
     "WRAP_SPAN",
@@ -176,7 +176,9 @@ class Recordings(TorqueRoute):
     band : ndarray, shape (n,)
         Standstill band [rad/s] per joint (motor, where the drive's friction acts there):
         the velocity noise band of the raw logs
-        (:func:`~dynid.identification.velocity_noise.noise_band`); for velocities derived from the
+        (:func:`~dynid.identification.velocity_noise.noise_band`; of velocities exact to
+        round-off, their rounding: :func:`~dynid.identification.velocity_noise.
+        pieces_noise_std`); for velocities derived from the
         positions, the noise they carry divided by ``band_gain``
         (:mod:`~dynid.identification.derived_band`).
     skipped : tuple of str
@@ -717,12 +719,10 @@ def _sides_band(
     n = sides[0].dq.shape[1] if K is None else K.shape[0]
     out = np.zeros(n)
     if measured:
-        dq = np.concatenate([x.dq for x in measured])
-        if K is not None:
-            dq = dq @ K.T
-        if dq.shape[0] >= 8:  # the times of joined pieces step back: left out there
-            t = np.concatenate([x.t for x in measured])
-            out = np.asarray(noise_band(velocity_noise_std(dq, t)), dtype=np.float64)
+        dq = [x.dq if K is None else x.dq @ K.T for x in measured]
+        if sum(v.shape[0] for v in dq) >= 8:  # the times of joined pieces step back
+            std = pieces_noise_std([(x.t, v) for x, v in zip(measured, dq, strict=True)])
+            out = np.asarray(noise_band(std), dtype=np.float64)
     cutoff, lowpassed, gain = derived
     of_q = [(x.t, x.q if K is None else x.q @ K.T) for x in sides if x.dq_derived]
     band = derived_velocity_band(of_q, cutoff, lowpassed=lowpassed) if of_q else None
