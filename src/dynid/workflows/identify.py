@@ -93,6 +93,7 @@ from .recordings import (
     Recorded,
     check_derived_velocities,
     check_limits,
+    check_sign_map,
     check_signs,
     check_torque_unit,
     check_unit_findings,
@@ -792,6 +793,9 @@ def _read_logs(
     rec, checked = usable_recorded(rec, checked, robot, opt.max_gap_s)
     check_units(checked)
     check_signs(checked.select(slice(len(logs), None)), robot)  # the held-out log's
+    # the recordings' sign under the --units given, before the fit's check of the torques
+    # as read hints the very flip applied
+    check_sign_map(checked.select(slice(0, len(logs))), robot, (opt.columns or (None, None))[1])
     check_torque_unit(checked, robot, cmap)
     return list(rec.logs[: len(logs)])
 

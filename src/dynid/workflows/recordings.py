@@ -112,6 +112,7 @@ __all__ = [
     "usable_velocities",
     "checked_accelerations",
     "check_limits",
+    "check_sign_map",
     "check_signs",
     "sign_findings",
     "warn_signs",
@@ -765,6 +766,19 @@ def check_signs(
         wrong = recorded_sign_map_findings(rec, robot, recorded, units).get(f.name)
         said = f.text if wrong is None else wrong.removeprefix(f"{f.name}: ")
         raise DataError(said, file=f.name)  # (the finding named the file: once)
+
+
+def check_sign_map(rec: Recorded, robot: Robot, units: str | None) -> None:
+    """Refuse a recording whose torques the ``--units`` given (``units``) read with the
+    wrong sign (:func:`recorded_sign_map_findings`): a file already in dynid's sign read
+    with ``tau=-1``, or a joint's ``tau3=-1`` its file does not need, confirmed by the
+    robot's rigid-body torques. The finding names the joints and hints the ``--units``
+    that read the files right given those applied (``tau=1``; ``tau=-1,b.csv:tau=-1``
+    when the other recordings read right), where the generic sign check of the torques
+    as read would hint the very flip applied. Nothing without ``units``, or when they
+    negate no torque."""
+    for name, said in recorded_sign_map_findings(rec, robot, None, units).items():
+        raise DataError(said.removeprefix(f"{name}: "), file=name)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:

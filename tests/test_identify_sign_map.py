@@ -1,0 +1,93 @@
+"""``identify`` under a ``--units`` whose torque signs read the files the wrong way (logs
+already in dynid's sign read with ``tau=-1``, or with a joint's ``tau3=-1`` they do not
+need): refused with the ``--units`` that read the files right given those applied, not
+the very flip applied (it once hinted ``--units tau=-1`` to a run given ``--units
+tau=-1``). Following the hint, the fit's residual falls to the simulated sensors' noise."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import re
+import warnings
+
+import numpy as np
+import pytest
+
+import dynid
+from dynid.cli.__main__ import main
+from dynid.exceptions import DynidWarning
+from dynid.io.torque_log import save_torque_log
+from dynid.simulation.measurement import SensorNoise
+
+from conftest import recordings
+
+#: The simulated torque sensors' noise [N m]: the truth the fit's residual falls to.
+TAU_STD = 0.01
+
+
+def _negated(log):
+    """``log`` with every torque column negated (a controller of the other convention)."""
+    return dataclasses.replace(log, tau=-log.tau)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """Two Panda logs in dynid's sign (a.csv, b.csv) and b.csv negated (nb.csv)."""
+    a, b = recordings(
+        dynid.panda(), (3, 4), friction=None, duration=3.0, noise=SensorNoise(tau_std=TAU_STD)
+    )
+    d = tmp_path_factory.mktemp("idsign")
+    save_torque_log(d / "a.csv", a)
+    save_torque_log(d / "b.csv", b)
+    save_torque_log(d / "na.csv", _negated(a))
+    return d
+
+
+def _identify(d, names, units, out, *extra):
+    """identify's exit code and its error line (the last one of stderr)."""
+    args = ["identify", "--robot", "panda", "--data", *(str(d / n) for n in names)]
+    args += ["--out", str(out), "--terms", "links", "--units", units, "--no-figures", *extra]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        return main(args)
+
+
+def _hint(text):
+    return re.search(r"hint: --units (\S+)", text).group(1)
+
+
+@pytest.mark.parametrize(
+    ("names", "units", "hint"),
+    [
+        (["a.csv", "b.csv"], "tau=-1", "tau=1"),
+        (["a.csv", "b.csv"], "tau=-1,tau3=-1", "tau=1"),
+        (["na.csv", "b.csv"], "tau=-1", "tau=-1,b.csv:tau=-1"),
+    ],
+    ids=["every-file", "every-joint-but-one", "one-file-of-two"],
+)
+def test_identify_hints_the_units_that_read_the_files_right(
+    files, tmp_path, capsys, names, units, hint
+):
+    """Refused naming the files' sign under the units given; the hint is no relative
+    flip (``tau=-1`` again) but the --units that read every file right; following it,
+    the residual is below the sensors' noise (0.01 N m; the filter lowers it)."""
+    assert _identify(files, names, units, tmp_path / "x") == 2
+    err = capsys.readouterr().err
+    assert "the sign map given (--units " + units + ")" in err
+    assert _hint(err) == hint
+    assert _identify(files, names, _hint(err), tmp_path / "y", "-q") == 0
+    fit = json.loads((tmp_path / "y" / "identification.json").read_text())
+    assert fit["residual_rms"] < TAU_STD
+
+
+def test_identify_consistent_hints_the_units_that_read_the_files_right(files, tmp_path, capsys):
+    """identify --consistent reads the files as identify does: the same hint."""
+    assert _identify(files, ["a.csv", "b.csv"], "tau=-1", tmp_path / "x", "--consistent") == 2
+    assert _hint(capsys.readouterr().err) == "tau=1"
+
+
+def test_units_that_read_the_files_right_are_not_doubted(files, tmp_path, capsys):
+    """na.csv negated, read with tau=-1: no sign finding."""
+    assert _identify(files, ["na.csv"], "tau=-1", tmp_path / "x", "-q") == 0
+    assert "sign" not in capsys.readouterr().err
