@@ -215,6 +215,7 @@ def identify_payload_files(
         drop_invalid=drop_invalid,
         cutoff_hz=known,
         drive=read_drive,
+        sign_map=True,
     )
     rec = read_recordings(
         paths, kin, owner=f"robot {kin.name!r}", q_start=q_start, max_gap_s=max_gap_s, **read_as

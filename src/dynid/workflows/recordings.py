@@ -74,7 +74,7 @@ from ..identification.log import (
     velocity_note,
     with_derived_velocities,
 )
-from ..identification.model_sign import every_joint_entry, sign_confirmed
+from ..identification.model_sign import every_joint_entry, flip_entries, sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
 from ..identification.recorded_signs import SignFinding, recording_sign_findings
 from ..identification.sanity import too_few_samples, torque_unit_finding
@@ -196,6 +196,7 @@ def read_recordings(
     max_gap_s: float | None = None,
     reference: Robot | None = None,
     signs: bool = False,
+    sign_map: bool = False,
 ) -> Recorded:
     """The torque logs of ``data`` (files, or folders of ``.csv``/``.npz`` files) of
     ``robot``, read and checked (module docstring).
@@ -228,6 +229,11 @@ def read_recordings(
         Warn of a recording of the opposite torque sign, naming its joints and the
         ``--units`` entries (:func:`warn_signs`, against ``reference``), as ``validate``
         does before judging it.
+    sign_map : bool
+        Refuse a recording whose torques the ``--units`` applied (those given, else
+        ``recorded``'s) read with the wrong sign, with the ``--units`` that read it right
+        (:func:`check_sign_map`, against ``reference``): before a fit, whose own sign
+        check of the torques as read would hint the very flip applied.
 
     Returns
     -------
@@ -268,6 +274,8 @@ def read_recordings(
     out, checked = usable_recorded(out, checked, robot, max_gap_s)  # units known right
     check_units(checked)
     check_derived_velocities(out, cmap)
+    if sign_map:
+        check_sign_map(checked, robot if reference is None else reference, mine[1], recorded)
     if signs:  # said, naming the joints: the verdict judges the log as it is
         warn_signs(checked, robot if reference is None else reference)
     check_torque_unit(checked, robot if reference is None else reference, cmap)
@@ -667,7 +675,10 @@ def recorded_sign_map_findings(
         wrong = tuple(k for k in ks if as_held[k] and not as_read[k])
         if wrong:
             found[name] = (negated, wrong, tuple(k for k in ks if as_read[k]))
-    alike = len(set(found.values())) == 1 and len(found) == len(rec.names)
+    # one hint reads every file when each found needs the same torques undone (which
+    # joints confirm it may differ: a load's wrist, one file's fast joint)
+    undone = {(f[0], _undone(*f, robot.n)) for f in found.values()}
+    alike = len(undone) == 1 and len(found) == len(rec.names)
     return {
         name: _sign_map_finding(
             _SignMap(name, said, units is None, robot.joint_names, alike or len(rec.names) == 1),
@@ -675,6 +686,16 @@ def recorded_sign_map_findings(
         )
         for name, f in found.items()
     }
+
+
+def _undone(
+    negated: tuple[int, ...], wrong: tuple[int, ...], right: tuple[int, ...], n: int
+) -> tuple[int, ...]:
+    """The joints whose negation a file's hint undoes (:func:`_sign_map_finding`): every
+    one negated when the map negates all ``n`` and none is confirmed as read (``right``:
+    the file in dynid's sign, its joints the model cannot tell with it), else those
+    confirmed as the file holds them (``wrong``)."""
+    return negated if not right and len(negated) == n else wrong
 
 
 @dataclass(frozen=True, slots=True)
@@ -697,14 +718,17 @@ def _sign_map_finding(
     """The words of :func:`recorded_sign_map_findings` for one recording: the torques of
     ``negated`` joints read negated, ``wrong`` of them confirmed as the file holds them,
     ``right`` as read."""
-    whole = not right and len(negated) == len(m.names)  # the file in dynid's sign throughout
-    undo = negated if whole else wrong
+    undo = _undone(negated, wrong, right, len(m.names))
+    whole = undo == negated and len(negated) == len(m.names)  # in dynid's sign throughout
     hint = units_negating(m.units, [k for k in negated if k not in undo], len(m.names))
     alone = ""  # the hint reads every file; with others that read right, this one's own
+    flips = parse_column_map(None, m.units).flips.get("tau", ())
     if not m.every and whole and m.name not in m.units:
         hint = f"{m.units},{every_joint_entry(m.name)}"
+    elif not m.every and m.name not in m.units and not set(undo) & set(flips):
+        hint = f"{m.units},{flip_entries(undo, m.name)}"  # (a file's flip adds to tau=-1)
     elif not m.every:
-        alone = " (validated on its own: they read every file given)"
+        alone = " (for this file alone: they read every file given)"
     joints = ", ".join(f"{m.names[k]} (tau{k + 1})" for k in wrong)
     whose = "the model's recorded sign map" if m.recorded else "the sign map given"
     untold = [k for k in negated if k not in wrong and k not in right]
@@ -768,16 +792,16 @@ def check_signs(
         raise DataError(said, file=f.name)  # (the finding named the file: once)
 
 
-def check_sign_map(rec: Recorded, robot: Robot, units: str | None) -> None:
-    """Refuse a recording whose torques the ``--units`` given (``units``) read with the
-    wrong sign (:func:`recorded_sign_map_findings`): a file already in dynid's sign read
-    with ``tau=-1``, or a joint's ``tau3=-1`` its file does not need, confirmed by the
-    robot's rigid-body torques. The finding names the joints and hints the ``--units``
-    that read the files right given those applied (``tau=1``; ``tau=-1,b.csv:tau=-1``
-    when the other recordings read right), where the generic sign check of the torques
-    as read would hint the very flip applied. Nothing without ``units``, or when they
-    negate no torque."""
-    for name, said in recorded_sign_map_findings(rec, robot, None, units).items():
+def check_sign_map(rec: Recorded, robot: Robot, units: str | None, recorded: Any = None) -> None:
+    """Refuse a recording whose torques the applied ``--units`` read with the wrong sign
+    (:func:`recorded_sign_map_findings`): ``units`` as given, else the model's
+    ``recorded`` ones (its ``info.column_map``). A file already in dynid's sign read with
+    ``tau=-1``, or a joint's ``tau3=-1`` its file does not need, confirmed by the robot's
+    rigid-body torques. The finding names the joints and hints the ``--units`` that read
+    the files right given those applied (``tau=1``; ``tau=-1,b.csv:tau=-1`` when the
+    other recordings read right), where the generic sign check of the torques as read
+    would hint the very flip applied. Nothing when the units applied negate no torque."""
+    for name, said in recorded_sign_map_findings(rec, robot, recorded, units).items():
         raise DataError(said.removeprefix(f"{name}: "), file=name)
 
 
