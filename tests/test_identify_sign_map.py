@@ -133,3 +133,18 @@ def test_payload_hints_the_units_that_read_the_files_right(tmp_path, capsys):
     assert _run("payload", tmp_path, names, _hint(err), tmp_path / "y", "-q") == 0
     doc = json.loads((tmp_path / "y" / "payload.json").read_text())
     assert abs(doc["mass"] - mass) < 4 * doc["std"]["mass"]
+
+
+def test_the_held_out_log_gets_its_own_entry_beside_the_units(files, tmp_path, capsys):
+    """--validate-on b.csv (in dynid's sign) beside na.csv (negated), given tau=-1: the
+    held-out log was refused with --units tau=-1 (read again as the flip applied); now
+    with --units tau=-1,b.csv:tau=-1, which reads both; following it, the fit's residual
+    is below the sensors' noise."""
+    extra = ("--validate-on", str(files / "b.csv"))
+    assert _identify(files, ["na.csv"], "tau=-1", tmp_path / "x", *extra) == 2
+    err = capsys.readouterr().err
+    assert "b.csv: the file looks already in dynid's sign" in err
+    assert _hint(err) == "tau=-1,b.csv:tau=-1"
+    assert _identify(files, ["na.csv"], _hint(err), tmp_path / "y", "-q", *extra) == 0
+    fit = json.loads((tmp_path / "y" / "identification.json").read_text())
+    assert fit["residual_rms"] < TAU_STD
