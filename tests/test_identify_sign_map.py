@@ -63,8 +63,9 @@ def _hint(text):
         (["a.csv", "b.csv"], "tau=-1", "tau=1"),
         (["a.csv", "b.csv"], "tau=-1,tau3=-1", "tau=1"),
         (["na.csv", "b.csv"], "tau=-1", "tau=-1,b.csv:tau=-1"),
+        (["a.csv", "b.csv"], "tau=-1,b.csv:tau=-1", "tau=1"),
     ],
-    ids=["every-file", "every-joint-but-one", "one-file-of-two"],
+    ids=["every-file", "every-joint-but-one", "one-file-of-two", "a-files-entry"],
 )
 def test_identify_hints_the_units_that_read_the_files_right(
     files, tmp_path, capsys, names, units, hint
@@ -148,3 +149,19 @@ def test_the_held_out_log_gets_its_own_entry_beside_the_units(files, tmp_path, c
     assert _identify(files, ["na.csv"], _hint(err), tmp_path / "y", "-q", *extra) == 0
     fit = json.loads((tmp_path / "y" / "identification.json").read_text())
     assert fit["residual_rms"] < TAU_STD
+
+
+def test_units_reading_writes_the_fewest_entries():
+    """The --units text that reads each file with its torques negated, by hand."""
+    from dynid.io.sign_entries import units_reading
+
+    assert units_reading("tau=-1", {"a.csv": [], "b.csv": []}, 6) == "tau=1"
+    assert units_reading("tau=-1", {"a.csv": range(6), "b.csv": []}, 6) == "tau=-1,b.csv:tau=-1"
+    assert units_reading("q=deg,tau=-1,b.csv:tau=-1", {"a.csv": [], "b.csv": [2]}, 6) == (
+        "q=deg,tau=1,b.csv:tau3=-1"
+    )
+    assert units_reading("tau=-1", {"a.csv": range(6), "b.csv": [0, 1, 3, 4, 5]}, 6) == (
+        "tau=-1,b.csv:tau3=-1"
+    )
+    flips = "tau3=-1,tau4=-1"  # every file's flips stay: b.csv's own entries add to them
+    assert units_reading(flips, {"a.csv": [2, 3], "b.csv": [2]}, 6) is None

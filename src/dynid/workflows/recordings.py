@@ -74,7 +74,7 @@ from ..identification.log import (
     velocity_note,
     with_derived_velocities,
 )
-from ..identification.model_sign import every_joint_entry, flip_entries, sign_confirmed
+from ..identification.model_sign import every_joint_entry, sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
 from ..identification.recorded_signs import SignFinding, recording_sign_findings
 from ..identification.sanity import too_few_samples, torque_unit_finding
@@ -87,7 +87,7 @@ from ..identification.unit_mix import (
 )
 from ..identification.velocity_noise import moving_joints
 from ..io.columns import CURRENT_UNITS, LEFT_OUT, ColumnMap, parse_column_map
-from ..io.sign_entries import tau_negated, units_negating
+from ..io.sign_entries import tau_negated, units_negating, units_reading
 from ..io.torque_log import declared_tau_unit
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -662,8 +662,10 @@ def recorded_sign_map_findings(
     except DataError:  # not a plain --units text: nothing to judge
         return {}
     found: dict[str, tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]] = {}
+    wanted: dict[str, set[int]] = {}  # each file's torques to read negated
     for name, log in zip(rec.names, rec.logs, strict=True):
         negated = tau_negated(cmap.for_file(name), log.tau.shape[1])
+        wanted[name] = set(negated)
         if not negated or too_few_samples(log) is not None:
             continue
         sign = np.ones(log.tau.shape[1])
@@ -675,13 +677,12 @@ def recorded_sign_map_findings(
         wrong = tuple(k for k in ks if as_held[k] and not as_read[k])
         if wrong:
             found[name] = (negated, wrong, tuple(k for k in ks if as_read[k]))
-    # one hint reads every file when each found needs the same torques undone (which
-    # joints confirm it may differ: a load's wrist, one file's fast joint)
-    undone = {(f[0], _undone(*f, robot.n)) for f in found.values()}
-    alike = len(undone) == 1 and len(found) == len(rec.names)
+    for name, f in found.items():  # (which joints confirm it may differ: a load's wrist)
+        wanted[name] ^= set(_undone(*f, robot.n))
+    hint = units_reading(said, wanted, robot.n) if found else None  # reads every file
     return {
         name: _sign_map_finding(
-            _SignMap(name, said, units is None, robot.joint_names, alike or len(rec.names) == 1),
+            _SignMap(name, said, units is None, robot.joint_names, len(rec.names) == 1, hint),
             *f,
         )
         for name, f in found.items()
@@ -702,14 +703,17 @@ def _undone(
 class _SignMap:
     """Whose sign map a finding judges (:func:`recorded_sign_map_findings`): the file's
     ``name``, the applied ``units``, whether they are the model's ``recorded`` ones, the
-    robot's joint ``names``, and whether the hint may read every file (``every``: one
-    recording, or every one found alike) or names this file's own entry."""
+    robot's joint ``names``, whether the hint may read every file (``every``: one
+    recording) or names this file's own entry, and the ``--units`` that read every file
+    right (``hint``, :func:`~dynid.io.sign_entries.units_reading`; None where a file's
+    own entries cannot)."""
 
     name: str
     units: str
     recorded: bool
     names: Sequence[str]
     every: bool
+    hint: str | None = None
 
 
 def _sign_map_finding(
@@ -722,11 +726,10 @@ def _sign_map_finding(
     whole = undo == negated and len(negated) == len(m.names)  # in dynid's sign throughout
     hint = units_negating(m.units, [k for k in negated if k not in undo], len(m.names))
     alone = ""  # the hint reads every file; with others that read right, this one's own
-    flips = parse_column_map(None, m.units).flips.get("tau", ())
-    if not m.every and whole and m.name not in m.units:
+    if m.hint is not None:
+        hint = m.hint
+    elif not m.every and whole and m.name not in m.units:
         hint = f"{m.units},{every_joint_entry(m.name)}"
-    elif not m.every and m.name not in m.units and not set(undo) & set(flips):
-        hint = f"{m.units},{flip_entries(undo, m.name)}"  # (a file's flip adds to tau=-1)
     elif not m.every:
         alone = " (for this file alone: they read every file given)"
     joints = ", ".join(f"{m.names[k]} (tau{k + 1})" for k in wrong)
