@@ -1,6 +1,9 @@
 """The torque signs a ``--units`` text reads a file with, and the ``--units`` text that
 reads it with others: a hint for a file whose torques the applied sign map reads the wrong
-way (``tau=-1`` applied to a file already in dynid's sign: ``tau=1``).
+way (``tau=-1`` applied to a file already in dynid's sign: ``tau=1``); of several files,
+the one text that reads each right (:func:`units_reading`: ``tau=-1,b.csv:tau=-1`` where
+b.csv alone is already in dynid's sign). ``validate``, ``identify``, ``friction``,
+``payload`` and ``observe`` hint it (``dynid.workflows.recordings.check_sign_map``).
 
 A file's torques on joint ``k`` are read negated when the ``tau`` factor is negative
 (``tau=-1``) or when a single joint's entry flips it (``tau3=-1``, or the file's own
