@@ -217,6 +217,7 @@ def fit_friction_files(
         q_start=opt.q_start,
         max_gap_s=max_gap_s,
         reference=model.equivalent_robot if isinstance(model, IdentifiedModel) else None,
+        sign_map=True,
     )
     rec, _ = despiked_recordings(rec, robot.joint_names, SPIKES_BEFORE_FIT)  # as identify
 

@@ -97,6 +97,7 @@ from .recordings import (
     Recorded,
     check_derived_velocities,
     check_limits,
+    check_sign_map,
     check_signs,
     check_torque_unit,
     check_unit_findings,
@@ -780,7 +781,9 @@ def _read_logs(
     from ``q_start`` (:func:`given_start`). The held-out log of ``opt.validate_on``
     (``heldout``, read) is checked with them, and its sign too
     (:func:`~dynid.workflows.recordings.check_signs`; the fit checks the recordings'):
-    judged on torques in other units or of the other sign, a held-out error says nothing."""
+    judged on torques in other units or of the other sign, a held-out error says nothing.
+    A recording the ``--units`` given read with the wrong torque sign is refused with the
+    ``--units`` that read it right (:func:`~dynid.workflows.recordings.check_sign_map`)."""
     logs = [
         read_torque_log(
             p,
@@ -806,7 +809,10 @@ def _read_logs(
     check_limits(checked, robot)
     rec, checked = usable_recorded(rec, checked, robot, opt.max_gap_s)
     check_units(checked)
-    check_signs(checked.select(slice(len(logs), None)), robot)  # the held-out log's
+    # every file's sign under the --units given (the fit's check of the torques as read
+    # would hint the flip applied), then the held-out log's as read (the fit checks the rest)
+    check_sign_map(checked, robot, (opt.columns or (None, None))[1])
+    check_signs(checked.select(slice(len(logs), None)), robot)
     check_torque_unit(checked, robot, cmap)
     return list(rec.logs[: len(logs)])
 

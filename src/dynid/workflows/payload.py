@@ -153,9 +153,8 @@ def identify_payload_files(
         Drop invalid rows (counted) instead of failing.
     cutoff_hz : float or "none", optional
         Torque logs: zero-phase low-pass cut-off [Hz]; default: the identification's
-        recorded one (with its decimation; none if it was identified without), else the
-        one read from the recordings' motion; ``"none"``
-        (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
+        recorded one (with its decimation; none if it was identified without), else the one
+        read from the motion; ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): none.
         Refused with static data, which are not filtered.
     max_gap_s : float, optional
         Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces.
@@ -167,8 +166,7 @@ def identify_payload_files(
         the arm's.
     q_start : tuple of float, optional
         Torque logs: the joint positions [rad] at the first sample of the one motor-side
-        log ``data`` whose motor encoders wrap every turn
-        (:func:`~dynid.workflows.recordings.given_start`).
+        log ``data`` whose encoders wrap (:func:`~dynid.workflows.recordings.given_start`).
     terms : str or Structure, optional
         Torque logs: the friction beside the load, as ``identify``'s ``terms`` names it
         (default ``"auto"``; :func:`~dynid.feasibility.payload.identify_payload`).
@@ -183,8 +181,9 @@ def identify_payload_files(
         ``frame`` is not a frame of the arm.
     DataError
         A bad file; several static data files; ``gravity_only`` with torque logs; a
-        recording in other units or without a piece long enough to filter (each named); one
-        ``arm`` was identified from, without ``unloaded``.
+        recording in other units, read with the wrong torque sign by the ``--units``
+        applied (hinting those that read it right) or without a piece long enough to filter
+        (each named); one ``arm`` was identified from, without ``unloaded``.
     OptionError
         ``terms`` with static data, or naming an unknown term, an armature or a spring.
     """
@@ -215,6 +214,7 @@ def identify_payload_files(
         drop_invalid=drop_invalid,
         cutoff_hz=known,
         drive=read_drive,
+        sign_map=True,
     )
     rec = read_recordings(
         paths, kin, owner=f"robot {kin.name!r}", q_start=q_start, max_gap_s=max_gap_s, **read_as

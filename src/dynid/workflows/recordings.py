@@ -87,7 +87,7 @@ from ..identification.unit_mix import (
 )
 from ..identification.velocity_noise import moving_joints
 from ..io.columns import CURRENT_UNITS, LEFT_OUT, ColumnMap, parse_column_map
-from ..io.sign_entries import tau_negated, units_negating
+from ..io.sign_entries import tau_negated, units_negating, units_reading
 from ..io.torque_log import declared_tau_unit
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -112,6 +112,7 @@ __all__ = [
     "usable_velocities",
     "checked_accelerations",
     "check_limits",
+    "check_sign_map",
     "check_signs",
     "sign_findings",
     "warn_signs",
@@ -195,6 +196,7 @@ def read_recordings(
     max_gap_s: float | None = None,
     reference: Robot | None = None,
     signs: bool = False,
+    sign_map: bool = False,
 ) -> Recorded:
     """The torque logs of ``data`` (files, or folders of ``.csv``/``.npz`` files) of
     ``robot``, read and checked (module docstring).
@@ -227,6 +229,11 @@ def read_recordings(
         Warn of a recording of the opposite torque sign, naming its joints and the
         ``--units`` entries (:func:`warn_signs`, against ``reference``), as ``validate``
         does before judging it.
+    sign_map : bool
+        Refuse a recording whose torques the ``--units`` applied (those given, else
+        ``recorded``'s) read with the wrong sign, with the ``--units`` that read it right
+        (:func:`check_sign_map`, against ``reference``): before a fit, whose own sign
+        check of the torques as read would hint the very flip applied.
 
     Returns
     -------
@@ -267,6 +274,8 @@ def read_recordings(
     out, checked = usable_recorded(out, checked, robot, max_gap_s)  # units known right
     check_units(checked)
     check_derived_velocities(out, cmap)
+    if sign_map:
+        check_sign_map(checked, robot if reference is None else reference, mine[1], recorded)
     if signs:  # said, naming the joints: the verdict judges the log as it is
         warn_signs(checked, robot if reference is None else reference)
     check_torque_unit(checked, robot if reference is None else reference, cmap)
@@ -653,8 +662,10 @@ def recorded_sign_map_findings(
     except DataError:  # not a plain --units text: nothing to judge
         return {}
     found: dict[str, tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]] = {}
+    wanted: dict[str, set[int]] = {}  # each file's torques to read negated
     for name, log in zip(rec.names, rec.logs, strict=True):
         negated = tau_negated(cmap.for_file(name), log.tau.shape[1])
+        wanted[name] = set(negated)
         if not negated or too_few_samples(log) is not None:
             continue
         sign = np.ones(log.tau.shape[1])
@@ -666,28 +677,43 @@ def recorded_sign_map_findings(
         wrong = tuple(k for k in ks if as_held[k] and not as_read[k])
         if wrong:
             found[name] = (negated, wrong, tuple(k for k in ks if as_read[k]))
-    alike = len(set(found.values())) == 1 and len(found) == len(rec.names)
+    for name, f in found.items():  # (which joints confirm it may differ: a load's wrist)
+        wanted[name] ^= set(_undone(*f, robot.n))
+    hint = units_reading(said, wanted, robot.n) if found else None  # reads every file
     return {
         name: _sign_map_finding(
-            _SignMap(name, said, units is None, robot.joint_names, alike or len(rec.names) == 1),
+            _SignMap(name, said, units is None, robot.joint_names, len(rec.names) == 1, hint),
             *f,
         )
         for name, f in found.items()
     }
 
 
+def _undone(
+    negated: tuple[int, ...], wrong: tuple[int, ...], right: tuple[int, ...], n: int
+) -> tuple[int, ...]:
+    """The joints whose negation a file's hint undoes (:func:`_sign_map_finding`): every
+    one negated when the map negates all ``n`` and none is confirmed as read (``right``:
+    the file in dynid's sign, its joints the model cannot tell with it), else those
+    confirmed as the file holds them (``wrong``)."""
+    return negated if not right and len(negated) == n else wrong
+
+
 @dataclass(frozen=True, slots=True)
 class _SignMap:
     """Whose sign map a finding judges (:func:`recorded_sign_map_findings`): the file's
     ``name``, the applied ``units``, whether they are the model's ``recorded`` ones, the
-    robot's joint ``names``, and whether the hint may read every file (``every``: one
-    recording, or every one found alike) or names this file's own entry."""
+    robot's joint ``names``, whether the hint may read every file (``every``: one
+    recording) or names this file's own entry, and the ``--units`` that read every file
+    right (``hint``, :func:`~dynid.io.sign_entries.units_reading`; None where a file's
+    own entries cannot)."""
 
     name: str
     units: str
     recorded: bool
     names: Sequence[str]
     every: bool
+    hint: str | None = None
 
 
 def _sign_map_finding(
@@ -696,14 +722,16 @@ def _sign_map_finding(
     """The words of :func:`recorded_sign_map_findings` for one recording: the torques of
     ``negated`` joints read negated, ``wrong`` of them confirmed as the file holds them,
     ``right`` as read."""
-    whole = not right and len(negated) == len(m.names)  # the file in dynid's sign throughout
-    undo = negated if whole else wrong
+    undo = _undone(negated, wrong, right, len(m.names))
+    whole = undo == negated and len(negated) == len(m.names)  # in dynid's sign throughout
     hint = units_negating(m.units, [k for k in negated if k not in undo], len(m.names))
     alone = ""  # the hint reads every file; with others that read right, this one's own
-    if not m.every and whole and m.name not in m.units:
+    if m.hint is not None:
+        hint = m.hint
+    elif not m.every and whole and m.name not in m.units:
         hint = f"{m.units},{every_joint_entry(m.name)}"
     elif not m.every:
-        alone = " (validated on its own: they read every file given)"
+        alone = " (for this file alone: they read every file given)"
     joints = ", ".join(f"{m.names[k]} (tau{k + 1})" for k in wrong)
     whose = "the model's recorded sign map" if m.recorded else "the sign map given"
     untold = [k for k in negated if k not in wrong and k not in right]
@@ -765,6 +793,19 @@ def check_signs(
         wrong = recorded_sign_map_findings(rec, robot, recorded, units).get(f.name)
         said = f.text if wrong is None else wrong.removeprefix(f"{f.name}: ")
         raise DataError(said, file=f.name)  # (the finding named the file: once)
+
+
+def check_sign_map(rec: Recorded, robot: Robot, units: str | None, recorded: Any = None) -> None:
+    """Refuse a recording whose torques the applied ``--units`` read with the wrong sign
+    (:func:`recorded_sign_map_findings`): ``units`` as given, else the model's
+    ``recorded`` ones (its ``info.column_map``). A file already in dynid's sign read with
+    ``tau=-1``, or a joint's ``tau3=-1`` its file does not need, confirmed by the robot's
+    rigid-body torques. The finding names the joints and hints the ``--units`` that read
+    the files right given those applied (``tau=1``; ``tau=-1,b.csv:tau=-1`` when the
+    other recordings read right), where the generic sign check of the torques as read
+    would hint the very flip applied. Nothing when the units applied negate no torque."""
+    for name, said in recorded_sign_map_findings(rec, robot, recorded, units).items():
+        raise DataError(said.removeprefix(f"{name}: "), file=name)
 
 
 def check_torque_unit(rec: Recorded, robot: Robot, cmap: ColumnMap | None) -> None:
