@@ -259,3 +259,28 @@ def test_report_headline_says_the_torque_constants_look_off():
     assert _gains_words({**doc, "named": []}) == "" and _gains_words(None) == ""
     torques = _gains_words({**doc, "effort": "torque", "per": "joint", "named": [1]})
     assert torques == "the torques of joint 2 read 0.667 times the true ones (scale by 1.5)"
+
+
+def test_a_gain_loose_over_the_folds_is_said_beside_a_named_one(panda):
+    """Joint 2 logged through 1.5 and joint 4 through 1.13 (1 % noise, three recordings),
+    judged at the noise floor: joint 2 is named; joint 4's factor, given a spread over the
+    folds of 0.17 (as a UR5 trial's wrist read it), is neither named nor vouched for: the
+    sentence gives its factor and spread; with its own spread it is named."""
+    rng = np.random.default_rng(12)
+    W, G, gd, tau = _panda_columns(panda, 12)
+    labels = np.repeat(np.arange(3), tau.shape[0] // 3)
+    truth = np.array([1.0, 1.5, 1.0, 1.13, 1.0, 1.0, 1.0])
+    noise = 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    found = drive_gains(
+        W, tau / truth + rng.normal(size=tau.shape) * noise, noise, None, G, gd, labels
+    )
+    assert found is not None and found.heldout_std is not None
+    np.testing.assert_allclose(found.factor[[1, 3]], truth[[1, 3]], rtol=0.02)
+    spread = found.heldout_std.copy()
+    spread[3] = 0.17  # as a wrist's gain spreads where the folds excite it unevenly
+    loose = dataclasses.replace(found, heldout_std=spread, floor=True)  # at the noise floor
+    assert 1 in loose.named and 3 not in loose.named and loose.vague == (3,)
+    said = loose.sentence()
+    assert said is not None and "joint 4's 1.13 (spread 0.17 over the folds)" in said, said
+    own = dataclasses.replace(found, floor=True)  # its own spread: named
+    assert own.vague == () and 3 in own.named

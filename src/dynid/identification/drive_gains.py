@@ -266,6 +266,21 @@ class DriveGains:
             return ()
         return tuple(int(k) for k in np.flatnonzero(self._off() & ~self.improves))
 
+    @property
+    def vague(self) -> tuple[int, ...]:
+        """The motors (from 0) neither :attr:`named` nor :attr:`unconfirmed` whose gain
+        reads at least :data:`OFF` from 1 yet spreads over the folds by at least
+        :data:`OFF` (:attr:`heldout_std`): determined too loosely to be a finding, too
+        loosely to vouch for the constant either (a UR5 trial's wrist motor 4 through a
+        constant 0.85 times the true one: 1.13 in-sample, 0.17 over the folds)."""
+        if self.heldout_std is None:
+            return ()
+        said = set(self.named) | set(self.unconfirmed)
+        d = np.abs(np.nan_to_num(self.factor, nan=1.0) - 1.0)
+        spread = np.nan_to_num(self.heldout_std, nan=0.0)
+        wide = self.determined & (d >= OFF) & (spread >= OFF * np.abs(self.factor))
+        return tuple(int(k) for k in np.flatnonzero(wide) if int(k) not in said)
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: ``factor`` and ``std`` per motor (null where left out), ``scaled``,
         ``ratio_fixed``, ``ratio_fitted``, ``ratio_held`` (per motor), ``determined`` and
@@ -345,6 +360,18 @@ class DriveGains:
             said += (
                 " not named: fitting it does not improve the prediction of the held-out "
                 "data by more than its standard error"
+            )
+        vague = self.vague
+        if vague:
+            spread = self.heldout_std
+            assert spread is not None  # vague motors have a spread over the folds
+            said += "; " + ", ".join(
+                f"{unit} {k + 1}'s {self.factor[k]:.3g} (spread {spread[k]:.2g} over the folds)"
+                for k in vague
+            )
+            said += (
+                " not named either: the data leave it that uncertain, so its torque_constant "
+                "may be off by that much unseen"
             )
         loose = ", ".join(str(k + 1) for k in np.flatnonzero(~self.determined))
         if loose:
