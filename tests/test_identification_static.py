@@ -588,3 +588,23 @@ def test_tall_qr_in_blocks_gives_numpys_triangular_factor(m):
     ref = np.linalg.qr(np.column_stack([W / scale, y]), mode="r")
     signs = np.sign(np.diag(R)) * np.sign(np.diag(ref))
     np.testing.assert_allclose(R * signs[:, None], ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_tall_pivoted_qr_in_blocks_gives_scipys_factors():
+    """The blocked pivoted QR of a tall matrix (three blocks and a short one, a column
+    nearly repeated) gives scipy's pivots, its R up to the signs of the rows, an
+    orthonormal Q and Q R = X[:, piv]."""
+    import scipy.linalg
+
+    from dynid.identification.solvers import tall_pivoted_qr
+
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(2048 * 3 + 7, 50)) * np.logspace(-2, 2, 50)
+    X[:, 3] = 2.0 * X[:, 5] + 1e-9 * X[:, 7]
+    Q, R, piv = tall_pivoted_qr(X)
+    Qr, Rr, pr = scipy.linalg.qr(X, mode="economic", pivoting=True)
+    np.testing.assert_array_equal(piv, pr)
+    signs = np.sign(np.diag(R)) * np.sign(np.diag(Rr))
+    np.testing.assert_allclose(R * signs[:, None], Rr, rtol=0, atol=1e-12 * np.abs(Rr).max())
+    np.testing.assert_allclose(Q.T @ Q, np.eye(50), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(Q @ R, X[:, piv], rtol=0, atol=1e-12 * np.abs(X).max())

@@ -22,6 +22,7 @@ __all__ = [
     "StdMethod",
     "block_grams",
     "checked_std",
+    "tall_pivoted_qr",
     "unexcited_columns",
     "unexcited_combinations",
 ]
@@ -357,6 +358,45 @@ def _geqrf_r(A: NDArray[np.float64]) -> NDArray[np.float64]:
     if info != 0:  # pragma: no cover - LAPACK argument error
         raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
     return np.triu(qr[: min(A.shape)])
+
+
+def tall_pivoted_qr(
+    X: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]:
+    """Economic QR with column pivoting ``X[:, piv] = Q R`` of ``X`` (M, p): ``Q`` (M, p)
+    orthonormal, ``R`` (p, p) upper triangular, ``piv`` (p,), as ``scipy.linalg.qr(X,
+    mode="economic", pivoting=True)`` (the same ``R`` up to the signs of its rows and
+    ``Q`` of its columns, the same pivots). A tall ``X`` (M >= 4 p, several blocks) is
+    factored in blocks of :data:`_QR_BLOCK_ROWS` rows without pivoting, the stacked
+    factors with pivoting (the column norms the pivots follow are the same), and ``Q``
+    assembled block by block: a third of the time of LAPACK's pivoted QR over rows that
+    leave the cache."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
+    M, p = X.shape
+    if M < 4 * p or M <= 2 * _QR_BLOCK_ROWS:
+        Q, R, piv = scipy.linalg.qr(X, mode="economic", pivoting=True)
+        return Q, R, piv
+    lapack = scipy.linalg.lapack
+    factors, parts = [], []
+    for a in range(0, M, _QR_BLOCK_ROWS):
+        blk = np.asfortranarray(X[a : a + _QR_BLOCK_ROWS])
+        qr, tau, _, info = lapack.dgeqrf(blk, overwrite_a=True)
+        if info != 0:  # pragma: no cover - LAPACK argument error
+            raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
+        factors.append((qr, tau))
+        parts.append(np.triu(qr[: min(qr.shape)]))
+    Q2, R, piv = scipy.linalg.qr(np.vstack(parts), mode="economic", pivoting=True)
+    Q = np.empty((M, p))
+    a = o = 0
+    for (qr, tau), part in zip(factors, parts, strict=True):
+        k = part.shape[0]
+        Qb, _, info = lapack.dorgqr(qr[:, :k], tau, overwrite_a=1)
+        if info != 0:  # pragma: no cover - LAPACK argument error
+            raise RankDeficientError(f"LAPACK dorgqr failed with info={info}")
+        Q[a : a + qr.shape[0]] = Qb @ Q2[o : o + k]
+        a, o = a + qr.shape[0], o + k
+    return Q, R, piv
 
 
 def _solve_qr(
