@@ -578,13 +578,13 @@ def test_identify_static_is_the_same_with_the_numpy_regressor(monkeypatch, noise
 def test_tall_qr_in_blocks_gives_numpys_triangular_factor(m):
     """The blocked (tall-skinny) factor of [W / scale, y] equals numpy's QR's R up to the
     signs of its rows, a short last block included (5 rows under 41 columns)."""
-    from dynid.identification.solvers import _tall_r
+    from dynid.identification.solvers import tall_r
 
     rng = np.random.default_rng(m)
     W = rng.normal(size=(m, 40)) * np.logspace(-3, 3, 40)
     y = rng.normal(size=m)
     scale = np.linalg.norm(W, axis=0)
-    R = _tall_r(W, scale, y)
+    R = tall_r(W, scale, y)
     ref = np.linalg.qr(np.column_stack([W / scale, y]), mode="r")
     signs = np.sign(np.diag(R)) * np.sign(np.diag(ref))
     np.testing.assert_allclose(R * signs[:, None], ref, rtol=0, atol=1e-12 * np.abs(ref).max())

@@ -23,6 +23,7 @@ __all__ = [
     "block_grams",
     "checked_std",
     "tall_pivoted_qr",
+    "tall_r",
     "unexcited_columns",
     "unexcited_combinations",
 ]
@@ -322,28 +323,29 @@ def _solve_semi_normal(
     return rk, cond, bk, e, cov_s, scale, cond_u, vmin
 
 
-#: Rows of each block of :func:`_tall_r`: a block and its factor stay in cache.
+#: Rows of each block of :func:`tall_r`: a block and its factor stay in cache.
 _QR_BLOCK_ROWS = 2048
 
 
-def _tall_r(
+def tall_r(
     Wk: NDArray[np.float64], scale: NDArray[np.float64], y: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """The upper triangular factor (k+1, k+1) of ``[Wk / scale, y]`` (m, k+1), m > k+1, by
-    unpivoted Householder QR (LAPACK ``geqrf``) of blocks of :data:`_QR_BLOCK_ROWS` rows,
-    then of their factors stacked (tall-skinny QR: the same factor up to the signs of its
-    rows, in about half the time of one ``geqrf`` over rows that leave the cache)."""
-    m, k = Wk.shape[0], Wk.shape[1] + 1
+    """The upper triangular factor (k, k) of ``[Wk / scale, y]`` (m, k), ``y`` (m,) or (m,
+    q), m > k, by unpivoted Householder QR (LAPACK ``geqrf``) of blocks of
+    :data:`_QR_BLOCK_ROWS` rows, then of their factors stacked (tall-skinny QR: the same
+    factor up to the signs of its rows, in about half the time of one ``geqrf`` over rows
+    that leave the cache)."""
+    Y = y.reshape(y.shape[0], -1)
+    m, c = Wk.shape
+    k = c + Y.shape[1]
     parts: list[NDArray[np.float64]] = []
     for a in range(0, m, _QR_BLOCK_ROWS):
         b = min(a + _QR_BLOCK_ROWS, m)
-        if b - a < k and parts:  # a short last block joins the factors' QR as it is
-            parts.append(np.column_stack([Wk[a:b] / scale, y[a:b]]))
-            continue
         blk = np.empty((b - a, k), order="F")
-        np.divide(Wk[a:b], scale, out=blk[:, : k - 1])
-        blk[:, k - 1] = y[a:b]
-        parts.append(_geqrf_r(blk))
+        np.divide(Wk[a:b], scale, out=blk[:, :c])
+        blk[:, c:] = Y[a:b]
+        # a short last block joins the factors' QR as it is
+        parts.append(blk if b - a < k and parts else _geqrf_r(blk))
     if len(parts) == 1:
         return parts[0]
     return _geqrf_r(np.asfortranarray(np.vstack(parts)))
@@ -427,7 +429,7 @@ def _solve_qr(
     scale = np.where(norms > 0, norms, 1.0)
     if m > 4 * (rk + 1):
         # stage 1: R of [Ws y] (its last column holds Q0^T y)
-        R0 = _tall_r(Wk, scale, y)
+        R0 = tall_r(Wk, scale, y)
         A, b = R0[:rk, :rk], R0[:rk, rk]
     else:
         A, b = Wk / scale, y
