@@ -12,6 +12,7 @@ import pytest
 from dynid.exceptions import OptionError
 from dynid.identification.holdout import (
     HeldOut,
+    _factored,
     block_labels,
     block_normals,
     cross_validate,
@@ -95,3 +96,31 @@ def test_shared_eigen_solves_rows_of_the_same_gram_with_their_own_targets():
             np.testing.assert_allclose(x, ref, rtol=1e-10, atol=1e-12)
             assert sd is not None
             np.testing.assert_allclose(sd, np.sqrt(var), rtol=1e-8)
+
+
+@pytest.mark.parametrize("case", ["well-conditioned", "ill-conditioned", "rank-deficient"])
+def test_normal_equations_solve_as_lstsq_whichever_factorisation(case):
+    """Normals.solve_with_std predicts as numpy's least squares on the rows: a
+    well-conditioned G by Cholesky (its coefficients and classical standard deviations
+    those of numpy's inverse too), an ill-conditioned one (cond 1.6e8 scaled: to cond *
+    eps) or a singular one (a repeated column) by its eigenpairs."""
+    rng = np.random.default_rng(12)
+    W = rng.normal(size=(400, 6)) * np.logspace(-3, 3, 6)  # scales: column scaling undoes
+    if case == "ill-conditioned":
+        W[:, 5] = W[:, 4] * 1e3 + 10.0 * rng.normal(size=400)
+    if case == "rank-deficient":
+        W[:, 5] = 2.0 * W[:, 4]
+    y = W @ rng.normal(size=6) + 0.1 * rng.normal(size=400)
+    n = block_normals(W, y, np.zeros(400, np.intp))[0]
+    assert (_factored(n.G, 1e-10)[2] is None) == (case == "well-conditioned")
+    x, sd = n.solve_with_std()
+    assert sd is not None
+    d = np.linalg.norm(W, axis=0)
+    ref = np.linalg.lstsq(W / d, y, rcond=1e-10)[0] / d  # minimum norm in scaled columns
+    tol = 1e-10 if case == "well-conditioned" else 1e-7  # cond(G) * eps: 2e-15, 4e-8
+    np.testing.assert_allclose(W @ x, W @ ref, rtol=tol, atol=1e-12 * np.abs(y).max())
+    if case == "well-conditioned":
+        np.testing.assert_allclose(x, ref, rtol=1e-10)
+        r = y - W @ ref
+        var = (r @ r) / (400 - 6) * np.diag(np.linalg.inv(W.T @ W))
+        np.testing.assert_allclose(sd, np.sqrt(var), rtol=1e-6)

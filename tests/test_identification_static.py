@@ -572,3 +572,39 @@ def test_identify_static_is_the_same_with_the_numpy_regressor(monkeypatch, noise
     assert compiled.info.dropped_rows == numpy_path.info.dropped_rows == ("g1",)
     np.testing.assert_allclose(compiled.beta, numpy_path.beta, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(compiled.fit.std, numpy_path.fit.std, rtol=1e-10)
+
+
+@pytest.mark.parametrize("m", [300, 2048 * 3 + 5, 2048 * 2 + 40])
+def test_tall_qr_in_blocks_gives_numpys_triangular_factor(m):
+    """The blocked (tall-skinny) factor of [W / scale, y] equals numpy's QR's R up to the
+    signs of its rows, a short last block included (5 rows under 41 columns)."""
+    from dynid.identification.solvers import tall_r
+
+    rng = np.random.default_rng(m)
+    W = rng.normal(size=(m, 40)) * np.logspace(-3, 3, 40)
+    y = rng.normal(size=m)
+    scale = np.linalg.norm(W, axis=0)
+    R = tall_r(W, scale, y)
+    ref = np.linalg.qr(np.column_stack([W / scale, y]), mode="r")
+    signs = np.sign(np.diag(R)) * np.sign(np.diag(ref))
+    np.testing.assert_allclose(R * signs[:, None], ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_tall_pivoted_qr_in_blocks_gives_scipys_factors():
+    """The blocked pivoted QR of a tall matrix (three blocks and a short one, a column
+    nearly repeated) gives scipy's pivots, its R up to the signs of the rows, an
+    orthonormal Q and Q R = X[:, piv]."""
+    import scipy.linalg
+
+    from dynid.identification.solvers import tall_pivoted_qr
+
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(2048 * 3 + 7, 50)) * np.logspace(-2, 2, 50)
+    X[:, 3] = 2.0 * X[:, 5] + 1e-9 * X[:, 7]
+    Q, R, piv = tall_pivoted_qr(X)
+    Qr, Rr, pr = scipy.linalg.qr(X, mode="economic", pivoting=True)
+    np.testing.assert_array_equal(piv, pr)
+    signs = np.sign(np.diag(R)) * np.sign(np.diag(Rr))
+    np.testing.assert_allclose(R * signs[:, None], Rr, rtol=0, atol=1e-12 * np.abs(Rr).max())
+    np.testing.assert_allclose(Q.T @ Q, np.eye(50), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(Q @ R, X[:, piv], rtol=0, atol=1e-12 * np.abs(X).max())

@@ -277,3 +277,18 @@ def test_observe_moving_the_states_finds_no_position_jump(panda, delay_ms):
         )
     (span,) = prep.spans
     assert prep.log.t[span[0]] >= delay_ms / 1e3 and prep.log.t[span[1] - 1] <= 3.0 - delay_ms / 1e3
+
+
+def test_the_model_columns_are_projected_out_as_by_lstsq_with_its_rank_cut():
+    """The delay's and the residual's parts the model's columns take (a tall matrix with a
+    repeated column, rank 29 of 30) are numpy lstsq's at rcond 1e-10: the same fitted
+    columns from the blocked triangular factor."""
+    from dynid.identification.torque_delay import _projected
+
+    rng = np.random.default_rng(5)
+    A = rng.normal(size=(9000, 30))
+    A[:, 7] = A[:, 3]
+    A /= np.linalg.norm(A, axis=0)
+    B = A @ rng.normal(size=(30, 2)) + rng.normal(size=(9000, 2))
+    ref = np.linalg.lstsq(A, B, rcond=1e-10)[0]
+    np.testing.assert_allclose(A @ _projected(A, B), A @ ref, rtol=0, atol=1e-12)

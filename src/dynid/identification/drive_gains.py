@@ -47,6 +47,8 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .solvers import tall_pivoted_qr
+
 __all__ = [
     "DETERMINED",
     "EXPLAINED",
@@ -690,9 +692,7 @@ class _Factored:
     @classmethod
     def of(cls, X: NDArray[np.float64]) -> _Factored:
         """The factors of ``X`` (rows, p)."""
-        import scipy.linalg  # here: the command's start loads no scipy
-
-        Q, R, piv = scipy.linalg.qr(X, mode="economic", pivoting=True)
+        Q, R, piv = tall_pivoted_qr(X)
         d = np.abs(np.diag(R))
         r = int(np.count_nonzero(d > _RANK_RTOL * max(float(d[0]) if d.size else 0.0, 1e-300)))
         return cls(np.asarray(Q[:, :r]), np.asarray(R[:r, :r]), np.asarray(piv[:r]))

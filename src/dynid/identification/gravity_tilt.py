@@ -179,11 +179,14 @@ def gravity_tilt(
         W = np.asarray(columns(rows), dtype=np.float64)
         Ww = (W / s[:, None]).reshape(rows.size * n, -1)
         Gw = (G / s[:, None]).reshape(-1, 2)
-        G = G - W @ np.linalg.lstsq(Ww, Gw, rcond=None)[0]  # (one weight per row)
         T = np.asarray(tau, dtype=np.float64)[rows]
         tw = (T / s).reshape(-1)
-        r = T - W @ np.linalg.lstsq(Ww, tw, rcond=None)[0]
-        dof = int(np.linalg.matrix_rank(Ww))
+        # one factorisation for the tilt's columns, the torques and the rank (lstsq's
+        # default rcond is matrix_rank's tolerance): a third of three (one weight per row)
+        both, _, rank, _ = np.linalg.lstsq(Ww, np.column_stack([Gw, tw]), rcond=None)
+        G = G - W @ both[:, :2]
+        r = T - W @ both[:, 2]
+        dof = int(rank)
     Gw = (G / s[:, None]).reshape(-1, 2)
     rw = (r / s).reshape(-1)
     above = float(np.mean(rw**2)) - (1.0 - dof / rw.size)

@@ -53,25 +53,57 @@ DEFAULT_FOLDS = 5
 #: Fewest samples a block may hold.
 MIN_BLOCK_SAMPLES = 10
 
-_Eigen = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
-#: The column-scaled eigendecompositions :meth:`Normals.solve` made while
-#: :func:`shared_eigen` is active: (shape, ``G``'s bytes, rtol) -> (d, s, U), read only,
-#: the most recently used first to stay.
-_EIGEN: ContextVar[OrderedDict[Hashable, _Eigen] | None] = ContextVar("_EIGEN", default=None)
-#: Eigendecompositions :func:`shared_eigen` holds at most (the least recently used
+#: The column scales ``d`` (p,) and a factorisation of the column-scaled ``G``: ``(d, R,
+#: None)`` with ``R`` (p, p) its upper Cholesky factor, or ``(d, U, s)`` its eigenpairs kept.
+_Factor = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]
+#: The column-scaled factorisations :meth:`Normals.solve` made while
+#: :func:`shared_eigen` is active: (shape, ``G``'s bytes, rtol) -> :data:`_Factor`, read
+#: only, the most recently used first to stay.
+_EIGEN: ContextVar[OrderedDict[Hashable, _Factor] | None] = ContextVar("_EIGEN", default=None)
+#: Factorisations :func:`shared_eigen` holds at most (the least recently used
 #: dropped first): about 40 MB for 70 columns, with their keys.
 EIGEN_HELD = 512
 
 
 @contextmanager
 def shared_eigen() -> Iterator[None]:
-    """Within the block, the eigendecomposition behind :meth:`Normals.solve` and
+    """Within the block, the factorisation behind :meth:`Normals.solve` and
     :meth:`Normals.std` of normal equations whose ``G`` holds the same numbers is computed
     once and read back (a structure search judges the same columns of the same folds
     again: 16 % of its solves on a Panda log's tests): the same numbers, not recomputed.
     Nested blocks share the outer one's; what it holds is dropped at its end."""
     with scoped(_EIGEN, OrderedDict):
         yield
+
+
+#: The column-scaled ``G`` is solved by Cholesky when LAPACK's estimate of its reciprocal
+#: condition number (1-norm) is above this: its solution then equals the eigenvectors' to
+#: round-off (at most ``cond * eps``, 1e-10 relative) at a tenth of the cost.
+CHOLESKY_RCOND = 1e-6
+
+
+def _factored(G: NDArray[np.float64], rtol: float) -> _Factor:
+    """The column scales ``d`` (``sqrt(diag G)``, 1 for a zero column) and the column-scaled
+    ``G``'s factorisation: Cholesky when it is well conditioned (:data:`CHOLESKY_RCOND`,
+    and far from any eigenvalue ``rtol^2`` times the largest would leave out: every
+    direction is kept, the unique solution), else its eigenpairs with a scaled eigenvalue
+    below ``rtol^2`` times the largest left out."""
+    from scipy.linalg.lapack import dpocon, dpotrf
+
+    d = np.sqrt(np.maximum(np.diag(G), 0.0))
+    d = np.where(d > 0, d, 1.0)
+    Gs = G / np.outer(d, d)
+    Gs = 0.5 * (Gs + Gs.T)
+    if Gs.size:
+        R, info = dpotrf(Gs, lower=0, clean=1)
+        if info == 0:
+            rcond, info = dpocon(R, float(np.abs(Gs).sum(axis=0).max()))
+            floor = max(CHOLESKY_RCOND, 1e4 * Gs.shape[0] * rtol**2)
+            if info == 0 and rcond > floor:
+                return d, np.asarray(R, dtype=np.float64), None
+    s, U = np.linalg.eigh(Gs)
+    keep = s > (rtol**2) * max(float(s[-1]), 0.0) if s.size else s > 0
+    return d, U[:, keep], s[keep]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -143,36 +175,25 @@ class Normals:
         """``100 ||W x - y|| / ||y||``."""
         return 100.0 * math.sqrt(self.sse(x) / self.c) if self.c > 0 else 0.0
 
-    def _scaled_eigen(
-        self, rtol: float
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """The column scales ``d`` and the eigenpairs ``s, U`` of the column-scaled ``G``
-        kept (a scaled eigenvalue below ``rtol^2`` times the largest left out); read from
-        :func:`shared_eigen` when it holds them."""
+    def _scaled_eigen(self, rtol: float) -> _Factor:
+        """The column scales ``d`` and a factorisation of the column-scaled ``G``
+        (:func:`_factored`); read from :func:`shared_eigen` when it holds it."""
         held = _EIGEN.get()
         if held is None:
-            return self._eigen(rtol)
+            return _factored(self.G, rtol)
         key = (self.G.shape, self.G.dtype.str, self.G.tobytes(), float(rtol))
         got = held.get(key)
         if got is not None:
             held.move_to_end(key)
             return got
-        got = self._eigen(rtol)
+        got = _factored(self.G, rtol)
         for a in got:
-            a.flags.writeable = False
+            if a is not None:
+                a.flags.writeable = False
         held[key] = got
         if len(held) > EIGEN_HELD:
             held.popitem(last=False)
         return got
-
-    def _eigen(self, rtol: float) -> _Eigen:
-        """:meth:`_scaled_eigen` computed."""
-        d = np.sqrt(np.maximum(np.diag(self.G), 0.0))
-        d = np.where(d > 0, d, 1.0)
-        Gs = self.G / np.outer(d, d)
-        s, U = np.linalg.eigh(0.5 * (Gs + Gs.T))
-        keep = s > (rtol**2) * max(float(s[-1]), 0.0) if s.size else s > 0
-        return d, s[keep], U[:, keep]
 
     def solve(self, rtol: float = 1e-10) -> NDArray[np.float64]:
         """Least-squares ``x`` (p,): minimum norm in the column-scaled coordinates,
@@ -183,26 +204,31 @@ class Normals:
         """Classical standard deviations (p,) of the least-squares ``x``:
         ``sqrt(diag(sigma^2 G^+))`` with ``sigma^2 = ||W x - y||^2 / (rows - p)`` and the
         pseudo-inverse of :meth:`solve` (0 for a direction left out)."""
-        d, s, U = self._scaled_eigen(rtol)
-        return self._std(x, d, s, U)
+        return self._std(x, self._scaled_eigen(rtol))
 
     def solve_with_std(
         self, rtol: float = 1e-10, *, std: bool = True
     ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
         """:meth:`solve` and (``std``) :meth:`std` of its solution from one
-        eigendecomposition."""
-        d, s, U = self._scaled_eigen(rtol)
-        x = np.asarray((U @ ((U.T @ (self.b / d)) / s)) / d, dtype=np.float64)
-        return x, self._std(x, d, s, U) if std else None
+        factorisation."""
+        f = self._scaled_eigen(rtol)
+        d, A, s = f
+        if s is None:  # Cholesky: A = R, upper, with R^T R the scaled G
+            from scipy.linalg.lapack import dpotrs
 
-    def _std(
-        self,
-        x: NDArray[np.float64],
-        d: NDArray[np.float64],
-        s: NDArray[np.float64],
-        U: NDArray[np.float64],
-    ) -> NDArray[np.float64]:
-        var = np.sum(U**2 / s, axis=1) / d**2
+            x = np.asarray(dpotrs(A, self.b / d, lower=0)[0] / d, dtype=np.float64)
+        else:
+            x = np.asarray((A @ ((A.T @ (self.b / d)) / s)) / d, dtype=np.float64)
+        return x, self._std(x, f) if std else None
+
+    def _std(self, x: NDArray[np.float64], f: _Factor) -> NDArray[np.float64]:
+        d, A, s = f
+        if s is None:  # diag((R^T R)^-1): the rows' squares of R^-1
+            from scipy.linalg.lapack import dtrtri
+
+            var = np.sum(dtrtri(A, lower=0)[0] ** 2, axis=1) / d**2
+        else:
+            var = np.sum(A**2 / s, axis=1) / d**2
         s2 = self.sse(x) / max(self.rows - self.p, 1)
         return np.asarray(np.sqrt(s2 * var), dtype=np.float64)
 

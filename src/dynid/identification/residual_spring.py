@@ -178,9 +178,9 @@ def residual_spring(
     if A.shape[0] <= A.shape[1]:
         return None
     y = (np.asarray(tau, dtype=np.float64)[rows] / s).reshape(-1)
-    x, *_ = np.linalg.lstsq(A, y, rcond=None)
+    x, _, rank, _ = np.linalg.lstsq(A, y, rcond=None)  # its rank matrix_rank's, one SVD
     r = y - A @ x
-    dof = int(np.linalg.matrix_rank(A))
+    dof = int(rank)
     var = max(float(r @ r) / max(r.size - dof, 1), 1.0)
     cov = np.linalg.pinv(A.T @ A)[-n:, -n:] * var
     k = np.asarray(x[-n:], dtype=np.float64)

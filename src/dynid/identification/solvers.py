@@ -22,6 +22,8 @@ __all__ = [
     "StdMethod",
     "block_grams",
     "checked_std",
+    "tall_pivoted_qr",
+    "tall_r",
     "unexcited_columns",
     "unexcited_combinations",
 ]
@@ -321,6 +323,84 @@ def _solve_semi_normal(
     return rk, cond, bk, e, cov_s, scale, cond_u, vmin
 
 
+#: Rows of each block of :func:`tall_r`: a block and its factor stay in cache.
+_QR_BLOCK_ROWS = 2048
+
+
+def tall_r(
+    Wk: NDArray[np.float64], scale: NDArray[np.float64], y: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The upper triangular factor (k, k) of ``[Wk / scale, y]`` (m, k), ``y`` (m,) or (m,
+    q), m > k, by unpivoted Householder QR (LAPACK ``geqrf``) of blocks of
+    :data:`_QR_BLOCK_ROWS` rows, then of their factors stacked (tall-skinny QR: the same
+    factor up to the signs of its rows, in about half the time of one ``geqrf`` over rows
+    that leave the cache)."""
+    Y = y.reshape(y.shape[0], -1)
+    m, c = Wk.shape
+    k = c + Y.shape[1]
+    parts: list[NDArray[np.float64]] = []
+    for a in range(0, m, _QR_BLOCK_ROWS):
+        b = min(a + _QR_BLOCK_ROWS, m)
+        blk = np.empty((b - a, k), order="F")
+        np.divide(Wk[a:b], scale, out=blk[:, :c])
+        blk[:, c:] = Y[a:b]
+        # a short last block joins the factors' QR as it is
+        parts.append(blk if b - a < k and parts else _geqrf_r(blk))
+    if len(parts) == 1:
+        return parts[0]
+    return _geqrf_r(np.asfortranarray(np.vstack(parts)))
+
+
+def _geqrf_r(A: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The upper triangular factor (min(M, k), k) of ``A`` (M, k), column-major,
+    overwritten by LAPACK ``geqrf`` in place."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
+    qr, _, _, info = scipy.linalg.lapack.dgeqrf(A, overwrite_a=True)
+    if info != 0:  # pragma: no cover - LAPACK argument error
+        raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
+    return np.triu(qr[: min(A.shape)])
+
+
+def tall_pivoted_qr(
+    X: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]:
+    """Economic QR with column pivoting ``X[:, piv] = Q R`` of ``X`` (M, p): ``Q`` (M, p)
+    orthonormal, ``R`` (p, p) upper triangular, ``piv`` (p,), as ``scipy.linalg.qr(X,
+    mode="economic", pivoting=True)`` (the same ``R`` up to the signs of its rows and
+    ``Q`` of its columns, the same pivots). A tall ``X`` (M >= 4 p, several blocks) is
+    factored in blocks of :data:`_QR_BLOCK_ROWS` rows without pivoting, the stacked
+    factors with pivoting (the column norms the pivots follow are the same), and ``Q``
+    assembled block by block: a third of the time of LAPACK's pivoted QR over rows that
+    leave the cache."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
+    M, p = X.shape
+    if M < 4 * p or M <= 2 * _QR_BLOCK_ROWS:
+        Q, R, piv = scipy.linalg.qr(X, mode="economic", pivoting=True)
+        return Q, R, piv
+    lapack = scipy.linalg.lapack
+    factors, parts = [], []
+    for a in range(0, M, _QR_BLOCK_ROWS):
+        blk = np.asfortranarray(X[a : a + _QR_BLOCK_ROWS])
+        qr, tau, _, info = lapack.dgeqrf(blk, overwrite_a=True)
+        if info != 0:  # pragma: no cover - LAPACK argument error
+            raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
+        factors.append((qr, tau))
+        parts.append(np.triu(qr[: min(qr.shape)]))
+    Q2, R, piv = scipy.linalg.qr(np.vstack(parts), mode="economic", pivoting=True)
+    Q = np.empty((M, p))
+    a = o = 0
+    for (qr, tau), part in zip(factors, parts, strict=True):
+        k = part.shape[0]
+        Qb, _, info = lapack.dorgqr(qr[:, :k], tau, overwrite_a=1)
+        if info != 0:  # pragma: no cover - LAPACK argument error
+            raise RankDeficientError(f"LAPACK dorgqr failed with info={info}")
+        Q[a : a + qr.shape[0]] = Qb @ Q2[o : o + k]
+        a, o = a + qr.shape[0], o + k
+    return Q, R, piv
+
+
 def _solve_qr(
     Wk: NDArray[np.float64],
     y: NDArray[np.float64],
@@ -348,15 +428,8 @@ def _solve_qr(
     norms = np.sqrt(np.einsum("ij,ij->j", Wk, Wk))
     scale = np.where(norms > 0, norms, 1.0)
     if m > 4 * (rk + 1):
-        # stage 1: R of [Ws y] by unpivoted Householder QR (LAPACK geqrf, column-major, in
-        # place); its last column holds Q0^T y
-        Ay = np.empty((m, rk + 1), order="F")
-        np.divide(Wk, scale, out=Ay[:, :rk])
-        Ay[:, rk] = y
-        qr0, _, _, info = scipy.linalg.lapack.dgeqrf(Ay, overwrite_a=True)
-        if info != 0:  # pragma: no cover - LAPACK argument error
-            raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
-        R0 = np.triu(qr0[: rk + 1])
+        # stage 1: R of [Ws y] (its last column holds Q0^T y)
+        R0 = tall_r(Wk, scale, y)
         A, b = R0[:rk, :rk], R0[:rk, rk]
     else:
         A, b = Wk / scale, y

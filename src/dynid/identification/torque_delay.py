@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .serial import SerialMeat, serial_of_pieces
+from .solvers import tall_r
 
 __all__ = [
     "BLOCKS",
@@ -286,7 +287,7 @@ def _fit(
         if A.shape[1]:
             scale = np.linalg.norm(A, axis=0)
             A = A / scale
-            both = np.linalg.lstsq(A, np.stack([x, y], axis=1), rcond=1e-10)[0]
+            both = _projected(A, np.stack([x, y], axis=1))
             x, y = x - A @ both[:, 0], y - A @ both[:, 1]
     xx = float(x @ x)
     yy = float(y @ y)
@@ -300,6 +301,18 @@ def _fit(
     var = float(meat.result()[0, 0]) / xx**2 * m / max(m - 1, 1)
     var = max(var, _blocks_var(x * r, sizes, len(j)) / xx**2)
     return delta, float(np.sqrt(max(var, 0.0))), delta**2 * xx / yy
+
+
+def _projected(A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``lstsq(A, B, rcond=1e-10)`` (p, q) of ``A`` (m, p), ``B`` (m, q): of a tall ``A``
+    from the triangular factor ``[[R, C], [0, D]]`` of ``[A B]`` (blocked QR,
+    :func:`~dynid.identification.solvers.tall_r`) as ``lstsq(R, C)``: ``R`` holds ``A``'s
+    singular values, the same rank cut, in a third of the time on the whole rows."""
+    m, p = A.shape
+    if m < 4 * (p + B.shape[1]):
+        return np.asarray(np.linalg.lstsq(A, B, rcond=1e-10)[0], dtype=np.float64)
+    T = tall_r(A, np.ones(p), B)
+    return np.asarray(np.linalg.lstsq(T[:p, :p], T[:p, p:], rcond=1e-10)[0], dtype=np.float64)
 
 
 def _blocks_var(score: NDArray[np.float64], sizes: list[int], rows: int) -> float:
