@@ -63,13 +63,17 @@ def _information(
     objective: str,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """``H^-1``, the data's information ``G^T A^T A G`` and the prior's ``w M_0`` over the
-    unknowns ``[phi; I_a; f]`` (module docstring; arguments as :func:`prior_share`)."""
+    unknowns ``[phi; I_a; f]`` (module docstring; arguments as :func:`prior_share`), all
+    three over ``max(w, 1)``: the shares and ``H^-1 w M_0`` are the same, and a weight near
+    the largest float (a fit that returns the prior) does not overflow."""
     phi = np.asarray(phi, dtype=np.float64).reshape(-1, 10)
     p, kf = P.shape[1], A.shape[1] - P.shape[0]
     G = np.zeros((P.shape[0] + kf, p + kf))
     G[: P.shape[0], :p] = P
     G[P.shape[0] :, p:] = np.eye(kf)
-    data = G.T @ (A.T @ A) @ G
+    scale = max(float(weight), 1.0)
+    data = G.T @ (A.T @ A) @ G / scale
+    weight = float(weight) / scale
     m0 = divergence_hessian(prior_phi)
     factor = 2.0 if objective != "logdet" else 1.0
     at = m0 if objective != "logdet" else divergence_hessian(phi)

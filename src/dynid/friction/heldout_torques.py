@@ -643,6 +643,8 @@ def residual_gains(
     v: Validation,
     noise: NDArray[np.float64],
     folds: NDArray[np.intp] | None = None,
+    *,
+    described: bool = False,
 ) -> DriveGains | None:
     """The gain per motor of the logged efforts the prediction ``v`` points to
     (:func:`~dynid.identification.drive_gains.drive_gains`; ``noise`` (n,) [N m] each
@@ -653,7 +655,12 @@ def residual_gains(
     joints gravity loads; a motor named only where fitting its gain improves the prediction
     of the held-out fold (``folds`` (M,): each sample's, the identification's recordings or
     time blocks; default :data:`~dynid.identification.holdout.DEFAULT_FOLDS` contiguous
-    time blocks). None for a robot's own parameters or a log without accelerations."""
+    time blocks). ``described``: the common scale from the description's links also for a
+    model read from its file (whose robot holds none: the gains then relative), as a
+    current log's constants at the noise floor are judged; above the floor a model read
+    back keeps relative gains, which do not take up a tilted base's gravity (a UR5 tilted
+    0.3 deg: its wrist's torques named 1.12 x with the description's scale, the tilt
+    unsaid). None for a robot's own parameters or a log without accelerations."""
     log = v.log
     if isinstance(model, Robot) or log.ddq is None:
         return None
@@ -667,7 +674,7 @@ def residual_gains(
     drive = model.drive
     motor = drive is not None and drive.side == "motor"
     K = drive.transmission if motor and drive is not None else None
-    robot = model.description  # a model read from its file: the description's links
+    robot = model.description if described else model.robot
     G = gd = None
     if np.any(robot.phi):
         rest = np.zeros_like(q)

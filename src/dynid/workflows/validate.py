@@ -636,7 +636,7 @@ def _with_hints(
     floor = verdict.level == "good"  # a current log's constants judged at the floor too
     judged = (dependence or gains_too) and (not floor or gains_too)
     whole = joined_validation(val.parts) if judged else None
-    gains = None if whole is None else residual_gains(model, whole, noise.total)
+    gains = None if whole is None else residual_gains(model, whole, noise.total, described=floor)
     if gains is not None and floor:  # named only clear of 1 over the time blocks too
         gains = dataclasses.replace(gains, floor=True)
     said = None if gains is None else gains.sentence()
