@@ -84,6 +84,8 @@ def test_a_held_out_logs_gap_and_jitter_are_named(gapped, tmp_path, capsys, comm
     assert into == pytest.approx(before - 1000.0, abs=1e-3)
     assert said == pytest.approx(length, rel=5e-3)
     assert _said_jitter(text) == pytest.approx(JITTER, rel=0.3)
+    m = re.search(r"(\d+) sample\(s\) missing from the stamps' grid \(dropped, the gaps'", text)
+    assert m is not None and int(m[1]) == round(length * RATE) - 1, text  # the gap's samples
     name = "validation.json" if command == "validate" else "friction.json"
     doc = json.loads((out / name).read_text())
     (gap,) = (doc if command == "validate" else doc["metadata"])["recordings"][0]["gaps"]

@@ -155,7 +155,9 @@ def timing_record(
     :func:`gaps_between`) with ``start_s``, its first stamp [s] (when known); and ``stamp_jitter_s``
     with ``period_s`` [s] where its stamps are jittered (its reader's ``cleaning``, said
     as :func:`~dynid.identification.log.jitter_text` says it). Empty for a recording of
-    uniform stamps without gaps."""
+    uniform stamps without gaps; ``samples_missing``, the samples missing from the stamps'
+    grid (:attr:`~dynid.identification.log.LogCleaning.n_dropped`: dropped samples, those
+    of the gaps included), when any."""
     out: dict[str, Any] = {}
     if gaps:
         out["gaps"] = [[float(t), float(length)] for t, length in gaps]
@@ -164,12 +166,15 @@ def timing_record(
     if jitter_text(cleaning.stamp_jitter_s, cleaning.period_s) is not None:
         out["stamp_jitter_s"] = float(cleaning.stamp_jitter_s)
         out["period_s"] = float(cleaning.period_s)
+    if cleaning.n_dropped:
+        out["samples_missing"] = int(cleaning.n_dropped)
     return out
 
 
 def recording_line(rec: Mapping[str, Any]) -> str:
     """``a.csv: 2 pieces, 3000 samples, cut at the gap(s) after t = ... (7 s into a.csv;
-    0.3 s long); stamps jittered, std 0.04 ms at a 1 ms period``: a recording's record
+    0.3 s long); stamps jittered, std 0.04 ms at a 1 ms period; 305 sample(s) missing from
+    the stamps' grid (dropped, the gaps' included)``: a recording's record
     (``file``, ``pieces``, ``samples``, and :func:`timing_record`'s keys when there),
     its gaps as ``identify`` says them (:func:`gaps_text`) and its stamps' jitter
     (:func:`~dynid.identification.log.jitter_text`)."""
@@ -180,6 +185,10 @@ def recording_line(rec: Mapping[str, Any]) -> str:
     jitter = rec.get("stamp_jitter_s")
     if jitter is not None and (said := jitter_text(jitter, rec.get("period_s", np.nan))):
         line += f"; {said}"
+    if missing := rec.get("samples_missing"):
+        line += f"; {missing} sample(s) missing from the stamps' grid (dropped" + (
+            ", the gaps' included)" if rec.get("gaps") else ")"
+        )
     return line
 
 
