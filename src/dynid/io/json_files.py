@@ -44,8 +44,12 @@ def jsonable(x: Any, where: str = "") -> Any:
             text(str(k)): jsonable(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()
         }
     if isinstance(x, np.ndarray):
+        if x.dtype.kind in "biu" or (x.dtype.kind == "f" and np.isfinite(x).all()):
+            return x.tolist()  # Python numbers already (a NaN is named element by element)
         return jsonable(x.tolist(), where)
     if isinstance(x, (list, tuple)):
+        if all(type(v) is int or (type(v) is float and math.isfinite(v)) for v in x):
+            return list(x)  # plain numbers: as they are (one check, no call per number)
         return [jsonable(v, f"{where}[{i}]") for i, v in enumerate(x)]
     if isinstance(x, (bool, np.bool_)):
         return bool(x)
