@@ -3,8 +3,10 @@ that has imported the command line already (:mod:`docs_pages` runs the pages).
 
 A page's commands spent most of a second each importing numpy, scipy, matplotlib and the
 library before they did anything. ``python docs_commands.py serve SOCKET`` imports every
-subcommand's modules (not numba: a one-sample call without numba loaded takes the numpy
-path, as a fresh process does) and listens on the Unix socket ``SOCKET``; ``python
+subcommand's modules and the scipy subpackages the commands import inside their functions
+(:data:`SCIPY`: ``scipy.signal`` alone took over a second, most of it parsing docstrings;
+not numba: a one-sample call without numba loaded takes the numpy path, as a fresh process
+does) and listens on the Unix socket ``SOCKET``; ``python
 docs_commands.py run SOCKET ARGS...`` (the ``dynid`` of a page's ``PATH``) hands it the
 arguments, its working folder, environment and standard streams, and exits as the forked
 command did. Each command is thus a process of its own, as written on the page: its own
@@ -29,6 +31,12 @@ import sys
 #: variables whose difference does not change what the server imported
 _FREE = frozenset({"PATH", "PWD", "OLDPWD", "SHLVL", "_", "PYTEST_CURRENT_TEST"})
 _FRESH = b"fresh"
+#: the scipy subpackages a page's commands import inside their functions (none loads numba)
+SCIPY = (
+    "scipy.fft", "scipy.integrate", "scipy.interpolate", "scipy.linalg", "scipy.ndimage",
+    "scipy.optimize", "scipy.signal", "scipy.sparse", "scipy.spatial", "scipy.special",
+    "scipy.stats",
+)  # fmt: skip
 
 
 def _comparable(env: dict[str, str]) -> dict[str, str]:
@@ -74,8 +82,8 @@ def serve(path: str) -> None:
     import dynid
     from dynid.cli import __main__ as cli
 
-    for name in cli.SUBCOMMANDS:
-        importlib.import_module(f"dynid.cli.{name}")
+    for name in (*(f"dynid.cli.{name}" for name in cli.SUBCOMMANDS), *SCIPY):
+        importlib.import_module(name)
     if "numba" in sys.modules or not hasattr(os, "pidfd_open"):
         # (numba loaded would change the numpy paths of one-sample calls)
         raise SystemExit("docs_commands: every command runs fresh")
