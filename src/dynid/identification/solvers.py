@@ -351,15 +351,21 @@ def tall_r(
     return _geqrf_r(np.asfortranarray(np.vstack(parts)))
 
 
-def _geqrf_r(A: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The upper triangular factor (min(M, k), k) of ``A`` (M, k), column-major,
-    overwritten by LAPACK ``geqrf`` in place."""
+def _geqrf(A: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """LAPACK ``geqrf`` of ``A`` (M, k), column-major, overwritten in place: its packed
+    factors and their ``tau``."""
     import scipy.linalg  # scipy on first use (start-up time)
 
-    qr, _, _, info = scipy.linalg.lapack.dgeqrf(A, overwrite_a=True)
+    qr, tau, _, info = scipy.linalg.lapack.dgeqrf(A, overwrite_a=True)
     if info != 0:  # pragma: no cover - LAPACK argument error
         raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
-    return np.triu(qr[: min(A.shape)])
+    return qr, tau
+
+
+def _geqrf_r(A: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The upper triangular factor (min(M, k), k) of ``A`` (M, k), column-major,
+    overwritten by :func:`_geqrf` in place."""
+    return np.triu(_geqrf(A)[0][: min(A.shape)])
 
 
 def tall_pivoted_qr(
@@ -382,10 +388,7 @@ def tall_pivoted_qr(
     lapack = scipy.linalg.lapack
     factors, parts = [], []
     for a in range(0, M, _QR_BLOCK_ROWS):
-        blk = np.asfortranarray(X[a : a + _QR_BLOCK_ROWS])
-        qr, tau, _, info = lapack.dgeqrf(blk, overwrite_a=True)
-        if info != 0:  # pragma: no cover - LAPACK argument error
-            raise RankDeficientError(f"LAPACK dgeqrf failed with info={info}")
+        qr, tau = _geqrf(np.asfortranarray(X[a : a + _QR_BLOCK_ROWS]))
         factors.append((qr, tau))
         parts.append(np.triu(qr[: min(qr.shape)]))
     Q2, R, piv = scipy.linalg.qr(np.vstack(parts), mode="economic", pivoting=True)
