@@ -147,3 +147,26 @@ def test_an_inertia_the_motion_does_not_tell_apart_is_not_fitted():
     assert inertia_determined(A)
     A[..., 9] = A[..., 4] + 1e-6 * rng.normal(size=(200, 7))  # Jzz moves with Jxx
     assert not inertia_determined(A)
+
+
+def test_a_model_without_friction_keeps_the_carried_loads_notes(monkeypatch):
+    """Regression: with a model without friction, the note on its friction replaced the
+    carried loads' notes instead of following them."""
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    from dynid.observer import results
+
+    monkeypatch.setattr(results, "load_words", lambda ld, identified: f"carried {ld.mass} kg")
+    load = SimpleNamespace(mass=0.8, whole=False)
+    fake = SimpleNamespace(
+        model=SimpleNamespace(
+            source="identified", friction=None, robot=SimpleNamespace(joint_names=["a", "b"])
+        ),
+        logs=[SimpleNamespace(path=Path("free.csv"), loads=[load])],
+        unmodelled=None, load=None, frame=None, wrench=None, friction_source=None,
+        score=lambda: None, mostly_flagged_note=lambda: None,
+    )  # fmt: skip
+    notes = results.ObserveResult.notes.fget(fake)
+    assert notes[0] == "free.csv: carried 0.8 kg", notes
+    assert notes[1] == results.no_friction_note(None, ["a", "b"]), notes

@@ -292,7 +292,7 @@ class ObserveResult:
             for ld in x.loads
         )
         if self.model.friction is None:
-            out = (no_friction_note(self.unmodelled, self.model.robot.joint_names),)
+            out += (no_friction_note(self.unmodelled, self.model.robot.joint_names),)
         if self.model.friction is not None:
             own = None
             if self.friction_source is not None:
