@@ -440,15 +440,9 @@ class LoadTorque:
         if m == 0 or (not u.any() and not s.any()):
             self._last = float(t[-1]) if m else last
             return u
-        from scipy.signal import lfilter
-
         steps = np.diff(t if last is None else np.concatenate([[last], t]))
         dt = float(np.median(steps)) if steps.size else 0.0
-        alpha = 1.0 - np.exp(-self._K * dt)  # one step of K/(s + K), per joint
-        out = np.empty_like(u)
-        for j in range(u.shape[1]):
-            zi = [(1.0 - alpha[j]) * s[j]]
-            out[:, j], _ = lfilter([alpha[j]], [1.0, alpha[j] - 1.0], u[:, j], zi=zi)
+        out = _lag(u, self._K, dt, s)
         s = out[-1].copy()
         s[np.abs(s) < 1e-12] = 0.0
         self._state, self._last = s, float(t[-1])
