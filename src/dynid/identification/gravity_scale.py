@@ -36,6 +36,7 @@ __all__ = [
     "gravity_ratios",
     "gravity_scale_factor",
     "gravity_scale_finding",
+    "gravity_scale_words",
     "recorded_scale",
 ]
 
@@ -120,8 +121,16 @@ def gravity_scale_finding(
     joints or lie within :data:`OFF` of 1. ``drive``: the drive the log was read through (a
     log of currents: its torque constant is named)."""
     found = gravity_scale_factor(robot, model, q)
-    if found is None:
-        return None
+    return None if found is None else gravity_scale_words(robot, found, drive)
+
+
+def gravity_scale_words(
+    robot: Robot,
+    found: tuple[float, NDArray[np.float64], NDArray[np.intp]],
+    drive: Drive | None = None,
+) -> str:
+    """:func:`gravity_scale_finding`'s sentence of the factor :func:`gravity_scale_factor`
+    ``found`` (common factor, each joint's, the loaded joints) of ``robot``."""
     mean, r, js = found
     names = ", ".join(robot.joint_names[j] for j in js)
     said = (

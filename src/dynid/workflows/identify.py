@@ -56,7 +56,7 @@ from ..identification.estimators import ESTIMATORS, EstimatorName
 from ..identification.gravity_scale import (
     GRAVITY_SCALE,
     gravity_scale_factor,
-    gravity_scale_finding,
+    gravity_scale_words,
 )
 from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.log import TorqueLog
@@ -653,10 +653,10 @@ def _say_gravity_scale(
     if held is not None and held.gains is not None and held.gains.named:
         return model
     q = [log.q if drive is None else drive.joint_states(log.q)[0] for log in logs]
-    found = gravity_scale_finding(robot, model, q, drive)
     factor = gravity_scale_factor(robot, model, q)
-    if found is None or factor is None:
+    if factor is None:
         return model
+    found = gravity_scale_words(robot, factor, drive)
     warnings.warn(found, DynidWarning, stacklevel=4)
     info = dataclasses.replace(
         model.info,
