@@ -272,7 +272,7 @@ def standstill_blocks(
     (:func:`~dynid.observer.friction.standstill_margin`); ``rest``: the calibrated margin
     at settled rests (:func:`standstill_rest_blocks`)."""
     for a, y, _ in standstill_rest_blocks(
-        model, t, dq, options, block, bands=bands, derived=derived, rest=rest
+        model, t, dq, options, block, bands=bands, derived=derived, rest=rest, settle=False
     ):
         if y is not None:
             yield a, y
@@ -288,7 +288,8 @@ def standstill_rest_blocks(
     bands: tuple[NDArray[np.float64], ...] | None = None,
     derived: bool = False,
     rest: RestMargin | None = None,
-) -> Iterator[tuple[int, NDArray[np.float64] | None, NDArray[np.float64]]]:
+    settle: bool = True,
+) -> Iterator[tuple[int, NDArray[np.float64] | None, NDArray[np.float64] | None]]:
     """:func:`standstill_blocks` with the settled part of every joint's rests: ``(first
     sample, margin (m, n) [N m] or None where it is zero so far, seconds into the settled
     part of a rest (m, n) [s], NaN elsewhere)`` (:func:`~dynid.observer.rest_margin.at_rest`,
@@ -297,7 +298,8 @@ def standstill_rest_blocks(
     ``rest``, the margin of a joint in the settled part of a rest is ``min(its Coulomb
     bound, its calibrated rest level)`` before the lag (:mod:`dynid.observer.rest_margin`);
     ``settle_s`` is ``rest``'s, else
-    :func:`~dynid.observer.rest_margin.settle_seconds` of the gains.
+    :func:`~dynid.observer.rest_margin.settle_seconds` of the gains. ``settle`` False
+    without ``rest``: the settled parts are not needed, not read (None).
     """
     N, n = dq.shape
     size = _MARGIN_BLOCK if block is None else int(block)
@@ -310,9 +312,11 @@ def standstill_rest_blocks(
         b = min(a + size, N)
         e = min(N, int(np.searchsorted(t, t[b - 1] + clock.settle_s, "right")) + 1)
         w = standstill_margin(model.friction, dq[a:b], bands, derived=derived)
-        mask = at_rest(model.friction, dq[a:e], bands)  # read settle_s ahead
-        settled = clock.settled(t[a:e], mask, b - a)
-        if rest is not None:
+        settled = None
+        if settle or rest is not None:
+            mask = at_rest(model.friction, dq[a:e], bands)  # read settle_s ahead
+            settled = clock.settled(t[a:e], mask, b - a)
+        if rest is not None and settled is not None:
             w = np.where(np.isfinite(settled), rest.at_rest(w), w)
         if prev is None and not np.any(w):
             yield a, None, settled  # zero so far: its lag is zero too
