@@ -511,9 +511,7 @@ def _held_out(
             ho = model.holdout
             k = ho.folds if ho is not None and ho.scheme == "blocks" else DEFAULT_FOLDS
             folds = _block_folds(every.log.q.shape[0], k)
-        gains = residual_gains(model, every, total, folds)
-        if gains is not None and not above:  # named only clear of 1 over the folds too
-            gains = dataclasses.replace(gains, floor=True)
+        gains = residual_gains(model, every, total, folds, floor=not above)
         if gains is not None and gains.named:  # the gains explain it: no spring, no tilt
             return dataclasses.replace(held, gains=gains)
     if above:
@@ -645,6 +643,7 @@ def residual_gains(
     folds: NDArray[np.intp] | None = None,
     *,
     described: bool = False,
+    floor: bool = False,
 ) -> DriveGains | None:
     """The gain per motor of the logged efforts the prediction ``v`` points to
     (:func:`~dynid.identification.drive_gains.drive_gains`; ``noise`` (n,) [N m] each
@@ -660,7 +659,9 @@ def residual_gains(
     current log's constants at the noise floor are judged; above the floor a model read
     back keeps relative gains, which do not take up a tilted base's gravity (a UR5 tilted
     0.3 deg: its wrist's torques named 1.12 x with the description's scale, the tilt
-    unsaid). None for a robot's own parameters or a log without accelerations."""
+    unsaid). ``floor``: the prediction is at the noise floor, each motor named only clear
+    of 1 over the folds too (:attr:`~dynid.identification.drive_gains.DriveGains.floor`).
+    None for a robot's own parameters or a log without accelerations."""
     log = v.log
     if isinstance(model, Robot) or log.ddq is None:
         return None
@@ -689,8 +690,8 @@ def residual_gains(
         return None
     per: Literal["joint", "motor"] = "joint" if per_joint(drive) else "motor"  # gear ratio 1
     if drive is not None and drive.effort == "current":
-        return dataclasses.replace(found, effort="current", per=per)
-    return dataclasses.replace(found, per=per)
+        return dataclasses.replace(found, effort="current", per=per, floor=floor)
+    return dataclasses.replace(found, per=per, floor=floor)
 
 
 def beside_columns(

@@ -636,9 +636,11 @@ def _with_hints(
     floor = verdict.level == "good"  # a current log's constants judged at the floor too
     judged = (dependence or gains_too) and (not floor or gains_too)
     whole = joined_validation(val.parts) if judged else None
-    gains = None if whole is None else residual_gains(model, whole, noise.total, described=floor)
-    if gains is not None and floor:  # named only clear of 1 over the time blocks too
-        gains = dataclasses.replace(gains, floor=True)
+    gains = (  # at the floor, named only clear of 1 over the time blocks too
+        None
+        if whole is None
+        else residual_gains(model, whole, noise.total, described=floor, floor=floor)
+    )
     said = None if gains is None else gains.sentence()
     if said is not None and floor:  # at the floor, the factors said
         verdict = dataclasses.replace(verdict, reason=f"{verdict.reason}; {said}")
