@@ -155,3 +155,29 @@ def test_the_ratio_to_the_noise_floor_is_printed_with_three_significant_digits()
     assert "(9.5e+05 x the noise floor" in far.reason, far.reason
     near = judge_prediction(0.279, 0.268)
     assert "(1.04 x the noise floor" in near.reason, near.reason
+
+
+def test_torques_mostly_noise_are_judged_usable_at_best_never_unusable_for_a_right_model():
+    """A servo arm whose current steps are the size of its torques: the noise is 55 % of
+    the measured torques. The true model's prediction errs exactly the noise (about 56 %,
+    past the 50 % rule of a wrong log) and is usable, said to be judged on mostly noise,
+    never "unusable" nor "at the floor"; a prediction of no torque (100 %) and one of
+    another motion's torques (another robot's log) stay unusable."""
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 10.0, 4000)
+    true = np.column_stack([np.sin(1.3 * t), 0.5 * np.cos(0.7 * t) + 0.2])
+    noise = rng.normal(size=true.shape)
+    noise *= 0.66 * np.linalg.norm(true) / np.linalg.norm(noise)
+    measured = true + noise
+
+    def percent(pred: np.ndarray) -> float:
+        return float(100.0 * np.linalg.norm(measured - pred) / np.linalg.norm(measured))
+
+    floor = percent(true)  # the noise's norm over the torques'
+    assert 50.0 < floor < 60.0
+    v = judge_prediction(floor * 1.06, floor)
+    assert v.level == "fair" and v.label == "usable", v
+    assert "mostly noise" in v.reason, v.reason
+    assert judge_prediction(percent(np.zeros_like(true)), floor).level == "unusable"
+    other = np.column_stack([np.sin(2.9 * t + 1.0), 0.5 * np.cos(2.3 * t) - 0.2])
+    assert judge_prediction(percent(other), floor).level == "unusable"

@@ -15,9 +15,17 @@ fair          at most 3 x the floor, or below 15 %          use it; effects outs
               ("usable")                                    model remain (see residuals)
 poor          below 50 %                                    add model terms, excite more,
                                                             check the drive
-unusable      50 % or more, or torques anti-correlated      check the data first: another
-              with the model's (opposite sign)              robot, other units, other sign
+unusable      50 % or more (unless within 3 x a noise       check the data first: another
+              floor that high), 100 % or more, or torques  robot, other units, other sign
+              anti-correlated with the model's (opposite
+              sign)
 ============  ===========================================  ================================
+
+Torques mostly noise (a floor of 33 % or more, :data:`NOISY_FLOOR_PERCENT`: a prediction
+of no torque at all is then within 3 x the floor) cannot tell a good model from a poor
+one: within 3 x such a floor the verdict is usable, with that said, never at the floor
+(a servo arm's coarse current steps the size of its torques: 59.9 % at 1.06 x a floor of
+55.8 % read "unusable" for a model 3 % off the truth).
 
 The pooled error is dominated by the joints of the largest torques: a wrist whose noise is
 a hundredth of the shoulder's can err ten times its noise within a pooled error at the
@@ -62,6 +70,7 @@ __all__ = [
     "JOINT_GOOD",
     "LEVELS",
     "NEGLIGIBLE_PERCENT",
+    "NOISY_FLOOR_PERCENT",
     "ROUND_OFF_PERCENT",
     "NOISE_FLOOR_SHARE",
     "SYSTEMATIC_RATIO",
@@ -84,8 +93,14 @@ LEVELS: tuple[Level, ...] = ("good", "fair", "poor", "unusable")
 FLOOR_GOOD, FLOOR_FAIR = 1.5, 3.0
 #: Relative error [%]: good below GOOD_PERCENT (without a floor), usable below FAIR_PERCENT.
 GOOD_PERCENT, FAIR_PERCENT = 5.0, 15.0
-#: Relative error [%] from which the model does not explain the torques.
+#: Relative error [%] from which the model does not explain the torques (unless its noise
+#: floor explains it: within FLOOR_FAIR x a floor that high).
 UNUSABLE_PERCENT = 50.0
+#: A noise floor [%] from which a prediction of no torque at all is within FLOOR_FAIR x it:
+#: the torques are mostly noise and cannot tell a good model from a poor one (coarse
+#: current steps of a servo against torques of their size); a verdict on them is at best
+#: usable.
+NOISY_FLOOR_PERCENT = 100.0 / FLOOR_FAIR
 #: Relative error [%] of a joint: good below JOINT_GOOD, usable below JOINT_FAIR (or
 #: within FLOOR_GOOD, FLOOR_FAIR x its noise).
 JOINT_GOOD, JOINT_FAIR = 10.0, 25.0
@@ -352,7 +367,8 @@ def pooled_verdict(
             "a log of the opposite torque sign, or of another robot",
             r,
         )
-    if not math.isfinite(e) or e >= UNUSABLE_PERCENT:
+    explained = r is not None and r <= FLOOR_FAIR and e < 100.0  # by a floor that high
+    if not math.isfinite(e) or (e >= UNUSABLE_PERCENT and not explained):
         what = (
             "100 % or more: worse than predicting no torque"
             if e >= 100.0
@@ -364,6 +380,16 @@ def pooled_verdict(
             "unusable",
             f"the model does not explain the torques: error {e:.3g} % ({what}); a log of "
             "another robot, in other units or of another sign?",
+            r,
+        )
+    if r is not None and r <= FLOOR_FAIR and floor >= NOISY_FLOOR_PERCENT:
+        return Verdict(
+            "fair",
+            "usable",
+            f"error {e:.3g} %{at}: the torques are mostly noise, {floor:.3g} % of them, so "
+            "these data cannot tell a good model from a poor one (a prediction of no torque "
+            f"would be {100.0 / floor:.3g} x the floor); judge it on a recording of larger "
+            "torques or finer torque readings",
             r,
         )
     if r is not None and r <= FLOOR_GOOD:

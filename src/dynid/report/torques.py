@@ -23,6 +23,7 @@ from ..identification.verdict import (
     JOINT_FAIR,
     JOINT_GOOD,
     LEVELS,
+    NOISY_FLOOR_PERCENT,
     SYSTEMATIC_RATIO,
     UNUSABLE_PERCENT,
     joint_levels,
@@ -94,7 +95,8 @@ def validate_answer(run: RunFiles) -> Answer | None:
         )
         + f", usable up to {FLOOR_FAIR:g} x or below {FAIR_PERCENT:g} %, poor below "
         f"{UNUSABLE_PERCENT:g} %, unusable from {UNUSABLE_PERCENT:g} % or with torques of "
-        "the opposite sign",
+        f"the opposite sign; torques mostly noise (a floor of {NOISY_FLOOR_PERCENT:.3g} % or "
+        "more) are at best usable",
     ]
     facts[1:1] = spring_facts(doc)  # where the verdict names a spring: its stiffness
     facts[:0] = delay_facts(doc)  # a named lag first: the hints after it may be the lag
