@@ -285,3 +285,23 @@ def test_a_log_too_short_to_identify_is_named_so(panda_log):
     seconds."""
     with pytest.raises(DataError, match=r"too short to identify \(13 samples, 0.048 s"):
         identify_recordings(dynid.panda(), [panda_log.select(slice(0, 13))])
+
+
+def test_torques_one_gear_ratio_below_the_gravity_torques_name_constants_given_at_the_motors(
+    panda_log,
+):
+    """A servo arm's currents read through each motor's torque constant on a joint-side
+    drive of gear ratio 345 on every joint (a datasheet's value, at the motor): the torques
+    are 1/345 of the robot's gravity torques, and the scale line says the constants look
+    given at the motors (every gear ratio the same: the per-joint reading cannot tell);
+    through gear ratio 1 it does not."""
+    tau = panda_log.tau / 345.0
+    log = dataclasses.replace(panda_log, tau=tau)
+    geared = Drive(345.0 * np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
+    (line,) = [f for f in check_torque_log(dynid.panda(), log, geared) if "times the model" in f]
+    factor = float(re.search(r"are ([0-9.e+-]+) times the model", line)[1])  # type: ignore[index]
+    assert 0.8 / 345 < factor < 1.2 / 345, line  # the log's friction aside
+    assert "near the gear ratio, 345: torque_constant looks given at the motors" in line, line
+    plain = Drive(np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
+    said = " ".join(check_torque_log(dynid.panda(), log, plain))
+    assert "times the model" in said and "given at the motors" not in said, said

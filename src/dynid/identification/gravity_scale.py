@@ -33,6 +33,7 @@ __all__ = [
     "OFF",
     "SHAPE",
     "UNIFORM",
+    "at_the_motors",
     "gravity_ratios",
     "gravity_scale_factor",
     "gravity_scale_finding",
@@ -143,7 +144,7 @@ def gravity_scale_words(
         return (
             f"{said}; if the description's masses are right, the drive file's torque_constant "
             f"is {mean:.3g} times the true one: multiply it by {1 / mean:.3g}"
-            f"{_at_the_motors(drive, 1 / mean)}"
+            f"{at_the_motors(drive, 1 / mean)}"
         )
     currents = (
         '; or the log holds motor currents: a drive file with effort = "current" and each '
@@ -157,7 +158,7 @@ def gravity_scale_words(
     )
 
 
-def _at_the_motors(drive: Drive, factor: float) -> str:
+def at_the_motors(drive: Drive, factor: float) -> str:
     """A clause when ``factor``, the torque constants' correction, is near the gear ratio
     every joint of a joint-side ``drive`` shares (within 1/3 to 3 times): constants given
     at the motors, where ``side = "joint"`` wants each joint's torque per A."""

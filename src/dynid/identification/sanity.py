@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .angle_time_units import degrees_findings, milliseconds_findings
+from .gravity_scale import at_the_motors
 from .log import TorqueLog
 from .model_sign import CHECKED_SAMPLES, gravity_spread, opposite_sign
 from .velocity_noise import moving_joints
@@ -159,7 +160,8 @@ def _scale_line(a: float, refused: bool = False, drive: Drive | None = None) -> 
         return (
             f"the measured torques (the currents times the drive's torque constants) are "
             f"{abs(a):.3g} times the model's gravity torques: the drive file's torque_constant "
-            f"or gear_ratio looks off by that factor; hint: {hint}"
+            f"or gear_ratio looks off by that factor{at_the_motors(drive, 1 / abs(a))}; "
+            f"hint: {hint}"
         )
     hint = (
         "--units tau=mNm"
