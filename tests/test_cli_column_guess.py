@@ -85,6 +85,26 @@ def test_motor_currents_and_a_time_in_ms_are_guessed_with_their_units(tmp_path, 
     assert "--units 't=ms,tau=A'" in line and "--drive whose effort is current" in line, line
 
 
+def test_a_servos_present_readings_are_guessed_and_read(tmp_path, capsys):
+    """Regression: a serial-bus servo arm's ``timestamp_ms, present_position_1..7,
+    present_current_1..7`` got no map (the reading's prefix hid the names); the hint maps
+    them and, pasted, reads the file's positions and currents."""
+    header = [
+        "timestamp_ms",
+        *(f"present_position_{j}" for j in range(1, N + 1)),
+        *(f"present_current_{j}" for j in range(1, N + 1)),
+    ]
+    path = tmp_path / "rec.csv"
+    body = _write(path, header, seed=3)
+    argv = ["identify", "--robot", "panda", "--data", str(path), "--out", str(tmp_path / "o")]
+    line = _error(argv, capsys)
+    spec = "t=timestamp_ms,q=present_position_{i},tau=present_current_{i}"
+    assert spec in line and "--units 't=ms,tau=A'" in line, line
+    log = load_mapped_torque_log(path, parse_column_map(spec)).log
+    np.testing.assert_array_equal(log.q, body[:, 1 : 1 + N])
+    np.testing.assert_array_equal(log.tau, body[:, 1 + N :])
+
+
 @pytest.mark.parametrize("command", ["identify", "observe"])
 def test_a_log_of_positions_only_is_told_that_torques_are_needed(tmp_path, capsys, command):
     """Regression: a 1 kHz log of t, q1..q7 only was told to "name the columns

@@ -47,6 +47,10 @@ ALIASES: dict[str, tuple[str, ...]] = {
 #: Names of motor currents' columns (lower case, without separators): read as ``tau`` in
 #: amperes (``--units tau=A``) through a drive whose effort is current.
 CURRENT_ALIASES = ("current", "cur", "i", "motorcurrent", "amps")
+#: Prefixes of a reading's name that say which value it is, not what (a servo's
+#: ``present_position_1``, a controller's ``actual_torque_1``), left out before the names
+#: are compared with :data:`ALIASES` (lower case, without separators; longest first).
+READING_PREFIXES = ("measured", "feedback", "present", "actual", "meas", "act", "fb")
 #: How many unused columns a message names (families count as one).
 SHOWN = 6
 
@@ -310,6 +314,11 @@ def position_count(names: Sequence[str]) -> int:
 
 
 def _root(template: str) -> str:
-    """A family's name without its joint field and separators, lower case
-    (``Effort_{i0}`` -> ``effort``)."""
-    return re.sub(r"[^a-z]", "", template.split("{")[0].lower())
+    """A family's name without its joint field, separators and a reading's prefix
+    (:data:`READING_PREFIXES`), lower case (``Effort_{i0}`` -> ``effort``,
+    ``present_current_{i}`` -> ``current``)."""
+    root = re.sub(r"[^a-z]", "", template.split("{")[0].lower())
+    for p in READING_PREFIXES:
+        if root.startswith(p) and len(root) > len(p):
+            return root[len(p) :]
+    return root
