@@ -85,7 +85,8 @@ def test_lagging_velocities_are_derived_again_naming_the_lag(sim, tmp_path, k):
     panda, _, g = sim
     path = save_torque_log(tmp_path / "lag.csv", TorqueLog(g.t, g.q, _lagged(g.dq, k), g.tau))
     with pytest.warns(DynidWarning) as said:
-        got = read_recordings([path], panda).logs[0]
+        rec = read_recordings([path], panda)
+    got = rec.logs[0]
     msg = [str(w.message) for w in said if "velocity columns" in str(w.message)]
     assert len(msg) == 1 and msg[0].startswith("lag.csv: ") and "\n" not in msg[0], msg
     assert f"lag the derivative of its positions by {k}.0" in msg[0], msg
@@ -95,6 +96,9 @@ def test_lagging_velocities_are_derived_again_naming_the_lag(sim, tmp_path, k):
     ref = read_recordings([clean], panda, columns=("dq=none", None)).logs[0]
     assert got.dq_derived and ref.dq_derived and got.ddq is None
     np.testing.assert_array_equal(got.dq, ref.dq)
+    side = rec.joint_side[0]  # what observe prepares from (regression: the lagging log's)
+    assert side.dq_derived, "the joint-side log kept the lagging velocity columns"
+    np.testing.assert_array_equal(side.dq, ref.dq)
 
 
 @pytest.mark.parametrize("joints", [tuple(range(7)), (4, 5, 6)])
@@ -107,7 +111,8 @@ def test_velocity_columns_of_zeros_are_derived_again_naming_the_joints(sim, tmp_
     dq[:, list(joints)] = 0.0
     path = save_torque_log(tmp_path / "zero.csv", TorqueLog(g.t, g.q, dq, g.tau))
     with pytest.warns(DynidWarning) as said:
-        got = read_recordings([path], panda).logs[0]
+        rec = read_recordings([path], panda)
+    got = rec.logs[0]
     msg = " ".join(str(w.message) for w in said)
     named = ", ".join(f"joint {j + 1}" for j in joints)
     assert f"hold no motion (zero or constant) on {named}, whose positions move" in msg, msg

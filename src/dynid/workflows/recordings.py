@@ -431,7 +431,7 @@ def usable_recorded(
     logs = usable_velocities(rec.logs, rec.names)
     if all(a is b for a, b in zip(logs, rec.logs, strict=True)):
         return rec, checked
-    rec = dataclasses.replace(rec, logs=logs)
+    rec = dataclasses.replace(rec, logs=logs, sides=None)  # the joint side made again
     return rec, unwrapped_recorded(rec, robot, max_gap_s)
 
 
