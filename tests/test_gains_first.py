@@ -404,6 +404,41 @@ def test_constants_given_at_the_motors_are_read_times_the_gear_ratios(panda, cur
     assert held.gains is None or not held.gains.named, held.gains
 
 
+def test_constants_given_at_the_motors_over_one_shared_gear_ratio_are_read_times_it(
+    panda, current_log
+):
+    """The same log through a drive of gear ratio 100 on every joint whose torque_constant
+    holds the motors' constants (the true joint torque per A over 100): the gains cannot
+    follow gear ratios that are all equal, but the torques are 1/100 of the description's
+    gravity torques, which no error of its masses makes; the currents are read through
+    torque_constant x 100, said in a warning and a note, and the model's constants are the
+    true ones with its held-out verdict at the noise floor. Through gear ratio 5 (a factor
+    the masses could make) nothing is corrected."""
+    drive = dataclasses.replace(
+        Drive.identity(7),
+        transmission=100.0 * np.eye(7),
+        effort="current",
+        torque_constant=KT / 100,
+    )
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        got = identify_files(panda, current_log, IdentifyOptions(drive=drive))
+    _said_once(said)
+    msg = [str(w.message) for w in said if "the gear ratio every joint shares" in str(w.message)]
+    assert len(msg) == 1 and "torque_constant x 100" in msg[0], msg
+    assert got.model.drive is not None and got.model.drive.torque_constant is not None
+    np.testing.assert_allclose(got.model.drive.torque_constant, KT, rtol=1e-12)
+    assert msg[0] in got.model.info.notes
+    held = got.heldout
+    assert held is not None and held.verdict.ratio is not None and held.verdict.ratio < 1.5
+    low = dataclasses.replace(drive, transmission=5.0 * np.eye(7), torque_constant=KT / 5)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        kept = identify_files(panda, current_log, IdentifyOptions(drive=low, terms="viscous"))
+    assert not [w for w in said if "the gear ratio every joint shares" in str(w.message)]
+    np.testing.assert_allclose(kept.model.drive.torque_constant, KT / 5, rtol=1e-12)
+
+
 @pytest.mark.parametrize(
     "factor, found",
     [

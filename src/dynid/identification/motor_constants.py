@@ -12,19 +12,41 @@ to the gear ratios 0.80 to 0.82, the wrist motor's gain not determined). Correct
 factors the model is off by the masses' error, 19 %, and the undetermined motor by its gear
 ratio; corrected by the gear ratios, by neither: the constants were right, at the motor.
 :func:`gear_ratio_pattern` tells the pattern; :meth:`GearRatioPattern.sentence` says it.
+
+Over gear ratios all equal the gains cannot tell the pattern from the masses' error: one
+factor on every joint. The factor itself can, when the gear ratio is larger than any error
+of a description's masses: the torques of a joint-side log are the robot's gravity torques
+(:func:`~dynid.identification.sanity.gravity_torque_scale`) over a factor within
+:data:`_COMMON` of the gear ratio, and a gear ratio above :data:`SHARED_MIN` puts that
+range clear of :data:`_COMMON` itself (a servo arm of gear ratio 345 on every joint, its
+motors' constants in the drive file: its torques 0.0029 times the gravity torques).
+:func:`shared_gear_ratio` tells it; identification then reads the currents through
+``torque_constant x gear_ratio`` with a warning (:meth:`SharedGearRatio.sentence`).
 """
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..model.drive import Drive
+from ..model.robot import Robot
 from .drive_gains import DriveGains
+from .log import TorqueLog, joint_side_log
+from .sanity import gravity_torque_scale
 
-__all__ = ["SPREAD", "GearRatioPattern", "gear_ratio_pattern"]
+__all__ = [
+    "SHARED_MIN",
+    "SPREAD",
+    "GearRatioPattern",
+    "SharedGearRatio",
+    "gear_ratio_pattern",
+    "shared_gear_ratio",
+]
 
 #: Largest spread (largest over smallest, less one) of the determined motors' gains over
 #: their gear ratios for the gains to follow the gear ratios.
@@ -35,6 +57,9 @@ _COMMON = (1.0 / 3.0, 3.0)
 #: Smallest ratio between the largest and smallest gear ratio of the determined motors:
 #: gains uniform over equal gear ratios are one common factor, not this pattern's.
 _DISTINCT = 1.2
+#: Smallest gear ratio shared by every joint whose factor the description's masses cannot
+#: make: above it ``[G / 3, 3 G]`` and :data:`_COMMON` do not meet.
+SHARED_MIN = _COMMON[1] / _COMMON[0]
 
 
 @dataclass(frozen=True, slots=True)
@@ -105,3 +130,76 @@ def gear_ratio_pattern(gains: DriveGains, drive: Drive) -> GearRatioPattern | No
     if not _COMMON[0] <= mid <= _COMMON[1]:
         return None
     return GearRatioPattern(ratio, common, tuple(int(k) for k in motors))
+
+
+@dataclass(frozen=True, slots=True)
+class SharedGearRatio:
+    """Torque constants given at the motors over one gear ratio shared by every joint
+    (module docstring).
+
+    Attributes
+    ----------
+    gear_ratio : float
+        The gear ratio every joint shares [-].
+    common : ndarray, shape (k,)
+        Per recording, its torques over the description's gravity torques times the gear
+        ratio [-] (the masses' error).
+    """
+
+    gear_ratio: float
+    common: NDArray[np.float64]
+
+    def corrected(self, drive: Drive) -> Drive:
+        """``drive`` with each torque constant times the gear ratio."""
+        assert drive.torque_constant is not None  # a drive of currents
+        kt = np.asarray(drive.torque_constant, dtype=np.float64) * self.gear_ratio
+        return dataclasses.replace(drive, torque_constant=kt)
+
+    def sentence(self) -> str:
+        """The finding and what was done, in words."""
+        lo, hi = float(self.common.min()), float(self.common.max())
+        span = f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g} to {hi:.3g}"
+        g = f"{self.gear_ratio:.4g}"
+        return (
+            f"torque_constant looks given at the motors: the currents read through it are "
+            f"1/{g} (the gear ratio every joint shares) times the description's gravity "
+            f"torques, times {span} (the masses' error); on a joint-side log (side = "
+            "\"joint\") torque_constant is each joint's torque per A, the motor's constant "
+            f"times its gear ratio: the currents are read through torque_constant x {g} "
+            "(identification.json's drive holds them: put them in the drive file)"
+        )
+
+
+def shared_gear_ratio(
+    robot: Robot, logs: Sequence[TorqueLog], drive: Drive | None
+) -> SharedGearRatio | None:
+    """Constants given at the motors over a shared gear ratio (module docstring), or None.
+
+    Parameters
+    ----------
+    robot : Robot
+        With its inertial parameters (the description's gravity torques).
+    logs : sequence of TorqueLog
+        The recordings as read (currents [A]).
+    drive : Drive or None
+        The drive they are read through: joint side, currents, no coupling, one gear
+        ratio above :data:`SHARED_MIN` on every joint.
+
+    Returns
+    -------
+    SharedGearRatio or None
+        When every recording's torques over the gravity torques, times the gear ratio, lie
+        within :data:`_COMMON`.
+    """
+    if drive is None or drive.side != "joint" or drive.effort != "current" or drive.is_coupled:
+        return None
+    ratio = np.abs(np.diag(np.asarray(drive.transmission, dtype=np.float64)))
+    if not np.allclose(ratio, ratio[0], rtol=1e-9, atol=0.0) or ratio[0] <= SHARED_MIN:
+        return None
+    scales = [gravity_torque_scale(robot, joint_side_log(log, drive)) for log in logs]
+    if not scales or any(a is None or not a > 0 for a in scales):
+        return None
+    common = np.asarray(scales, dtype=np.float64) * ratio[0]
+    if common.min() < _COMMON[0] or common.max() > _COMMON[1]:
+        return None
+    return SharedGearRatio(float(ratio[0]), common)

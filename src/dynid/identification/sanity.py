@@ -42,6 +42,7 @@ from .model_sign import CHECKED_SAMPLES, gravity_spread, opposite_sign
 from .velocity_noise import moving_joints
 
 __all__ = [
+    "gravity_torque_scale",
     "check_torque_log",
     "MIN_LOG_SAMPLES",
     "too_few_samples",
@@ -133,6 +134,15 @@ def _against_gravity(robot: Robot, log: TorqueLog) -> _GravitySaid:
         return _GravitySaid(degrees, frozen, opposite)
     step = max(1, log.n_samples // CHECKED_SAMPLES)
     return _GravitySaid(degrees, frozen, None, _torque_scale(robot, log.q[::step], log.tau[::step]))
+
+
+def gravity_torque_scale(robot: Robot, log: TorqueLog) -> float | None:
+    """The factor ``a`` of ``tau ~ a g(q)`` of a joint-side ``log`` against ``robot``'s
+    gravity torques (:func:`check_torque_log`'s scale finding), or None where it is not
+    compared (:class:`_GravitySaid`'s ``scale``) or the log is too short to check."""
+    if too_few_samples(log) is not None:
+        return None
+    return _against_gravity(robot, log).scale
 
 
 def _torque_scale(robot: Robot, q: NDArray[np.float64], tau: NDArray[np.float64]) -> float | None:

@@ -61,6 +61,7 @@ from ..identification.gravity_scale import (
 from ..identification.least_squares import STD_METHODS, StdMethod
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
+from ..identification.motor_constants import shared_gear_ratio
 from ..identification.residual_dependence import outside_model_note, round_off_note
 from ..identification.selection import fitted_logs, identify_recordings
 from ..identification.static import identify_static
@@ -524,7 +525,16 @@ def identify_logs(
     kw: dict[str, Any] = {} if opt.folds is None else {"folds": opt.folds}
     if validate_on is not None:
         kw["validate_on"] = validate_on
-    return _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
+    shared = shared_gear_ratio(robot, logs, opt.drive)
+    if shared is None:
+        return _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
+    said = shared.sentence()
+    warnings.warn(said, DynidWarning, stacklevel=2)
+    opt = dataclasses.replace(opt, drive=shared.corrected(opt.drive))  # type: ignore[arg-type]
+    got = _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
+    info = got.model.info
+    info = dataclasses.replace(info, notes=(*info.notes, said))
+    return dataclasses.replace(got, model=dataclasses.replace(got.model, info=info))
 
 
 def _prior(robot: Robot, opt: IdentifyOptions) -> Robot | None:
