@@ -73,6 +73,7 @@ from ..identification.motion_range import motion_range_hint, with_motion_range_h
 from ..identification.pieces import check_below_nyquist
 from ..identification.recorded_signs import SignFinding
 from ..identification.residual_dependence import (
+    dependence_hint,
     friction_left_out,
     held_terms,
     offsets_of,
@@ -88,6 +89,7 @@ from ..io.model_json import load_model_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
+from ..observer.residual_load import ResidualLoad, load_hint, residual_load
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
 from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
@@ -256,6 +258,11 @@ class ValidateResult:
         judges them (:func:`~dynid.friction.heldout_torques.residual_gains`; its named
         motors' factors the verdict's reason names, in place of a spring or a tilt); judged
         on a current log even beside a sign finding; None: not judged (a good verdict).
+    flange_load : ResidualLoad, optional
+        The rigid load at the flange fitted to the residual
+        (:func:`~dynid.observer.residual_load.residual_load`; named first in ``verdict``'s
+        reason, the joints diagnosed on what it leaves, when
+        :attr:`~dynid.observer.residual_load.ResidualLoad.named`); None: not judged.
     """
 
     validation: RecordingsValidation
@@ -279,6 +286,7 @@ class ValidateResult:
     applied_delay: AppliedDelay | None = None
     gravity_tilt: GravityTilt | None = None
     gains: DriveGains | None = None
+    flange_load: ResidualLoad | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -296,6 +304,9 @@ class ValidateResult:
         :meth:`~dynid.identification.residual_spring.ResidualSpring.as_dict`),
         ``gravity_tilt`` (the tilt of the gravity vector the residual points to, as
         ``heldout.json`` records it: null when not judged),
+        ``flange_load`` (the rigid load at the flange the residual was fitted with:
+        :meth:`~dynid.observer.residual_load.ResidualLoad.as_dict`, its ``named`` whether
+        the verdict names it; null when not judged),
         ``drive_gains`` (the gains per motor, when judged:
         :meth:`~dynid.identification.drive_gains.DriveGains.as_dict`) and
         ``torque_delay`` (the torques' lag behind the positions, when named:
@@ -330,6 +341,7 @@ class ValidateResult:
             "verdict": {"level": v.level, "label": v.label, "reason": v.reason},
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
             "gravity_tilt": None if self.gravity_tilt is None else self.gravity_tilt.as_dict(),
+            "flange_load": None if self.flange_load is None else self.flange_load.as_dict(),
             **({"drive_gains": self.gains.as_dict()} if self.gains is not None else {}),
             **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
             **({"torque_delay_used": a.as_dict()} if (a := self.applied_delay) else {}),
@@ -423,10 +435,11 @@ def validate_files(
     # a torque of the opposite sign leaves twice the torque, which no term of the model
     # explains: what the residual follows is not diagnosed (a current log's gains are)
     current = not beyond and placed is not None and placed.effort == "current"
-    verdict, springs, gains, tilt = _with_hints(
+    verdict, springs, gains, tilt, load = _with_hints(
         model, verdict, val, rec.logs, noise, names,
         dependence=not beyond and not opposite and sign_map is None,
         held=_terms_held(model, placed, label), gains_too=current,
+        payload=_payload_command(model, data, label, feasible, source),
     )  # fmt: skip
     verdict = with_motion_range_hint(verdict, speeds, dq, names)
     named = gains is not None and bool(gains.named)  # a scale off leaves no lag to name
@@ -452,7 +465,7 @@ def validate_files(
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=springs, gains=gains, torque_delay=delay, applied_delay=applied,
-        gravity_tilt=tilt,
+        gravity_tilt=tilt, flange_load=load,
     )  # fmt: skip
 
 
@@ -608,7 +621,10 @@ def _with_hints(
     dependence: bool = True,
     held: tuple[frozenset[str], str | None] = (frozenset(), None),
     gains_too: bool = False,
-) -> tuple[Verdict, ResidualSpring | None, DriveGains | None, GravityTilt | None]:
+    payload: str = "`dynid payload`",
+) -> tuple[
+    Verdict, ResidualSpring | None, DriveGains | None, GravityTilt | None, ResidualLoad | None
+]:
     """``verdict`` with what the residual of each joint above its noise follows
     (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
     ``dependence`` False: a recording that moves beyond the identification's data, where
@@ -632,7 +648,7 @@ def _with_hints(
     error = [v.log.tau - v.tau_hat for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     q = [v.log.q for v in val.parts]
-    springs = tilt = None
+    springs = tilt = load = None
     floor = verdict.level == "good"  # a current log's constants judged at the floor too
     judged = (dependence or gains_too) and (not floor or gains_too)
     whole = joined_validation(val.parts) if judged else None
@@ -652,11 +668,22 @@ def _with_hints(
         tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
         tau = [v.log.tau for v in val.parts]
         got = [v.log.ddq for v in val.parts]
-        ddq = [a for a in got if a is not None]
-        verdict = with_dependence_hint(
-            verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs, tau,
-            offsets, left_out, ddq if len(ddq) == len(got) else None, inertia,
-        )  # fmt: skip
+        ddq = [a for a in got if a is not None] if all(a is not None for a in got) else None
+        tilted = tilt is not None and tilt.named  # a tilt named is said first, as before
+        load = None if whole is None or tilted else _fitted_load(model, val, ddq, noise)
+        if load is not None and load.named:  # the joints diagnosed on what it leaves
+            verdict = with_hint(verdict, load_hint(load, payload))
+            rest = dependence_hint(
+                q, dq, load.residual, noise.total, names, terms, offsets=offsets,
+                left_out=left_out, ddq=ddq, inertia=inertia,
+            )  # fmt: skip
+            verdict = with_hint(verdict, None if rest is None else f"what it leaves: {rest}")
+            springs = None  # the load, not a spring, is what the residual follows
+        else:
+            verdict = with_dependence_hint(
+                verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
+                tau, offsets, left_out, ddq, inertia,
+            )  # fmt: skip
     verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
     high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
     if verdict.level == "good" and high is not None and noise.inputs is not None:
@@ -665,7 +692,50 @@ def _with_hints(
             verdict, reason=f"{verdict.reason}; a floor raised because {high}"
         )
     # the low-speed hint's "above the noise": the sensors' (its module docstring)
-    return with_low_speed_hint(verdict, dq, error, noise.sensor, names), springs, gains, tilt
+    verdict = with_low_speed_hint(verdict, dq, error, noise.sensor, names)
+    return verdict, springs, gains, tilt, load
+
+
+def _fitted_load(
+    model: IdentifiedModel | Robot,
+    val: RecordingsValidation,
+    ddq: Sequence[NDArray[np.float64]] | None,
+    noise: _Noise,
+) -> ResidualLoad | None:
+    """The rigid load at the flange fitted to the residual of every piece judged
+    (:func:`~dynid.observer.residual_load.residual_load`, its serial correlation over the
+    pieces' cut-off at their rate); None without the accelerations."""
+    if ddq is None:
+        return None
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    steps = np.concatenate([np.diff(v.log.t) for v in val.parts])
+    rate = 1.0 / float(np.median(steps)) if steps.size and np.median(steps) > 0 else None
+    return residual_load(
+        robot, [v.log.q for v in val.parts], [v.log.dq for v in val.parts], ddq,
+        [v.log.tau - v.tau_hat for v in val.parts], noise.total,
+        cutoff_hz=val.pieces.cutoff_hz, rate_hz=rate,
+    )  # fmt: skip
+
+
+def _payload_command(
+    model: IdentifiedModel | Robot,
+    data: str | Path | Sequence[str | Path],
+    label: str | None,
+    feasible: str | Path | None,
+    source: str | Path | None,
+) -> str:
+    """The ``dynid payload`` command that measures a load on the recordings ``data`` with
+    the model validated: ``--model`` its file, ``--params`` a feasible file's, else
+    ``--robot`` (``label`` ``"robot panda"``)."""
+    files = [data] if isinstance(data, str | Path) else list(data)
+    given = " ".join(str(f) for f in files)
+    if isinstance(model, IdentifiedModel):
+        what = f"--model {source or label or 'identification.json'}"
+    elif feasible is not None:
+        what = f"--params {feasible}"
+    else:
+        what = f"--robot {(label or model.name).removeprefix('robot ')}"
+    return f"`dynid payload {what} --data {given} --out DIR`"
 
 
 @dataclass(frozen=True, slots=True)
