@@ -191,6 +191,9 @@ def test_urdf_export_names_an_armature_without_gears_only_when_not_negligible(tm
     big = Drive.from_gears([1.0, 1.0], rotor_inertia=14.0 * diag, side="joint")  # a wrist's
     _, lines = _warnings(export_urdf, tmp_path / "c.urdf", _arm(), ExportOptions(drive=big))
     assert "(93 % of the joint's inertia)" in lines[0], lines[0]  # 14 / 15, not 1.4e+03 %
+    huge = Drive.from_gears([1.0, 1.0], rotor_inertia=250.0 * diag, side="joint")  # a servo's
+    _, lines = _warnings(export_urdf, tmp_path / "d.urdf", _arm(), ExportOptions(drive=huge))
+    assert "(99.6 % of the joint's inertia)" in lines[0], lines[0]  # 250 / 251, not 1e+02 %
 
 
 def test_template_dynamics_are_replaced_by_the_identified_friction(tmp_path):

@@ -360,8 +360,12 @@ def _rotor_warning(
 def _share(x: float) -> str:
     """The armature's share of its joint's inertia with it, from ``x`` (armature over
     ``M_jj``): ``12 %``, at most ``100 %`` (a joint without link inertia); a wrist's rotor
-    14 times its links' inertia reads 93 %, not 1.4e+03 %."""
-    return f"{100.0 * x / (1.0 + x):.2g} %" if np.isfinite(x) else "100 %"
+    14 times its links' inertia reads 93 %, not 1.4e+03 %, and one 250 times 99.6 %, not
+    1e+02 %."""
+    if not np.isfinite(x):
+        return "100 %"
+    share = 100.0 * x / (1.0 + x)
+    return f"{share:.2g} %" if share < 99.0 else f"{share:.3g} %"
 
 
 def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
