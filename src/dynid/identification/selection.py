@@ -720,9 +720,10 @@ def _refined_width(judged: Sequence[Candidate], off: _OffGrid, notes: list[str])
         return next((c.score for c in new if c.structure == mine and not c.skipped), None)
 
     assert isinstance(full.width, float)  # one width: the smooth laws of the grid
-    tried = refined_shape(scores, full.width, at)
+    tried = refined_shape(scores, full.width, at, probe=True)
     best = min([start, *(c for c in new if not c.skipped)], key=lambda c: c.score)
     if best is not start:
+        new += _siblings_at(best.structure, smooth, off)
         grid = sorted(scores)
         k = grid.index(full.width)
         lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
@@ -734,6 +735,24 @@ def _refined_width(judged: Sequence[Candidate], off: _OffGrid, notes: list[str])
             f"{start.heldout_error_percent:.4g} %)"
         )
     return new
+
+
+def _siblings_at(refined: Structure, smooth: Sequence[Candidate], off: _OffGrid) -> list[Candidate]:
+    """The other smooth laws of one width judged on the grid (``smooth``: with and
+    without the armature, the offset), each at the refined width of ``refined`` (fitted
+    in a regressor per armature choice and placement, :meth:`_OffGrid.judged`): the
+    terms the grid's best left out at a grid width far from the data's (an offset, an
+    armature whose columns a misshapen sign pulled) judged again where the sign fits,
+    so that the choice weighs them at that width too."""
+    w = refined.width
+    mine = [replace(c.structure, width=w) for c in smooth]
+    rest = [s for s in dict.fromkeys(mine) if s != refined]
+    out: list[Candidate] = []
+    for key in dict.fromkeys(regressor_group(s) for s in rest):
+        group = [s for s in rest if regressor_group(s) == key]
+        group.sort(key=lambda s: -len(s.friction))  # the largest first: its regressor
+        out += off.judged(group, "structure search, the smooth width", value=f"{w:g} terms")
+    return out
 
 
 def _refined_stribeck(judged: list[Candidate], off: _OffGrid, notes: list[str]) -> Structure:
