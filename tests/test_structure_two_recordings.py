@@ -99,3 +99,39 @@ def test_a_v_shaped_error_is_refined_past_the_parabola_s_vertex():
     best = min(tried, key=v)
     assert abs(math.log(best / 17.5)) < 0.05, tried
     assert v(best) < grid[10.0]
+
+
+def test_two_recordings_are_paired_over_time_blocks_of_each(two_recordings):
+    """Regression (two recordings gave the paired standard error one degree of freedom):
+    every candidate is scored on three contiguous time blocks of each held-out recording,
+    six to pair."""
+    sel, _, _, _ = two_recordings
+    assert all(len(c.part_scores) == 6 for c in sel.candidates)
+
+
+def test_part_labels_cut_each_recording_into_contiguous_blocks():
+    """Two exact recordings, five folds: each cut into three contiguous blocks of a third
+    of its samples, every row of a sample (two joints) alike, the blocks of the first
+    recording the first fold's; five recordings or more are not cut (closed form)."""
+    robot = planar_2r()
+    logs = [
+        *recordings(robot, (1,), friction=None, duration=0.5, fs=250.0),
+        *recordings(robot, (2,), friction=None, duration=0.4, fs=250.0),
+    ]
+    data = prepare_recordings(robot, logs, cutoff_hz=None)
+    sizes = [
+        sum(p.log.n_samples for p, r in zip(data.pieces, data.recording, strict=True) if r == k)
+        for k in (0, 1)
+    ]
+    parts = data.part_labels(5)
+    assert parts is not None
+    labels, fold = parts
+    per_sample = labels[::2]
+    np.testing.assert_array_equal(labels[1::2], per_sample)
+    counts = np.bincount(per_sample)
+    assert fold == (0, 0, 0, 1, 1, 1)
+    for k, size in enumerate(sizes):
+        mine = counts[3 * k : 3 * k + 3]
+        assert mine.sum() == size and mine.max() - mine.min() <= 1, (mine, size)
+    assert np.all(np.diff(per_sample) >= 0)
+    assert data.part_labels(2) is None
