@@ -108,6 +108,10 @@ class Candidate:
         below the Coulomb level, no Stribeck effect but a correction of the sign's shape
         (a smooth Coulomb narrower or wider than the data's); the candidate is skipped, and
         the search falls back to the law without the bump on those joints.
+    part_scores : tuple of float
+        The whitened held-out error [%] of every contiguous time block of the held-out
+        recordings (:attr:`~.holdout.HeldOut.parts`, each predicted by the fit of its fold),
+        which :func:`paired_se` pairs; empty: the folds are paired.
     relative_std : tuple of (str, float)
         Each coefficient it holds that a per-joint structure may leave out (``Ia5``,
         ``fv3``) and its relative standard deviation [%] in its fit on all data (as the
@@ -127,6 +131,7 @@ class Candidate:
     fold_whitened_percent: tuple[float, ...] = ()
     relative_std: tuple[tuple[str, float], ...] = ()
     negative_bump: tuple[str, ...] = ()
+    part_scores: tuple[float, ...] = ()
 
     @property
     def skipped(self) -> bool:
@@ -182,7 +187,12 @@ def paired_se(c: Candidate, best: Candidate) -> float:
     on one fold; the spread of each candidate's fold errors (``heldout_se_percent``) would
     call a consistently worse candidate as good as the best. The one-standard-error rule
     reads the spread of the differences instead. 0 for one fold (the folds of two
-    candidates always match: the same held-out data)."""
+    candidates always match: the same held-out data). Of fewer recordings than
+    ``--folds``, paired over the contiguous time blocks of each held-out recording
+    (:attr:`Candidate.part_scores`): two recordings' folds give the difference's spread
+    one degree of freedom, a tie or a gap by the luck of two numbers."""
+    if c.part_scores and len(c.part_scores) == len(best.part_scores):
+        return paired_fold_se(c.part_scores, best.part_scores)
     return paired_fold_se(c.fold_scores, best.fold_scores)
 
 
@@ -287,6 +297,7 @@ def candidate_judged(
     per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
     se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
     white = [t.relative_error_percent(x) for t, x in zip(sub.whitened, xs, strict=True)]
+    parts = [t.relative_error_percent(xs[f]) for t, f in zip(sub.parts, sub.part_fold, strict=True)]
     whole, whole_std = sub.whole.solve_with_std(rtol, std=check is not None)
     unphysical: tuple[Violation, ...] = ()
     relative: tuple[tuple[str, float], ...] = ()
@@ -310,6 +321,7 @@ def candidate_judged(
         fold_whitened_percent=tuple(white),
         relative_std=relative,
         negative_bump=negative,
+        part_scores=tuple(parts),
     )
 
 
@@ -372,7 +384,8 @@ def without_recordings(model: IdentifiedModel, skip: tuple[int, ...]) -> HeldOut
     held = heldout_of(model)
     kept = [t for j, t in enumerate(held.test) if j not in skip]
     white = tuple(t for j, t in enumerate(held.whitened) if j not in skip)
-    return replace(HeldOut.k_fold(kept), scheme=held.scheme, noise=held.noise, whitened=white)
+    out = replace(HeldOut.k_fold(kept), scheme=held.scheme, noise=held.noise, whitened=white)
+    return out.with_parts(*held.without_folds(skip)) if held.parts else out
 
 
 def recording_oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: float) -> list[float]:

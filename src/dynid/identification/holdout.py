@@ -378,6 +378,12 @@ class HeldOut:
         With a separate log: all of the identification data with the targets the separate
         log is judged on (the measured torques), where the training error is read; None:
         ``whole``.
+    parts : tuple of Normals
+        Contiguous time blocks of the folds' :attr:`whitened` rows (each a block of one
+        held-out recording, :meth:`~.recordings.Recordings.part_labels`), whose errors a
+        paired standard error reads; empty: the folds themselves.
+    part_fold : tuple of int
+        The fold each of :attr:`parts` belongs to (and is predicted by the fit of).
     """
 
     train: tuple[Normals, ...]
@@ -387,6 +393,8 @@ class HeldOut:
     noise: float = 1.0
     whitened: tuple[Normals, ...] = ()
     judged: Normals | None = None
+    parts: tuple[Normals, ...] = ()
+    part_fold: tuple[int, ...] = ()
 
     @classmethod
     def k_fold(cls, blocks: Sequence[Normals], test: Sequence[Normals] | None = None) -> HeldOut:
@@ -439,6 +447,8 @@ class HeldOut:
             self.noise,
             tuple(t._restricted(on) for t in self.whitened),
             None if self.judged is None else self.judged._restricted(on),
+            tuple(t._restricted(on) for t in self.parts),
+            self.part_fold,
         )
 
     def expanded(self, mask: NDArray[np.bool_]) -> HeldOut:
@@ -451,7 +461,25 @@ class HeldOut:
             self.noise,
             tuple(t.expanded(mask) for t in self.whitened),
             None if self.judged is None else self.judged.expanded(mask),
+            tuple(t.expanded(mask) for t in self.parts),
+            self.part_fold,
         )
+
+    def with_parts(self, parts: Sequence[Normals], part_fold: Sequence[int]) -> HeldOut:
+        """The same folds with :attr:`parts` (each block's whitened normal equations) and
+        the fold of each; unchanged when no fold holds two of them."""
+        fold = tuple(int(f) for f in part_fold)
+        if len(set(fold)) == len(fold):
+            return self
+        return replace(self, parts=tuple(parts), part_fold=fold)
+
+    def without_folds(self, skip: Sequence[int]) -> tuple[tuple[Normals, ...], tuple[int, ...]]:
+        """:attr:`parts` and :attr:`part_fold` of the folds not in ``skip``, the folds
+        numbered again in order."""
+        kept = [j for j in range(self.folds) if j not in skip]
+        new = {j: i for i, j in enumerate(kept)}
+        mine = [(p, new[f]) for p, f in zip(self.parts, self.part_fold, strict=True) if f in new]
+        return tuple(p for p, _ in mine), tuple(f for _, f in mine)
 
     def heldout_error_percent(
         self, xs: Sequence[NDArray[np.float64]], *, whitened: bool = False

@@ -46,6 +46,7 @@ def heldout_judge(
     if validation is not None:
         how = "a separate recording"
     scheme = "recordings" if len(data.names) > 1 else "blocks"
+    parts = data.part_labels(folds) if labels is not None and validation is None else None
     measured_ok = data.measured  # judged on the torques as measured: one more pass
     inv_noise = inverse_noise(data)
 
@@ -61,10 +62,12 @@ def heldout_judge(
         if isinstance(stack, StreamedRows) and stack.normals is not None and validation is None:
             assert labels is not None  # the fit gathered the folds' normals by these labels
             source = rows if measured_ok else selected_columns(stack.source, cols)
-            plain, white = normals_by_label_scaled(source, labels, None, inv_noise, b)
+            plain, white, held_parts = _judged_normals(
+                lambda lab: normals_by_label_scaled(source, lab, None, inv_noise, b), labels, parts
+            )
             judged = plain if measured_ok else None
             held = replace(HeldOut.k_fold(stack.normals, judged), scheme=scheme, whitened=white)
-            return held.expanded(cols)
+            return held.with_parts(*held_parts).expanded(cols)
         if isinstance(stack, StreamedRows):  # rows in blocks: one pass per set of labels
             source = selected_columns(stack.source, cols)
             e = np.concatenate([y - W @ b for W, y, _ in source()])
@@ -92,14 +95,55 @@ def heldout_judge(
             # model) would make a joint's error vanish with the terms it loses; the
             # measured rows judged unweighted too, the error of the torques as measured
             # (weighted, an irls fit read 40 % above the same model's plain error)
-            plain, white = normals_by_label_scaled(
-                rows if measured_ok else fitted, labels, None if measured_ok else rw, inv_noise, b
+            judged_rows = rows if measured_ok else fitted
+            weights = None if measured_ok else rw
+            plain, white, held_parts = _judged_normals(
+                lambda lab: normals_by_label_scaled(judged_rows, lab, weights, inv_noise, b),
+                labels,
+                parts,
             )
             judged = plain if measured_ok else None
             held = replace(HeldOut.k_fold(normals(labels), judged), scheme=scheme, whitened=white)
+            held = held.with_parts(*held_parts)
         return held.expanded(cols)
 
     return judge, how, (labels if validation is None else None)
+
+
+_Pass = Callable[[NDArray[np.intp]], tuple[tuple[Normals, ...], tuple[Normals, ...]]]
+
+
+def _judged_normals(
+    by_label: _Pass,
+    labels: NDArray[np.intp],
+    parts: tuple[NDArray[np.intp], tuple[int, ...]] | None,
+) -> tuple[tuple[Normals, ...], tuple[Normals, ...], tuple[tuple[Normals, ...], tuple[int, ...]]]:
+    """The judged rows' normal equations per fold, plain and whitened (``by_label``: one
+    pass over the rows by a labelling), from one pass by the folds' blocks ``parts``
+    (:meth:`~.recordings.Recordings.part_labels`: the labels and each block's fold) when
+    given, summed per fold; and the whitened blocks with their folds (empty without
+    ``parts`` or whitened rows)."""
+    if parts is None:
+        plain, white = by_label(labels)
+        return plain, white, ((), ())
+    fine, fold = parts
+    plain, white = by_label(fine)
+    if not white:
+        return _per_fold(plain, fold), white, ((), ())
+    return _per_fold(plain, fold), _per_fold(white, fold), (white, fold)
+
+
+def _per_fold(blocks: tuple[Normals, ...], fold: tuple[int, ...]) -> tuple[Normals, ...]:
+    """The normal equations of ``blocks`` summed per fold (``fold``: each block's, every
+    fold 0 .. k-1 present)."""
+    out: list[Normals] = []
+    for f in range(max(fold) + 1):
+        mine = [blk for blk, g in zip(blocks, fold, strict=True) if g == f]
+        total = mine[0]
+        for blk in mine[1:]:
+            total = total + blk
+        out.append(total)
+    return tuple(out)
 
 
 def inverse_noise(data: Recordings) -> NDArray[np.float64] | None:

@@ -44,7 +44,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..exceptions import DataError, DynidWarning, ShapeError
+from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import report
@@ -354,6 +354,36 @@ class Recordings(TorqueRoute):
             return labels, f"leave one recording out ({len(self.names)} recordings)"
         labels = np.repeat(block_labels(self.n_samples, folds), n)
         return labels, f"{folds} contiguous time blocks"
+
+    def part_labels(
+        self, folds: int = DEFAULT_FOLDS
+    ) -> tuple[NDArray[np.intp], tuple[int, ...]] | None:
+        """Of fewer recordings than ``folds`` (two or more), each recording's rows cut into
+        ``ceil(folds / recordings)`` contiguous time blocks (over its pieces in order, as
+        :func:`~.holdout.block_labels` cuts; one block for a recording too short): the
+        block of every row (rows of :meth:`blocks`) and the recording (fold of
+        :meth:`fold_labels`) each block belongs to. The fold still leaves its whole
+        recording out of the fit; its held-out error is scored per block, so that the
+        standard error of two candidates' difference, paired over the blocks
+        (:func:`~.candidates.paired_se`), has more than the one degree of freedom two
+        recordings give. None for one recording, or ``folds`` recordings or more."""
+        k_rec = len(self.names)
+        if k_rec < 2 or k_rec >= folds:
+            return None
+        per = -(-folds // k_rec)
+        counts = np.zeros(k_rec, np.int64)
+        for p, r in zip(self.pieces, self.recording, strict=True):
+            counts[r] += p.log.n_samples
+        cuts = [_blocks_or_one(int(c), per) for c in counts]
+        first = np.concatenate([[0], np.cumsum([int(c.max()) + 1 for c in cuts])])
+        done = np.zeros(k_rec, np.int64)
+        out = []
+        for p, r in zip(self.pieces, self.recording, strict=True):
+            m = p.log.n_samples
+            out.append(np.repeat(first[r] + cuts[r][done[r] : done[r] + m], self.n))
+            done[r] += m
+        fold = tuple(r for r, c in enumerate(cuts) for _ in range(int(c.max()) + 1))
+        return np.concatenate(out).astype(np.intp), fold
 
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
@@ -768,3 +798,12 @@ def standstill_band(
     derived = _derived(sides, cutoff_hz)
     K = None if transmission is None else np.asarray(transmission, dtype=np.float64)
     return np.asarray(derived[2] * _sides_band(sides, K, derived), dtype=np.float64)
+
+
+def _blocks_or_one(n_samples: int, k: int) -> NDArray[np.intp]:
+    """:func:`~.holdout.block_labels` of ``n_samples`` into ``k`` blocks, one block where
+    they are too few."""
+    try:
+        return block_labels(n_samples, k)
+    except OptionError:
+        return np.zeros(n_samples, np.intp)

@@ -15,7 +15,8 @@ columns) by its pooled held-out error; it keeps the **simplest candidate within 
 standard error of the best** (the one-standard-error rule of cross-validation: Hastie,
 Tibshirani and Friedman, *The Elements of Statistical Learning*, 2nd ed., Sec. 7.10),
 the standard error being that of the difference of the two candidates' errors paired
-over the folds (:func:`~dynid.identification.candidates.paired_se`), and differences
+over the folds (:func:`~dynid.identification.candidates.paired_se`; of fewer recordings
+than the folds, over contiguous time blocks of each held-out recording), and differences
 under 1 % of the lowest error counting as ties. A coefficient the data determine (its
 relative standard deviation in the fit that holds it at most
 :data:`~dynid.identification.candidates.DETERMINED_STD_PERCENT`, the standard deviation
@@ -93,6 +94,7 @@ from .log_rows import shared_steps
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded, sign_confirmed
+from .outlying_spans import outlying_spans, spans_text
 from .recordings import Recordings, prepare_recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
@@ -344,7 +346,7 @@ def select_structure(
     per: tuple[tuple[str, float], ...] = ()
     if len(data.names) > 1 and validation is None:
         per = _per_recording(chosen, full, groups, where, data.names, fit_rtol)
-    _warn_outlying(skip, per, keep)
+    _warn_outlying(skip, per, keep, {k: _outlying_where(k, chosen, off, data, robot) for k in skip})
     return Selection(
         tuple(judged),
         chosen,
@@ -394,26 +396,74 @@ def reversed_friction(selection: Selection) -> tuple[Violation, ...]:
 
 
 def _warn_outlying(
-    skip: tuple[int, ...], per: tuple[tuple[str, float], ...], keep: bool | None = None
+    skip: tuple[int, ...],
+    per: tuple[tuple[str, float], ...],
+    keep: bool | None = None,
+    spans: dict[int, str] | None = None,
 ) -> None:
     """One warning naming the recordings ``skip`` left out of the judgement, their held-out
-    errors with the chosen structure against the others' (``per``), and what the final
-    fit does with them (``keep``, :func:`_final_fit`)."""
+    errors with the chosen structure against the others' (``per``), where in each the
+    residual stands off (``spans``: its text per recording, :func:`_outlying_where`) and
+    what the final fit does with them (``keep``, :func:`_final_fit`)."""
     if not skip:
         return
     odd = [per[i] for i in skip]
     rest = [e for i, (_, e) in enumerate(per) if i not in skip]
     others = f"{min(rest):.3g} %" if len(rest) == 1 else f"{min(rest):.3g} to {max(rest):.3g} %"
     errors = ", ".join(f"{e:.3g} %" for _, e in odd)
+    where = [f"{per[i][0]}'s at {spans[i]}" for i in skip if spans and spans.get(i)]
     warnings.warn(
         f"{', '.join(n for n, _ in odd)}: held-out error{'s' if len(odd) > 1 else ''} "
         f"{errors} with the chosen structure, far above the other recordings' ({others}; "
         "metadata.selection.heldout_per_recording): it holds torques the model does not "
-        "(contacts, a payload?); the structure is chosen on the other recordings"
+        "(contacts, a payload?)"
+        + (
+            f"; the residual (predicted by the fit of the others) stands off {'; '.join(where)}"
+            if where
+            else ""
+        )
+        + "; the structure is chosen on the other recordings"
         + ("" if keep is None else f"; {_final_fit(keep, len(skip))}"),
         DynidWarning,
         stacklevel=3,
     )
+
+
+def _outlying_where(
+    k: int, chosen: Structure, off: _OffGrid, data: Recordings, robot: Robot
+) -> str:
+    """Where recording ``k``'s residual stands off (:func:`~.outlying_spans.spans_text`):
+    its torques as measured less the prediction of ``chosen`` fitted on the other
+    recordings (its fold's training rows, in the regressor ``off.where`` says, of
+    ``off.groups``); empty where none stands off or its rows do not match its samples."""
+    key = off.where.get(chosen)
+    if key is None:
+        return ""
+    model, terms = off.groups[key]
+    rtol = off.rtol
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    idx = np.flatnonzero(candidate_columns(chosen, model, terms) & np.asarray(fit.kept, bool))
+    held = heldout_of(model).restricted(idx)
+    if held.folds != len(data.names):
+        return ""
+    x = held.train[k].solve(rtol)
+    columns = model_columns(
+        robot, data, drive=model.drive, terms=tuple(t for t, _ in terms), base=model.base
+    )
+    labels, _ = data.fold_labels()
+    e, o = [], 0
+    for blk in data.measured_blocks(robot, columns):
+        mine = labels[o : o + blk.y.size] == k
+        o += blk.y.size
+        if mine.any():
+            e.append(blk.y[mine] - blk.W[mine][:, idx] @ x)
+    mine_pieces = [p for p, r in zip(data.pieces, data.recording, strict=True) if r == k]
+    t = np.concatenate([np.asarray(p.log.t, dtype=np.float64) for p in mine_pieces])
+    if o != labels.size or not e or sum(r.size for r in e) != t.size * data.n:
+        return ""
+    found = outlying_spans(t, np.concatenate(e).reshape(t.size, data.n))
+    start = data.starts[k] if k < len(data.starts) else None
+    return spans_text(found, robot.joint_names, start, data.names[k])
 
 
 def _final_fit(keep: bool, k: int) -> str:
@@ -720,9 +770,10 @@ def _refined_width(judged: Sequence[Candidate], off: _OffGrid, notes: list[str])
         return next((c.score for c in new if c.structure == mine and not c.skipped), None)
 
     assert isinstance(full.width, float)  # one width: the smooth laws of the grid
-    tried = refined_shape(scores, full.width, at)
+    tried = refined_shape(scores, full.width, at, probe=True)
     best = min([start, *(c for c in new if not c.skipped)], key=lambda c: c.score)
     if best is not start:
+        new += _siblings_at(best.structure, smooth, off)
         grid = sorted(scores)
         k = grid.index(full.width)
         lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
@@ -734,6 +785,24 @@ def _refined_width(judged: Sequence[Candidate], off: _OffGrid, notes: list[str])
             f"{start.heldout_error_percent:.4g} %)"
         )
     return new
+
+
+def _siblings_at(refined: Structure, smooth: Sequence[Candidate], off: _OffGrid) -> list[Candidate]:
+    """The other smooth laws of one width judged on the grid (``smooth``: with and
+    without the armature, the offset), each at the refined width of ``refined`` (fitted
+    in a regressor per armature choice and placement, :meth:`_OffGrid.judged`): the
+    terms the grid's best left out at a grid width far from the data's (an offset, an
+    armature whose columns a misshapen sign pulled) judged again where the sign fits,
+    so that the choice weighs them at that width too."""
+    w = refined.width
+    mine = [replace(c.structure, width=w) for c in smooth]
+    rest = [s for s in dict.fromkeys(mine) if s != refined]
+    out: list[Candidate] = []
+    for key in dict.fromkeys(regressor_group(s) for s in rest):
+        group = [s for s in rest if regressor_group(s) == key]
+        group.sort(key=lambda s: -len(s.friction))  # the largest first: its regressor
+        out += off.judged(group, "structure search, the smooth width", value=f"{w:g} terms")
+    return out
 
 
 def _refined_stribeck(judged: list[Candidate], off: _OffGrid, notes: list[str]) -> Structure:
