@@ -90,3 +90,21 @@ def test_a_held_out_logs_gap_and_jitter_are_named(gapped, tmp_path, capsys, comm
     doc = json.loads((out / name).read_text())
     (gap,) = (doc if command == "validate" else doc["metadata"])["recordings"][0]["gaps"]
     assert gap == pytest.approx([before, length], abs=1e-6)
+
+
+def test_a_long_hole_among_many_dropped_samples_is_said_before_them():
+    """Regression: a recording cut at five 0.03 s gaps, then a 2 s hole at t = 35 s, said
+    the first four gaps "and 2 more": the hole only in the JSON. The four longest are
+    said, in time order, the hole among them, and the rest with their longest length;
+    the report's table says the same."""
+    from dynid.identification.pieces import gaps_text
+    from dynid.report.page import _pieces
+
+    gaps = [[1.0, 0.03], [5.0, 0.03], [9.0, 0.03], [12.0, 0.03], [20.0, 0.03], [35.0, 2.0]]
+    said = gaps_text(gaps, 0.0, "rec1.csv")
+    assert "t = 35.000 s (2 s long)" in said, said
+    assert said.endswith("and 2 more, at most 0.03 s long"), said
+    stamps = [float(x) for x in re.findall(r"t = ([\d.]+) s", said)]
+    assert stamps == sorted(stamps) and len(stamps) == 4, said
+    row = _pieces({"pieces": 7, "gaps": gaps, "file": "rec1.csv"})
+    assert "t = 35.000 s, 2 s long" in row and "2 more, at most 0.03 s long" in row, row

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["offset_text", "said_time", "said_times", "stamp_text"]
+__all__ = ["longest_gaps", "offset_text", "said_time", "said_times", "stamp_text"]
 
 #: Decimals of a stamp said in seconds: milliseconds, the resolution of a log's stamps
 #: at up to 1 kHz.
@@ -62,3 +62,16 @@ def said_times(
     return f"t = {', '.join(stamp_text(t) for t in head)} s{rest}" + _paren(
         offset_text(offsets, t0, name)
     )
+
+
+def longest_gaps(
+    gaps: Sequence[Sequence[float]], shown: int = 4
+) -> tuple[list[tuple[float, float]], str]:
+    """The ``shown`` longest of a recording's ``gaps`` (``[t_before, length]`` [s] each),
+    in time order, and what is said of the others: ``" and 3 more, at most 0.03 s long"``
+    (empty for none): a 2 s hole among many dropped samples is never among "the others"."""
+    pairs = [(float(t), float(n)) for t, n in gaps]
+    keep = sorted(sorted(range(len(pairs)), key=lambda k: -pairs[k][1])[:shown])
+    rest = [pairs[k][1] for k in range(len(pairs)) if k not in set(keep)]
+    more = f" and {len(rest)} more, at most {max(rest):.3g} s long" if rest else ""
+    return [pairs[k] for k in keep], more

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .._times import offset_text, said_times, stamp_text
+from .._times import longest_gaps, offset_text, said_times, stamp_text
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -134,16 +134,17 @@ def gaps_between(pieces: Sequence[TorqueLog]) -> tuple[tuple[float, float], ...]
 def gaps_text(gaps: Sequence[Sequence[float]], t0: float | None, name: str | None) -> str:
     """``cut at the gap(s) after t = 86412.300 s (11.3 s into rec1.csv; 0.4 s long)``: the
     gaps a recording was cut at (``[t_before, length]`` [s] each, :func:`gaps_between`),
-    the first four, each stamp as in the file with its offset from the recording's first
-    stamp ``t0`` [s] (when that is not 0); empty without gaps. How ``identify``,
-    ``validate``, ``friction`` and ``payload`` say where a recording was cut."""
+    the four longest (:func:`~dynid._times.longest_gaps`), each stamp as in the file with
+    its offset from the recording's first stamp ``t0`` [s] (when that is not 0); empty
+    without gaps. How ``identify``, ``validate``, ``friction`` and ``payload`` say where a
+    recording was cut."""
     if not gaps:
         return ""
     said = []
-    for t, length in gaps[:4]:
+    shown, more = longest_gaps(gaps)
+    for t, length in shown:
         into = offset_text([t - (t0 or 0.0)], t0, name)
         said.append(f"t = {stamp_text(t)} s ({into + '; ' if into else ''}{length:.3g} s long)")
-    more = f" and {len(gaps) - 4} more" if len(gaps) > 4 else ""
     return f"cut at the gap(s) after {', '.join(said)}{more}"
 
 

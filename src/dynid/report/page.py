@@ -36,7 +36,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .._times import said_time
+from .._times import longest_gaps, said_time
 from ..io.atomic import write_text
 from .answers import answer_for
 from .html import cell, esc, figure, href, number, size, table
@@ -136,10 +136,11 @@ def _pieces(rec: Mapping[str, Any]) -> str:
     gaps = [g for g in rec.get("gaps") or () if isinstance(g, list) and len(g) == 2]
     t0 = rec.get("start_s") if isinstance(rec.get("start_s"), (int, float)) else None
     name = rec.get("file") if isinstance(rec.get("file"), str) else None
+    shown, more = longest_gaps(gaps)
     said = "; ".join(
-        f"gap after {esc(said_time(t, t0, name))}, {number(n, 3)} s long" for t, n in gaps[:4]
+        f"gap after {esc(said_time(t, t0, name))}, {number(n, 3)} s long" for t, n in shown
     )
-    more = f"; {len(gaps) - 4} more" if len(gaps) > 4 else ""
+    more = more.replace(" and", ";", 1)
     return esc(rec.get("pieces", "")) + (f" ({said}{more})" if said else "")
 
 
