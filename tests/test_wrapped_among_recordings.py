@@ -107,6 +107,22 @@ def test_a_wrap_on_a_joint_limited_to_less_than_a_turn_is_named_a_wrap(panda, fi
     assert "do not allow a whole turn" in text and "x pi/180" not in text
 
 
+def test_a_wrap_within_limits_across_pi_is_unwrapped_without_blame(panda, files):
+    """Regression: a joint of limits [-0.5, 4.7] (less than a turn, across pi) moving about
+    3.0 rad was logged wrapped, and its jumps at pi were called a whole turn its limits do
+    not allow ("the log or the robot description is wrong"); it crossed pi within them.
+    The wrap is said and unwrapped, without the blame."""
+    q_min, q_max = np.array(panda.q_min), np.array(panda.q_max)
+    q_min[6], q_max[6] = -0.5, 4.7
+    across = dataclasses.replace(panda, q_min=q_min, q_max=q_max)
+    log = read_recordings(files["b"], across).logs[0]
+    with pytest.warns(DynidWarning) as said:
+        prepare_recordings(across, [log], ["b.csv"])
+    text = " ".join(str(w.message) for w in said)
+    assert "recorded wrapped into [-pi, pi]" in text, text
+    assert "do not allow a whole turn" not in text and "is wrong" not in text, text
+
+
 def test_a_joint_in_degrees_is_still_named_degrees(panda, files, tmp_path):
     """a.csv with joint 7 written in degrees (57 times the radians, no jump):
     refused naming degrees and the conversion, as before."""

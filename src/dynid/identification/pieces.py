@@ -421,8 +421,10 @@ def wrapped_finding(
     ``[-pi, pi]`` and unwrapped, without the file's name (:func:`recording_pieces` says it
     per recording; several recordings say it once, naming them). Given the ``robot`` and
     the joint-side ``log`` as recorded, a joint whose limits span less than a turn
-    (:func:`turn_limited`) is named with the times [s] of its jumps and its limits, which
-    do not allow that motion: the log or the description is wrong (not degrees)."""
+    (:func:`turn_limited`) and whose motion, unwrapped, no whole turns put within them
+    (:func:`_within_limits`: limits across ``pi`` let a joint cross it) is named with the
+    times [s] of its jumps and its limits, which do not allow that motion: the log or the
+    description is wrong (not degrees)."""
     what = "motor(s)" if motors else "joint(s)"
     said = (
         f"{what} {', '.join(str(j + 1) for j in joints)} recorded wrapped into [-pi, pi] "
@@ -432,6 +434,8 @@ def wrapped_finding(
         return said
     limited = turn_limited(robot)
     for j in (j for j in joints if limited[j]):
+        if _within_limits(log.q[:, j], float(robot.q_min[j]), float(robot.q_max[j])):
+            continue  # limits across +-pi: the joint crossed it, no whole turn
         at = log.t[1:][np.abs(np.diff(log.q[:, j])) > np.pi]
         said += (
             f"; {robot.joint_names[j]} jumps a whole turn at "
@@ -441,6 +445,23 @@ def wrapped_finding(
             "(not degrees: those would be 57 times the radians)"
         )
     return said
+
+
+#: Slack [rad] of a joint's unwrapped motion against its limits (:func:`_within_limits`).
+_WRAP_LIMIT_SLACK = 0.05
+
+
+def _within_limits(q: NDArray[np.float64], lo: float, hi: float) -> bool:
+    """Whether a joint's positions ``q`` (N,) [rad], recorded wrapped into ``[-pi, pi]``,
+    unwrapped and moved by some whole turns, lie within its limits ``[lo, hi]`` [rad] (to
+    :data:`_WRAP_LIMIT_SLACK`): a joint of limits ``[-0.52, 4.71]`` moving from 0.7 to 4.1
+    rad is logged jumping a whole turn at pi without ever turning one."""
+    u = np.unwrap(np.asarray(q, dtype=np.float64))
+    a, b = float(u.min()), float(u.max())
+    if b - a > hi - lo + 2 * _WRAP_LIMIT_SLACK:
+        return False
+    k = np.ceil((lo - _WRAP_LIMIT_SLACK - a) / (2 * np.pi))  # the fewest turns up to lo
+    return b + 2 * np.pi * k <= hi + _WRAP_LIMIT_SLACK
 
 
 def start_turns(
