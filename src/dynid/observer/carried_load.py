@@ -70,6 +70,7 @@ __all__ = [
     "fit_carried_load",
     "lagged_rigid_regressor",
     "rigid_load_regressor",
+    "samples_within",
     "load_words",
 ]
 
@@ -170,13 +171,23 @@ class LoadSamples:
         if take.size:
             self._parts.append((t[take], q[take], r[take], contact[take]))
 
-    def within(self, start: float, end: float) -> tuple[NDArray, ...] | None:
-        """The kept samples from ``start`` to ``end`` [s]; None: none."""
+    def joined(self) -> tuple[NDArray, ...] | None:
+        """The kept samples of every block, each array joined once: times (K,) [s],
+        positions (K, n) [rad], residual (K, n) [N m] and contact threshold (K, n) [N m]
+        in time order; None: none kept."""
         if not self._parts:
             return None
-        t, q, r, c = (np.concatenate([p[i] for p in self._parts]) for i in range(4))
-        k = (t >= start) & (t <= end)
-        return (t[k], q[k], r[k], c[k]) if k.any() else None
+        return tuple(np.concatenate([p[i] for p in self._parts]) for i in range(4))
+
+
+def samples_within(
+    kept: tuple[NDArray, ...], start: float, end: float
+) -> tuple[NDArray, ...] | None:
+    """The samples of ``kept`` (:meth:`LoadSamples.joined`, times in order) from
+    ``start`` to ``end`` [s], both included; None: none."""
+    t = kept[0]
+    a, b = int(np.searchsorted(t, start, "left")), int(np.searchsorted(t, end, "right"))
+    return tuple(x[a:b] for x in kept) if b > a else None
 
 
 def rigid_load_regressor(
@@ -384,9 +395,12 @@ def carried_loads(
     times [s], positions [rad], velocities [rad/s] and accelerations [rad/s^2], each
     (N, ...), for the rigid load's inertia (:func:`lagged_rigid_regressor`); None: the
     weight alone."""
-    out = []
+    out: list[CarriedLoad] = []
+    joined = samples.joined()
+    if joined is None:
+        return out
     for a, b in spans:
-        if b - a < MIN_LOAD_S or (kept := samples.within(a, b)) is None:
+        if b - a < MIN_LOAD_S or (kept := samples_within(joined, a, b)) is None:
             continue
         t, q, r, c = kept
         rigid = None if motion is None else lagged_rigid_regressor(robot, motion, (a, b), gain, t)

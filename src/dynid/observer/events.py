@@ -370,6 +370,7 @@ class EventDetector:
         *,
         std: ArrayLike | None = None,
         standstill: ArrayLike | None = None,
+        levels: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
     ) -> list[ContactEvent]:
         """The events closed by the next block of samples (an event still open at its
         end, and a run over the threshold that reaches it, are carried to the next block
@@ -385,6 +386,12 @@ class EventDetector:
             :func:`~dynid.observer.detection.residual_std` and
             :func:`~dynid.observer.detection.standstill_series` of the block (for
             thresholds that use them; NaN std where ``r`` is NaN).
+        levels : (ndarray, ndarray), each shape (m, n), optional
+            The contact and collision thresholds at the block's samples [N m]
+            (:func:`~dynid.observer.thresholds.threshold_series` of ``std`` and
+            ``standstill``), built once by a caller that needs them too; ``std`` and
+            ``standstill`` are then not read. Their values where ``r`` is NaN are never
+            read.
 
         Raises
         ------
@@ -403,10 +410,14 @@ class EventDetector:
                     self.slack_s = slack
             self._last_t = float(ta[-1])
         seen: NDArray[np.bool_] = np.all(np.isfinite(ra), axis=1)
-        if std is not None:  # NaN where not observed, as r
-            std = np.where(seen[:, None], np.asarray(std, dtype=np.float64), 0.0)
+        if levels is not None:
+            contact = _checks.as_exact("contact", levels[0], ra.shape, allow_nonfinite=True)
+            collision = _checks.as_exact("collision", levels[1], ra.shape, allow_nonfinite=True)
+        else:
+            if std is not None:  # NaN where not observed, as r
+                std = np.where(seen[:, None], np.asarray(std, dtype=np.float64), 0.0)
+            contact, collision = threshold_series(self.thresholds, m, std, standstill)
         ra = np.where(seen[:, None], ra, 0.0)
-        contact, collision = threshold_series(self.thresholds, m, std, standstill)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.abs(ra) / contact
         ratio = np.where((ratio >= 0) & seen[:, None], ratio, np.nan)  # NaN: not observed

@@ -241,7 +241,8 @@ def _detected_once(
             a, b = blk.a, blk.a + blk.r.shape[0]
             if blk.friction is not None and blk.friction is not model.friction:
                 seen = blk.friction  # banded for the velocity noise (a note says so)
-            events += det.feed(log.t[a:b], blk.r, std=blk.std, standstill=blk.margin)
+            levels = threshold_series(thresholds, b - a, blk.std, blk.margin)  # built once
+            events += det.feed(log.t[a:b], blk.r, levels=levels)
             w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame, kind)
             if put is not None:
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
@@ -254,11 +255,11 @@ def _detected_once(
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
             sign.add(log.tau[a:b], blk.r)
-            _tallied(prep, thresholds, blk, unmodelled, load, samples)
+            _tallied(prep, levels[0], blk, unmodelled, load, samples)
             if keep is not None:
                 keep.put(blk)
             if strided is not None:
-                strided.add(log.t, blk, None if ext is None else ext[a:b])
+                strided.add(log.t, blk, levels, None if ext is None else ext[a:b])
         events += det.finish()
     events = [e for e in events if not at_load_edge(e.start, e.end, carried)]
     if (opposite := opposite_finding(sign, model.robot.joint_names)) is not None:
@@ -384,7 +385,7 @@ def _less_load(
 
 def _tallied(
     prep: PreparedLog,
-    thresholds: Thresholds,
+    contact: NDArray[np.float64],
     blk: ObservedBlock,
     unmodelled: FrictionTally | None,
     load: LoadTally | None,
@@ -392,12 +393,13 @@ def _tallied(
 ) -> None:
     """One block fed to the tallies off contacts (``unmodelled``: the friction the model
     misses; ``load``: a load at the flange it misses) and its samples over the threshold
-    to ``samples`` (a carried load's fit)."""
+    to ``samples`` (a carried load's fit); ``contact`` (m, n) [N m] the block's contact
+    threshold (:func:`~dynid.observer.thresholds.threshold_series`, NaN where not
+    observed)."""
     if unmodelled is None and load is None and samples is None:
         return
     log = prep.log
     a, b = blk.a, blk.a + blk.r.shape[0]
-    contact, _ = threshold_series(thresholds, b - a, blk.std, blk.margin)
     under = ~(np.abs(blk.r) > contact)
     if unmodelled is not None:  # the friction the model misses
         unmodelled.add(log.t[a:b], prep.dq[a:b], blk.r, under)
@@ -590,14 +592,20 @@ class _Strided:
         self.parts: list[tuple[NDArray, ...]] = []
         self.ext: list[NDArray] = []
 
-    def add(self, t: NDArray, blk: ObservedBlock, ext: NDArray | None) -> None:
+    def add(
+        self,
+        t: NDArray,
+        blk: ObservedBlock,
+        levels: tuple[NDArray, NDArray],
+        ext: NDArray | None,
+    ) -> None:
+        """One block with its contact and collision thresholds ``levels`` (each (m, n)
+        [N m], :func:`~dynid.observer.thresholds.threshold_series`)."""
         a, m = blk.a, blk.r.shape[0]
         rows = np.arange(-a % self.step, m, self.step)  # the block's samples k*step
         r = blk.r[rows]
         seen = np.all(np.isfinite(r), axis=1)
-        std = None if blk.std is None else np.where(seen[:, None], blk.std[rows], 0.0)
-        margin = None if blk.margin is None else blk.margin[rows]
-        c, k = threshold_series(self.thresholds, rows.size, std, margin)
+        c, k = levels[0][rows], levels[1][rows]  # copies: fancy indexing
         c[~seen], k[~seen] = np.nan, np.nan
         self.parts.append((t[a + rows], r, c, k))
         if ext is not None:
