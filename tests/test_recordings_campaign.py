@@ -212,6 +212,31 @@ def test_validate_refuses_another_joint_count_in_one_line_naming_the_file(
         assert not out.exists()
 
 
+def test_a_chain_with_a_joint_below_the_logs_is_told_to_start_later(panda, logs, tmp_path):
+    """Regression: a log of an arm read with a chain that holds one more joint below it
+    (a torso lift under a TIAGo arm) was told to end the chain earlier (--tip), which
+    misreads every joint. The Panda's joints 2..7 as a 6-joint log against the chain of
+    joints 2..7 and against joints 1..6: the hint says --base panda_link1 first, the
+    share of positions within each cut's limits beside it; the log of joints 1..6 is told
+    --tip link6 first."""
+    from dynid.workflows.data_files import read_torque_log
+
+    log = load_torque_log(logs / "rec2.csv")
+    for cols, first, second in (
+        (slice(1, 7), "--base link1", "--tip link6"),
+        (slice(0, 6), "--tip link6", "--base link1"),
+    ):
+        six = type(log)(log.t, log.q[:, cols], log.dq[:, cols], log.tau[:, cols])
+        path = save_torque_log(tmp_path / "six.csv", six)
+        with pytest.raises(DataError) as err:
+            read_torque_log(path, 7, robot=panda)
+        said = str(err.value)
+        assert first in said and second in said, said
+        assert said.index(first) < said.index(second), said
+        shares = [float(x) for x in re.findall(r"\(([\d.]+) %", said)]
+        assert len(shares) == 2 and shares[0] >= shares[1], said
+
+
 # --- the campaign: a bad recording beside a good one, on every command -------------------
 
 

@@ -368,34 +368,67 @@ def _read_torque_log(
         if missing:  # the robot's joints whose columns the file lacks, and how to map others
             raise DataError(
                 f"the log has {log.n} joints; {owner or 'the robot'} has {n}: {missing}; or "
-                "pass the robot the log was recorded with"
                 + (
-                    ""
+                    "pass the robot the log was recorded with"
                     if chain is None
-                    else f" (a URDF's chain ends before "
-                    f"{chain.joint_names[log.n]} with --tip {chain.link_names[log.n]})"
+                    else _joint_count_hint(log, chain).replace("; hint: ", ": ", 1)
                 ),
                 file=path.name,
             )
         raise DataError(
             f"the log has {log.n} joints; {owner or 'the robot'} has {n}; "
-            + _joint_count_hint(log.n, chain),
+            + _joint_count_hint(log, robot if robot is not None and robot.n == n else None),
             file=path.name,
         )
     return log
 
 
-def _joint_count_hint(n_log: int, robot: Robot | None) -> str:
-    """The hint of a log of ``n_log`` joints for ``robot``: the joints its chain holds
-    beyond the log's (a gripper's) and the ``--tip`` link before them, when it has more."""
-    if robot is None or not 0 < n_log < robot.n:
+def _joint_count_hint(log: TorqueLog, robot: Robot | None) -> str:
+    """The hint of ``log`` for ``robot`` of another joint count. With more joints in the
+    chain: the joints it holds beyond the log's at either end, the chain cut at its base
+    (``--base``, a torso lift below an arm) or at its tip (``--tip``, a gripper's), the one
+    whose limits hold more of the log's positions first (:func:`_within_share`). With
+    fewer: the chain's first and last joints, for a chain that starts or ends one too
+    soon."""
+    n_log = log.n
+    if robot is None or n_log <= 0:
         return "hint: pass the robot the log was recorded with"
-    extra = ", ".join(robot.joint_names[n_log:])
+    if n_log > robot.n:
+        return (
+            f"its chain runs from {robot.link_names[0]} through {robot.joint_names[0]}.."
+            f"{robot.joint_names[-1]} to {robot.link_names[-1]}: the log's "
+            f"{n_log - robot.n} more joint(s) lie outside it; hint: start the chain earlier "
+            f"with --base (a link below {robot.link_names[0]}) or end it later with --tip, "
+            "or pass the robot the log was recorded with"
+        )
+    k = robot.n - n_log
+    tip = (
+        _within_share(log, robot, slice(0, n_log)),
+        f"--tip {robot.link_names[n_log]} (leaves out {', '.join(robot.joint_names[n_log:])})",
+    )
+    base = (
+        _within_share(log, robot, slice(k, robot.n)),
+        f"--base {robot.link_names[k]} (leaves out {', '.join(robot.joint_names[:k])})",
+    )
+    first, second = sorted((tip, base), key=lambda c: -c[0])
     return (
-        f"its chain goes on past the log's joints with {extra}; hint: end the URDF's chain "
-        f"before them with --tip {robot.link_names[n_log]}, or pass the robot the log was "
+        f"its chain holds {k} joint(s) beyond the log's; hint: cut the URDF's chain with "
+        f"{first[1]} ({100 * first[0]:.3g} % of the log's positions within those joints' "
+        f"limits) or {second[1]} ({100 * second[0]:.3g} %), or pass the robot the log was "
         "recorded with"
     )
+
+
+def _within_share(log: TorqueLog, robot: Robot, joints: slice) -> float:
+    """The share (0 to 1) of ``log``'s positions (every joint's samples) within the limits
+    of ``robot``'s ``joints`` [rad or m], with a slack of 5 % of each limit's span: a log
+    of the arm's joints read against a torso lift's limits falls outside them."""
+    lo = np.asarray(robot.q_min, dtype=np.float64)[joints]
+    hi = np.asarray(robot.q_max, dtype=np.float64)[joints]
+    slack = 0.05 * np.where(np.isfinite(hi - lo), hi - lo, 0.0)
+    q = np.asarray(log.q, dtype=np.float64)
+    inside = (q >= lo - slack) & (q <= hi + slack)
+    return float(np.mean(inside)) if inside.size else 0.0
 
 
 def read_static_file(
