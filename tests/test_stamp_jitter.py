@@ -84,6 +84,10 @@ def test_cleaning_and_the_identify_summary_call_jitter_jitter(seed=4):
     ms = float(re.search(r"stamps jittered, std (\S+) ms at a 10 ms period", text)[1])
     assert ms == pytest.approx(drawn * 1e3, rel=0.05)
     assert "resampled onto a uniform grid, no sample dropped" in text and "gap" not in text
+    assert prep.record(1).log.decimate == 2 and "(1 in 2 after the" in text, text
+    every = prepare_torque_log(dynid.panda(), log, cutoff_hz=10.0, check=False).record(1).log
+    said = samples_text(every)  # "1 in 1" read as a riddle
+    assert every.decimate == 1 and "(every sample after the 10 Hz low-pass" in said, said
     gapped = _log(_gap(t), seed).cleaning
     assert gapped.n_dropped == 4 and gapped.gaps == ((t[999], t[1004]),)
 

@@ -440,11 +440,12 @@ def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
         if len(decimations) > 1
         else str(log.decimate)
     )
+    every = "every sample" if k == "1" else f"1 in {k}"  # "1 in 1" read as a riddle
     text = (
-        f"{log.n_samples_used} samples used (1 in {k} after the {how} and trimming "
+        f"{log.n_samples_used} samples used ({every} after the {how} and trimming "
         f"of {log.n_samples_log} recorded"
         if cut is not None
-        else f"{log.n_samples_used} samples used (1 in {k}, unfiltered, after the trimming "
+        else f"{log.n_samples_used} samples used ({every}, unfiltered, after the trimming "
         f"of {log.n_samples_log} recorded"
     )
     if log.resampled:
