@@ -2,16 +2,18 @@
 
 On a clean checkout nothing is cached: the workers of ``make test`` (one a core) would each
 compile the kernels the first test of theirs needs, the same kernel twice at once when two
-tests need it together (the inverse kinematics alone takes about a minute). The session
+tests need it together (the inverse kinematics alone takes about 13 s). The session
 start of ``tests/conftest.py`` runs this module in one process per group, in parallel,
 before the workers exist; they then load the kernels from the cache. Nothing here is
 checked: a kernel left out is compiled by the first test that needs it, as before.
 
 Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (the kinematics, forward and
-inverse, the Jacobians and link poses, and the regressors, each for a batch and one
-sample: about 35 s on one core) or 1 (the dynamics and the momentum observer: about 35 s).
+inverse, the Jacobians and link poses, the regressors and the gravity torques, each for a
+batch and one sample: about 30 s of one core's time on a busy machine) or 1 (the rest of
+the dynamics and the momentum observer: about 30 s).
 No compiled function is called from both groups (the inverse kinematics' Jacobian is
-inlined, as are the dynamics' functions the observer shares): two processes writing one
+inlined, as are the dynamics' functions the observer and the one-sample forward dynamics
+share): two processes writing one
 function's cache index at once can lose an entry.
 """
 
@@ -38,10 +40,10 @@ def warm(group: int) -> None:
             dynid.link_poses(robot, x)
             dynid.static_regressor(robot, x)
             dynid.torque_regressor(robot, x, v, v)
+            dynid.gravity_torques(robot, x)  # (here: it evens the groups' times)
             continue
         dynid.rnea(robot, x, v, v)
         dynid.mass_matrix(robot, x)
-        dynid.gravity_torques(robot, x)
         dynid.coriolis(robot, x, v)
         dynid.forward_dynamics(robot, x, v, v)
     if group == 1:  # the observer

@@ -330,9 +330,10 @@ def run(
         c = CACHE
         C = c.last.C if c.robot is robot and c.last is not None else packed(robot).C
     out = np.empty(shape[:-1] + tail)  # (tail: the result of one sample, e.g. (n,))
-    # one sample: the output as it is (the entry points are typed for it); a batch: flat,
-    # so that a batch kernel is compiled once whatever the batch shape
-    if f(C, *flats, out if ndim == 1 else out.reshape(-1)):
+    # one sample through a single-sample entry point: the output as it is (the entry points
+    # are typed for it); a batch, or one sample on the batch function (``link_poses``):
+    # flat, so that a batch kernel is compiled once whatever the shape
+    if f(C, *flats, out if ndim == 1 and kernel.one_name else out.reshape(-1)):
         return out
     return None
 
