@@ -35,8 +35,9 @@
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
 [s], ``joints`` (1-based) and ``joint_names`` (the same joints by name), ``peak`` [N m]
-(one per joint, signed), ``level`` (``contact`` or ``collision``) and ``log`` (the name
-of the event's log, one log or several), with the model's ``joints`` (names), the data
+(one per joint, signed), ``level`` (``contact``, ``collision``, or ``load``: a carried
+load's pick, an external force) and ``log`` (the name of the event's log, one log or
+several), with the model's ``joints`` (names), the data
 files, their sample counts, durations and the time their events cover (``data``,
 ``samples``, ``duration_s`` and ``flagged_s`` [s]: lists with one entry per log in
 ``data``'s order, a one-entry list for one log), the model's files and their SHA-256
@@ -285,7 +286,9 @@ EVENTS = Format(
                         "joints": Field("numbers", required=True, shape=(None,)),
                         "joint_names": Field("strings"),
                         "peak": Field("numbers", required=True, shape=(None,), unit=_NM),
-                        "level": Field("string", required=True, choices=("contact", "collision")),
+                        "level": Field(
+                            "string", required=True, choices=("contact", "collision", "load")
+                        ),
                         "log": Field("string"),
                         "damped_share": Field("number", low=0.0, high=1.0),
                         "unexplained_share": Field("number", nullable=True, low=0.0, high=1.0),
@@ -736,8 +739,8 @@ def save_observation(
 
 
 def _loads_info(result: ObserveResult, labels: Sequence[str]) -> dict[str, Any]:
-    """``loads``: the loads carried at the flange over an event of each log (neither
-    contacts nor false alarms; :mod:`~dynid.observer.carried_load`), each with its log
+    """``loads``: the loads carried at the flange over an event of each log (its event
+    kept with the level ``load``; :mod:`~dynid.observer.carried_load`), each with its log
     and its line; nothing when none."""
     out = [
         {**ld.as_dict(), "log": label, "summary": load_words(ld)}

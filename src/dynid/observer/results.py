@@ -132,7 +132,8 @@ class LogObservation:
         ``events``; None: no wrench estimated.
     loads : tuple of CarriedLoad
         Loads carried at the flange over a long event (:mod:`~dynid.observer.carried_load`):
-        neither contacts nor false alarms; ``events`` and the residual are those of the
+        each load's own event is in ``events`` with the level ``load`` (an external force,
+        scored as any event); the other events and the residual are those of the
         detection run again without their torque.
     """
 
@@ -171,10 +172,16 @@ class LogObservation:
             raise DataError(f"{self.path.name}: no residual series kept (keep_series off)")
         return self.r
 
-    def flagged_seconds(self) -> float:
-        """Time [s] the log's events cover: the sum of ``end - start`` (events never
-        overlap)."""
-        return float(sum(e.end - e.start for e in self.events))
+    def flagged_seconds(self, *, loads: bool = True) -> float:
+        """Time [s] the log's events cover: the length of the union of their ``[start,
+        end]`` (a carried load's event holds the contacts on top of it); ``loads`` False:
+        without the loads' events (level ``load``)."""
+        spans = sorted((e.start, e.end) for e in self.events if loads or e.level != "load")
+        total, reach = 0.0, -np.inf
+        for a, b in spans:
+            total += max(b - max(a, reach), 0.0)
+            reach = max(reach, b)
+        return float(total)
 
     def duration(self) -> float:
         """The log's duration [s], first to last sample (0 for fewer than two)."""
@@ -256,12 +263,13 @@ class ObserveResult:
         scores = [x.score for x in self.logs if x.score is not None]
         return combined(scores) if scores else None
 
-    def flagged(self) -> tuple[float, float]:
-        """``(flagged, logged)`` [s]: the time every log's events cover and the logs'
-        total duration. An event count alone misleads as a false-alarm measure: a lower
-        threshold can give fewer events that cover more time (runs merged into one)."""
+    def flagged(self, *, loads: bool = True) -> tuple[float, float]:
+        """``(flagged, logged)`` [s]: the time every log's events cover (``loads`` False:
+        without the carried loads' events) and the logs' total duration. An event count
+        alone misleads as a false-alarm measure: a lower threshold can give fewer events
+        that cover more time (runs merged into one)."""
         return (
-            float(sum(x.flagged_seconds() for x in self.logs)),
+            float(sum(x.flagged_seconds(loads=loads) for x in self.logs)),
             float(sum(x.duration() for x in self.logs)),
         )
 
@@ -323,7 +331,7 @@ class ObserveResult:
         the motion is the model's error, not contacts; None otherwise (a calibration)."""
         if self.min_duration_s is None:
             return None
-        flagged, logged = self.flagged()
+        flagged, logged = self.flagged(loads=False)  # a load's event is no model error
         if not (logged > 0 and flagged > MOST_FLAGGED_TIME * logged):
             return None
         return (
