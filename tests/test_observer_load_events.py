@@ -15,6 +15,7 @@ the wrench fit blames only a force whose own torque the residual contradicts.
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -159,3 +160,39 @@ def test_a_force_at_the_forearms_end_is_still_named_at_tool0():
     said = _warned(robot, q, r, np.full(6, 0.5))
     assert said is not None and "does not fit 1 event(s)" in said
     assert "wrist_1_joint..wrist_2_joint quiet" in said and "so on forearm_link" in said
+
+
+def test_observe_says_a_logs_jittered_stamps_as_validate_does(logs, capsys):
+    """Regression: observe said nothing of stamps jittered by 0.2 ms (std, simulated)
+    where identify, validate, friction and payload give the recording's line."""
+    sim = ["simulate", "--trajectory", "fourier", "-q", "--duration", "2", "--seed", "4"]
+    out = logs / "jitter.csv"
+    assert main([*sim, "--jitter", "0.0002", "--out", str(out)]) == 0
+    argv = ["observe", "--params", "panda", "--no-figures", "--data", str(out)]
+    argv += ["--thresholds", str(logs / "cal" / "thresholds.json"), "--out", str(logs / "j")]
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    (line,) = [x for x in err.splitlines() if "stamps jittered" in x]
+    assert "note: jitter.csv: 1 piece, 2001 samples" in line and "at a 1 ms period" in line
+    std = float(re.search(r"std ([0-9.]+) ms", line).group(1))
+    assert std == pytest.approx(0.2, rel=0.1)  # the sample std of 2000 draws
+
+
+def test_residuals_csv_says_over_which_span_a_loads_torque_was_taken(logs):
+    """Regression: residuals.csv did not say that its residual lacks a carried load's
+    torque, nor over which span: its first line now gives the load and its pick and
+    release, within 20 ms of the simulated push's 1.0 s and 2.5 s; the table still
+    starts on its fourth line."""
+    argv = ["observe", "--params", "panda", "--no-figures", "-q"]
+    argv += ["--thresholds", str(logs / "cal" / "thresholds.json")]
+    assert main([*argv, "--data", str(logs / "push.csv"), "--out", str(logs / "res")]) == 0
+    first = (logs / "res" / "residuals.csv").read_text().splitlines()[0]
+    said = re.search(
+        r"carried at the flange .*: ([0-9.]+) kg from ([0-9.]+) s to ([0-9.]+) s", first
+    )
+    assert said is not None, first
+    mass, picked, released = (float(x) for x in said.groups())
+    assert mass == pytest.approx(PUSH_N / 9.81, rel=0.05)
+    assert picked == pytest.approx(ONSET, abs=0.02) and released == pytest.approx(END, abs=0.02)
+    table = np.loadtxt(logs / "res" / "residuals.csv", delimiter=",", skiprows=3)
+    assert table.shape == (5001, 8)

@@ -130,6 +130,7 @@ from .observe_logs import (
     margin_series,
     observed_blocks,
     prepared_log,
+    recording_note,
 )
 from .recordings import (
     Recorded,
@@ -988,6 +989,7 @@ def _observation(
             tuple(a for a, _ in prep.spans),
             peak,
             friction=None if seen is model.friction else seen,
+            recording=recording_note(prep),
         )
 
     return in_file(path, run)

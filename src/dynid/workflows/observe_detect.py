@@ -66,7 +66,7 @@ from ..observer.wrench_fit import (
 )
 from ..signals import filtered_derivative
 from .data_files import in_file
-from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
+from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows, recording_note
 
 __all__ = [
     "Labels",
@@ -102,10 +102,12 @@ class ResidualSink(Protocol):
         n: int,
         frame: str | None,
         kind: WrenchKind = FULL,
+        loads: Sequence[CarriedLoad] = (),
     ) -> AbstractContextManager[Callable[..., None]]:
         """A writer ``put(t, r, wrench, damped)`` of log ``index`` of ``paths`` (``rows``
-        samples, ``n`` joints, the estimate ``kind`` at ``frame`` or none), called for
-        consecutive blocks of samples."""
+        samples, ``n`` joints, the estimate ``kind`` at ``frame`` or none, the carried
+        ``loads`` whose torque the residual lacks), called for consecutive blocks of
+        samples."""
         ...
 
 
@@ -295,6 +297,7 @@ def _detected_once(
         damped=None if fits is None else damped_shares(log.t, events, fits.damped),
         unexplained=unexplained,
         loads=tuple(carried),
+        recording=recording_note(prep),
     )
 
 
@@ -306,7 +309,7 @@ def detected_log(
     options: ObserverOptions,
     *,
     table: AbstractContextManager[Callable[..., None] | None] | None = None,
-    retable: Callable[[], AbstractContextManager[Callable[..., None] | None] | None] | None = None,
+    retable: Callable[..., AbstractContextManager[Callable[..., None] | None] | None] | None = None,
     loads: bool = True,
     **kw: Any,
 ) -> LogObservation:
@@ -317,8 +320,8 @@ def detected_log(
     (:attr:`~dynid.observer.results.LogObservation.loads`); the load's own event (its
     pick: an external force, a weight or a steady push along gravity alike) is kept with
     the level ``load`` and scored as any event. ``retable`` opens the residual table
-    again for that second run; ``loads`` False (``--no-loads``): no event is read as a
-    load."""
+    again for that second run (``retable(loads=...)``: its header names the loads);
+    ``loads`` False (``--no-loads``): no event is read as a load."""
     log = prep.log
     steps = np.diff(log.t)
     period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
@@ -341,7 +344,7 @@ def detected_log(
         return first
     kw = {**kw, "unmodelled": None, "load": None, "motion": motion}  # fed once, by the first
     kw["picks"] = load_events(found, first.events)
-    again = None if retable is None else retable()
+    again = None if retable is None else retable(loads=found)  # its header names them
     return _detected_once(
         prep, model, mapped, thresholds, options, table=again, carried=found, **kw
     )
