@@ -166,7 +166,7 @@ def test_a_model_without_friction_keeps_the_carried_loads_notes(monkeypatch):
         model=SimpleNamespace(
             source="identified", friction=None, robot=SimpleNamespace(joint_names=["a", "b"])
         ),
-        logs=[SimpleNamespace(path=Path("free.csv"), loads=[load])],
+        logs=[SimpleNamespace(path=Path("free.csv"), loads=[load], recording=None)],
         unmodelled=None, load=None, frame=None, wrench=None, friction_source=None,
         score=lambda: None, mostly_flagged_note=lambda: None,
     )  # fmt: skip

@@ -196,3 +196,10 @@ def test_residuals_csv_says_over_which_span_a_loads_torque_was_taken(logs):
     assert picked == pytest.approx(ONSET, abs=0.02) and released == pytest.approx(END, abs=0.02)
     table = np.loadtxt(logs / "res" / "residuals.csv", delimiter=",", skiprows=3)
     assert table.shape == (5001, 8)
+
+
+def test_no_loads_is_refused_when_calibrating(logs, capsys):
+    """--no-loads applies to detection only: a calibration refuses it, named by its flag."""
+    argv = ["observe", "--params", "panda", "--calibrate", "--no-loads"]
+    assert main([*argv, "--data", str(logs / "free.csv"), "--out", str(logs / "c2")]) == 2
+    assert "--no-loads applies when detecting" in capsys.readouterr().err
