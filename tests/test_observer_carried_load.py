@@ -2,7 +2,8 @@
 
 * a 0.8 kg weight at the flange from 1 s to 5 s (a simulated wrench ``-m g`` at the
   flange, base axes) with a contact on a link on top of it: named as a load within 3 % of
-  its mass, not an event, and the contact on top detected;
+  its mass, its pick an event of level ``load`` at 1 s (an external force), and the
+  contact on top detected;
 * a person pushing at a fixed point of link 4 for 2 s while the arm moves: an event,
   never a load;
 * a 0.8 kg load held through a whole log (the arm simulated carrying it): named with its
@@ -71,10 +72,12 @@ def test_a_carried_load_is_named_and_the_contact_on_top_is_found(logs):
     assert load.picked == pytest.approx(1.0, abs=0.02)
     assert load.released == pytest.approx(5.0, abs=0.02)
     assert not load.whole
-    assert not any(e.end - e.start > 1.0 for e in log.events)  # the load is no event
-    assert any(2.9 <= e.start <= 3.3 for e in log.events)  # the contact on top
-    said = [x for x in result.notes if "load: 0.8" in x]
-    assert said and "picked and released; not a contact" in said[0]
+    (pick,) = [e for e in log.events if e.level == "load"]  # an external force, reported
+    assert pick.start == pytest.approx(1.0, abs=0.02)
+    assert not any(e.end - e.start > 1.0 for e in log.events if e.level != "load")
+    assert any(2.9 <= e.start <= 3.3 for e in log.events if e.level != "load")  # on top
+    said = [x for x in result.notes if "read as a load of 0.8" in x]
+    assert said and "(or a steady push along gravity)" in said[0] and "--no-loads" in said[0]
 
 
 def test_a_long_push_at_a_fixed_point_is_not_a_load(logs):
@@ -138,7 +141,7 @@ def test_a_rigid_load_on_a_fast_motion_leaves_no_event_in_its_window(rigid):
     assert load.theta.shape == (10,)  # its inertia fitted
     assert load.mass == pytest.approx(MASS, rel=0.02)
     assert load.com == pytest.approx([0.0, 0.0, COM_Z], abs=0.003)
-    assert not [e for e in log.events if e.end > 1.2 and e.start < 4.8]
+    assert not [e for e in log.events if e.end > 1.2 and e.start < 4.8 and e.level != "load"]
 
 
 def test_an_inertia_the_motion_does_not_tell_apart_is_not_fitted():
@@ -163,7 +166,7 @@ def test_a_model_without_friction_keeps_the_carried_loads_notes(monkeypatch):
         model=SimpleNamespace(
             source="identified", friction=None, robot=SimpleNamespace(joint_names=["a", "b"])
         ),
-        logs=[SimpleNamespace(path=Path("free.csv"), loads=[load])],
+        logs=[SimpleNamespace(path=Path("free.csv"), loads=[load], recording=None)],
         unmodelled=None, load=None, frame=None, wrench=None, friction_source=None,
         score=lambda: None, mostly_flagged_note=lambda: None,
     )  # fmt: skip

@@ -54,6 +54,7 @@ FLAGS: dict[str, str] = {
     "label_tolerance_s": "--label-tolerance",
     "uncertainty": "--no-uncertainty",
     "standstill": "--no-standstill-margin",
+    "loads": "--no-loads",
     "total_mass_band": "--no-total-mass",
     "radii": "--radius",
     "ranges": "--range",

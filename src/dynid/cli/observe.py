@@ -65,6 +65,10 @@ A residual off contacts that follows the weight of a load at the flange the mode
 (a fit of its mass and centre of mass explaining more than a quarter of the residual under
 the threshold and reaching 15 % of some joint's threshold) gets a note with the mass and
 the way out: dynid payload on collision-free logs with the load, or identify again.
+A long event (1 s or more) that a weight at the flange explains is read as a load carried
+(or a steady push along gravity: the joint torques cannot tell them apart): its event
+keeps the level load and is scored as any event, and detection runs again without its
+torque for the contacts on top; --no-loads reads no event as a load.
 A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN none)
 named collision, contact or label (the first the log has), or mapped with --columns
 label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in
@@ -255,6 +259,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "0.02 s)",
     )
     add_torque_delay(p, recorded=True)
+    p.add_argument(
+        "--no-loads",
+        action="store_true",
+        help="detecting: read no event as a load carried at the flange (a weight and a "
+        "steady push along gravity look alike to the joint torques)",
+    )
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     p.add_argument("--out", type=output_path, required=True, help="output directory")
     return p
@@ -281,7 +291,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         # the series serve the figures only: a calibration's whole, a detection's strided
         keep_series=args.calibrate and not args.no_figures,
         figure_points=None if args.no_figures else FIGURE_POINTS,
-        label_tolerance_s=args.label_tolerance,
+        label_tolerance_s=args.label_tolerance, loads=not args.no_loads,
     )  # fmt: skip
     tables = ResidualTables(args.out)  # written a block at a time while detecting
     result = observe_files(opts, tables)

@@ -1127,4 +1127,14 @@ def _score_lines(result: ObserveResult, labels: list[str]) -> list[str]:
         for m in sc.missed:
             peak = "" if m.peak is None else f", peak true torque {m.peak:.3g} N m"
             rows.append(f"  missed in {lab}: {m.start:.3f} s .. {m.end:.3f} s{peak}")
+    for lab, x in zip(labels, result.logs, strict=True):
+        if x.score is None:
+            continue
+        for k in x.score.false_events:
+            if (e := x.events[k]).level == "load":
+                rows.append(
+                    f"  false alarm in {lab}: {e.start:.3f} s .. {e.end:.3f} s is a load's "
+                    "pick no labelled contact holds (an external force: a weight picked or "
+                    "a steady push along gravity; --no-loads reads none as a load)"
+                )
     return rows

@@ -35,8 +35,9 @@
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
 [s], ``joints`` (1-based) and ``joint_names`` (the same joints by name), ``peak`` [N m]
-(one per joint, signed), ``level`` (``contact`` or ``collision``) and ``log`` (the name
-of the event's log, one log or several), with the model's ``joints`` (names), the data
+(one per joint, signed), ``level`` (``contact``, ``collision``, or ``load``: a carried
+load's pick, an external force) and ``log`` (the name of the event's log, one log or
+several), with the model's ``joints`` (names), the data
 files, their sample counts, durations and the time their events cover (``data``,
 ``samples``, ``duration_s`` and ``flagged_s`` [s]: lists with one entry per log in
 ``data``'s order, a one-entry list for one log), the model's files and their SHA-256
@@ -77,12 +78,13 @@ from numpy.typing import NDArray
 from .. import __version__
 from .._checks import text
 from ..exceptions import DataError, DynidError
-from ..observer.carried_load import load_words
+from ..observer.carried_load import CarriedLoad, load_words
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import ContactScore
 from ..observer.thresholds import ModelFingerprint, RestMargin
+from ..observer.unmodelled_load import LOAD_FRAME
 from ..observer.wrench import FULL, WrenchKind, wrench_rank
 from .atomic import open_atomic
 from .schema import Field, Format, Record, load_document, save_document
@@ -285,7 +287,9 @@ EVENTS = Format(
                         "joints": Field("numbers", required=True, shape=(None,)),
                         "joint_names": Field("strings"),
                         "peak": Field("numbers", required=True, shape=(None,), unit=_NM),
-                        "level": Field("string", required=True, choices=("contact", "collision")),
+                        "level": Field(
+                            "string", required=True, choices=("contact", "collision", "load")
+                        ),
                         "log": Field("string"),
                         "damped_share": Field("number", low=0.0, high=1.0),
                         "unexplained_share": Field("number", nullable=True, low=0.0, high=1.0),
@@ -495,11 +499,18 @@ def save_residuals_csv(
     damped: NDArray[np.bool_] | None = None,
     frame: str | None = None,
     kind: WrenchKind = FULL,
+    loads: Sequence[CarriedLoad] = (),
 ) -> Path:
     """Write ``residuals.csv``: ``t, r1..rn`` (and the wrench at ``frame``, or the force
-    alone: ``kind``); returns the path."""
+    alone: ``kind``; the ``loads`` whose torque ``r`` lacks said in its header); returns
+    the path."""
     with residuals_csv(
-        path, t.shape[0], r.shape[1], frame=frame if wrench is not None else None, kind=kind
+        path,
+        t.shape[0],
+        r.shape[1],
+        frame=frame if wrench is not None else None,
+        kind=kind,
+        loads=loads,
     ) as put:
         put(t, r, wrench, damped)
     return Path(path)
@@ -507,19 +518,28 @@ def save_residuals_csv(
 
 @contextlib.contextmanager
 def residuals_csv(
-    path: str | Path, rows: int, n: int, *, frame: str | None = None, kind: WrenchKind = FULL
+    path: str | Path,
+    rows: int,
+    n: int,
+    *,
+    frame: str | None = None,
+    kind: WrenchKind = FULL,
+    loads: Sequence[CarriedLoad] = (),
 ) -> Iterator[Callable[..., None]]:
     """``residuals.csv`` written a block of rows at a time: yields ``put(t, r, wrench=None,
     damped=None)`` for consecutive blocks ``t`` (m,), ``r`` (m, n) and, with ``frame``,
     the wrench (m, 6) and its flag (m,), its units line saying what was estimated
-    (``kind``); the file (``rows`` in its header) appears when the block ends normally
-    (atomic), the bytes of :func:`save_residuals_csv` of the whole."""
+    (``kind``) and the carried loads whose torque the residual lacks
+    (:func:`load_header`); the file (``rows`` in its header) appears when the block
+    ends normally (atomic), the bytes of :func:`save_residuals_csv` of the whole."""
     names = ["t"] + [f"r{j + 1}" for j in range(n)]
     units = "t [s], r [N m]"
     if frame is not None:
         names += ["fx", "fy", "fz", "mx", "my", "mz", "damped"]
         units += f"; {_estimate_units(frame, kind)}"
     with open_atomic(Path(path), "w") as fh:
+        if loads:  # on the first line: readers skip three lines before the data
+            units += "; " + load_header(loads)
         fh.write(f"# dynid residuals; units: {units}\n# rows: {rows}\n")
         fh.write(",".join(names) + "\n")
 
@@ -539,6 +559,27 @@ def residuals_csv(
                 np.savetxt(fh, table[a : a + _CSV_ROWS], delimiter=",", fmt="%.17g")
 
         yield put
+
+
+def load_header(loads: Sequence[CarriedLoad]) -> str:
+    """The words of ``residuals.csv``'s first line on the carried loads whose torque the
+    residual lacks: ``r less the torque of loads carried at the flange (through the
+    observer's lag): 1.222 kg from 2.998 s to 4.504 s (event 3.004 s .. 4.536 s)``, their
+    pick and release [s] (``through the whole log`` for a load held throughout)."""
+    each = [
+        f"{ld.mass:.4g} kg "
+        + (
+            "through the whole log"
+            if ld.whole
+            else f"from {ld.picked:.3f} s to {ld.released:.3f} s"
+        )
+        + f" (event {ld.start:.3f} s .. {ld.end:.3f} s)"
+        for ld in loads
+    ]
+    return (
+        f"r less the torque of loads carried at the {LOAD_FRAME} (through the observer's "
+        f"lag): {', '.join(each)}"
+    )
 
 
 #: Rows of ``residuals.csv`` formatted at a time.
@@ -574,10 +615,12 @@ class ResidualTables:
         n: int,
         frame: str | None,
         kind: WrenchKind = FULL,
+        loads: Sequence[CarriedLoad] = (),
     ) -> Iterator[Callable[..., None]]:
-        """The writer of log ``index`` of ``paths`` (:func:`residuals_csv`)."""
+        """The writer of log ``index`` of ``paths`` (:func:`residuals_csv`; ``loads``:
+        those whose torque the residual lacks)."""
         path = self.out / f"{residual_names(paths)[index]}.csv"
-        with residuals_csv(path, rows, n, frame=frame, kind=kind) as put:
+        with residuals_csv(path, rows, n, frame=frame, kind=kind, loads=loads) as put:
             yield put
         if path not in self.written:
             self.written.append(path)
@@ -692,6 +735,7 @@ def save_observation(
                 damped=None if w is None else w.damped,
                 frame=None if w is None else w.frame,
                 kind=FULL if w is None else w.kind,
+                loads=x.loads,
             )  # fmt: skip
         )
     labels = log_labels([x.path for x in result.logs])
@@ -736,8 +780,8 @@ def save_observation(
 
 
 def _loads_info(result: ObserveResult, labels: Sequence[str]) -> dict[str, Any]:
-    """``loads``: the loads carried at the flange over an event of each log (neither
-    contacts nor false alarms; :mod:`~dynid.observer.carried_load`), each with its log
+    """``loads``: the loads carried at the flange over an event of each log (its event
+    kept with the level ``load``; :mod:`~dynid.observer.carried_load`), each with its log
     and its line; nothing when none."""
     out = [
         {**ld.as_dict(), "log": label, "summary": load_words(ld)}

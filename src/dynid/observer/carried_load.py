@@ -37,15 +37,20 @@ it). The pick and the release are read off the residual at the event's edges (th
 order lag crossed back to the step's time). Events of the second run that lie within
 :data:`EDGE_S` of the pick or the release are the step's own rest, not contacts.
 
+The load's own event stays (:func:`load_events`, level ``load``): to the joint torques a
+weight picked at the flange and a steady push along gravity are the same force, so it is
+reported as an external force and scored as any event, never dropped (a Talos arm pushed
+12 N down for 1.5 s: before, read as 1.22 kg and the push missed).
+
 On the trial's 80 s Panda log with a 0.8 kg object held from 30.0 s to 50.24 s and 5
 labelled contacts on top: 0.80 kg named, and the contacts on top detected (before: one
-20 s collision, a false alarm hiding them).
+20 s collision, a false alarm hiding them; its event is now of level ``load``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,6 +58,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..feasibility.payload import link_params_from_frame
 from ..model.robot import Robot
 from ..regressors.torque import torque_regressor
+from .events import ContactEvent
 from .unmodelled_load import LOAD_FRAME, load_regressor
 
 __all__ = [
@@ -69,6 +75,8 @@ __all__ = [
     "carried_loads",
     "fit_carried_load",
     "lagged_rigid_regressor",
+    "load_events",
+    "NO_LOADS",
     "rigid_load_regressor",
     "samples_within",
     "load_words",
@@ -488,21 +496,46 @@ def at_load_edge(start: float, end: float, loads: Sequence[CarriedLoad]) -> bool
     return False
 
 
+def load_events(loads: Sequence[CarriedLoad], events: Sequence[ContactEvent]) -> list[ContactEvent]:
+    """The event of each load picked and released (not held through the whole log): the
+    first run's event it was fitted on (the same ``start`` and ``end`` [s], among
+    ``events``), its level ``load``. A load is an external force at its pick, physically
+    a weight or a steady push along gravity alike: reported, never dropped."""
+    out = []
+    for ld in loads:
+        if ld.whole:
+            continue
+        for e in events:
+            if e.start == ld.start and e.end == ld.end:
+                out.append(replace(e, level="load"))
+                break
+    return out
+
+
+#: How the reading of an event as a load is turned off (the command line's flag).
+NO_LOADS = "--no-loads"
+
+
 def load_words(load: CarriedLoad, *, identified: bool = True) -> str:
-    """One line of a load: ``load: 0.80 kg at the flange from 30.01 s to 50.25 s (picked
-    and released; not a contact)``, with its centre of mass; a load held through the whole
-    log points to ``dynid payload``."""
+    """One line of a load: ``load: read as a load of 0.80 kg at the flange (or a steady
+    push along gravity) from 30.01 s to 50.25 s, an external-force event (level load,
+    scored as any event) ...``, with its centre of mass and how to turn the reading off
+    (:data:`NO_LOADS`); a load held through the whole log points to ``dynid payload``."""
     c = ", ".join(f"{x:+.3f}" for x in load.com)
-    head = f"load: {load.mass:.2f} kg at the {LOAD_FRAME}"
+    head = f"load: read as a load of {load.mass:.2f} kg at the {LOAD_FRAME}"
     com = f"CoM ({c}) m in the flange's axes; detection ran again without its torque"
+    off = f"{NO_LOADS} reads no event as a load"
     if not load.whole:
         return (
-            f"{head} from {load.start:.2f} s to {load.end:.2f} s (picked and released; not a "
-            f"contact), {com}"
+            f"{head} (or a steady push along gravity) from {load.start:.2f} s to "
+            f"{load.end:.2f} s, picked at {load.picked:.2f} s and released at "
+            f"{load.released:.2f} s: an external-force event (level load, scored as any "
+            f"event), {com} for the contacts on top; {off}"
         )
     todo = "model_with_payload.json for --model" if identified else "robot_with_payload.toml"
     return (
         f"{head} held through the whole log, {load.start:.2f} s to {load.end:.2f} s (not a "
         f"contact, not the model's error), {com}: the model lacks it; identify it with dynid "
-        f"payload on collision-free logs recorded with it ({todo}), then calibrate again"
+        f"payload on collision-free logs recorded with it ({todo}), then calibrate again; "
+        f"{off}"
     )

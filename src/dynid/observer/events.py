@@ -107,14 +107,16 @@ class ContactEvent:
         Joints over their threshold during the event, 1-based.
     peak : tuple of float
         Every joint's residual at its largest magnitude in the event [N m] (signed).
-    level : {"contact", "collision"}
+    level : {"contact", "collision", "load"}
+        ``load``: the onset of a load carried at the flange (its pick), an external force
+        read as a weight (:mod:`~dynid.observer.carried_load`); its span the load's.
     """
 
     start: float
     end: float
     joints: tuple[int, ...]
     peak: tuple[float, ...]
-    level: Literal["contact", "collision"]
+    level: Literal["contact", "collision", "load"]
 
 
 @dataclass(frozen=True, slots=True)

@@ -132,8 +132,13 @@ class LogObservation:
         ``events``; None: no wrench estimated.
     loads : tuple of CarriedLoad
         Loads carried at the flange over a long event (:mod:`~dynid.observer.carried_load`):
-        neither contacts nor false alarms; ``events`` and the residual are those of the
+        each load's own event is in ``events`` with the level ``load`` (an external force,
+        scored as any event); the other events and the residual are those of the
         detection run again without their torque.
+    recording : str or None
+        The log's stamps as ``identify`` and ``validate`` say them when jittered or
+        missing samples of their grid (``rec4.csv: 1 piece, 10000 samples; stamps
+        jittered, std 0.2 ms at a 2 ms period``); None: uniform.
     """
 
     path: Path
@@ -157,6 +162,7 @@ class LogObservation:
     damped: tuple[float, ...] | None = None
     unexplained: tuple[float, ...] | None = None
     loads: tuple[CarriedLoad, ...] = ()
+    recording: str | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -171,10 +177,16 @@ class LogObservation:
             raise DataError(f"{self.path.name}: no residual series kept (keep_series off)")
         return self.r
 
-    def flagged_seconds(self) -> float:
-        """Time [s] the log's events cover: the sum of ``end - start`` (events never
-        overlap)."""
-        return float(sum(e.end - e.start for e in self.events))
+    def flagged_seconds(self, *, loads: bool = True) -> float:
+        """Time [s] the log's events cover: the length of the union of their ``[start,
+        end]`` (a carried load's event holds the contacts on top of it); ``loads`` False:
+        without the loads' events (level ``load``)."""
+        spans = sorted((e.start, e.end) for e in self.events if loads or e.level != "load")
+        total, reach = 0.0, -np.inf
+        for a, b in spans:
+            total += max(b - max(a, reach), 0.0)
+            reach = max(reach, b)
+        return float(total)
 
     def duration(self) -> float:
         """The log's duration [s], first to last sample (0 for fewer than two)."""
@@ -256,18 +268,20 @@ class ObserveResult:
         scores = [x.score for x in self.logs if x.score is not None]
         return combined(scores) if scores else None
 
-    def flagged(self) -> tuple[float, float]:
-        """``(flagged, logged)`` [s]: the time every log's events cover and the logs'
-        total duration. An event count alone misleads as a false-alarm measure: a lower
-        threshold can give fewer events that cover more time (runs merged into one)."""
+    def flagged(self, *, loads: bool = True) -> tuple[float, float]:
+        """``(flagged, logged)`` [s]: the time every log's events cover (``loads`` False:
+        without the carried loads' events) and the logs' total duration. An event count
+        alone misleads as a false-alarm measure: a lower threshold can give fewer events
+        that cover more time (runs merged into one)."""
         return (
-            float(sum(x.flagged_seconds() for x in self.logs)),
+            float(sum(x.flagged_seconds(loads=loads) for x in self.logs)),
             float(sum(x.duration() for x in self.logs)),
         )
 
     @property
     def notes(self) -> tuple[str, ...]:
-        """What the run's reader should know, one line each: a model without friction
+        """What the run's reader should know, one line each: the logs whose stamps are
+        jittered or miss samples (:attr:`LogObservation.recording`); a model without friction
         (static data identify none) leaves the joints' friction in the residual, and in
         thresholds calibrated on it, where it reads as an external torque: how much the
         logs show at speed per joint, or that they show none
@@ -286,7 +300,8 @@ class ObserveResult:
         look late (:func:`~dynid.observer.scoring.shifted_labels_note`)."""
         identified = self.model.source == "identified"
         carried = [ld for x in self.logs for ld in x.loads]
-        out: tuple[str, ...] = tuple(
+        out: tuple[str, ...] = tuple(x.recording for x in self.logs if x.recording)
+        out += tuple(
             f"{x.path.name}: {load_words(ld, identified=identified)}"
             for x in self.logs
             for ld in x.loads
@@ -323,7 +338,7 @@ class ObserveResult:
         the motion is the model's error, not contacts; None otherwise (a calibration)."""
         if self.min_duration_s is None:
             return None
-        flagged, logged = self.flagged()
+        flagged, logged = self.flagged(loads=False)  # a load's event is no model error
         if not (logged > 0 and flagged > MOST_FLAGGED_TIME * logged):
             return None
         return (

@@ -124,7 +124,7 @@ def plot_residuals(
     axes[-1, 0].set_xlabel("time from the log's start [s]")
     fig.suptitle(title or "momentum observer: residual, thresholds and events", fontsize=10)
     handles, labels = axes[0, 0].get_legend_handles_labels()
-    for level in ("contact", "collision"):  # the events' shading, those drawn
+    for level in ("contact", "collision", "load"):  # the events' shading, those drawn
         if any(e.level == level for e in events):
             handles.append(Patch(color=COLOURS[level], alpha=0.25, lw=0))
             labels.append(f"{level} event")

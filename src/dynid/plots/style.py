@@ -29,6 +29,7 @@ COLOURS: Mapping[str, str] = MappingProxyType(
         "external": "tab:green",  # the true external torques of a simulated contact
         "contact": "gold",  # a contact event's window
         "collision": "tab:red",  # a collision event's window
+        "load": "tab:purple",  # a carried load's window (its pick: an external force)
         "label": "0.55",  # a labelled contact's window (hatched)
     }
 )

@@ -130,6 +130,7 @@ from .observe_logs import (
     margin_series,
     observed_blocks,
     prepared_log,
+    recording_note,
 )
 from .recordings import (
     Recorded,
@@ -254,6 +255,11 @@ class ObserveOptions:
         simulated log): how long after a contact's end [s] an event may start and still
         detect it and, of a label column (made by hand), how long before its start
         (:mod:`dynid.observer.scoring`; the true torques keep the exact lead, 0.02 s).
+    loads : bool
+        Detecting: read a long event that a weight at the flange explains as a carried
+        load (:mod:`~dynid.observer.carried_load`: an event of level ``load``, the
+        detection run again without its torque for the contacts on top); False
+        (``--no-loads``): no event is read as a load.
     """
 
     data: tuple[Path, ...]
@@ -287,6 +293,7 @@ class ObserveOptions:
     keep_series: bool = True
     figure_points: int | None = None
     label_tolerance_s: float = DEFAULT_TOLERANCE_S
+    loads: bool = True
 
 
 def load_observer_model(
@@ -452,7 +459,7 @@ def _refuse_unused(opts: ObserveOptions) -> None:
             field="frame",
         )
     else:
-        for name in ("merge_s", "min_duration_s", "label_tolerance_s"):
+        for name in ("merge_s", "min_duration_s", "label_tolerance_s", "loads"):
             if getattr(opts, name) != getattr(default, name):
                 raise OptionError(
                     "applies when detecting (events); calibrating finds none", field=name
@@ -567,6 +574,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 tolerance_s=opts.label_tolerance_s,
                 unmodelled=unmodelled,
                 load=load,
+                loads=opts.loads,
             )  # fmt: skip
         )
     return ObserveResult(
@@ -981,6 +989,7 @@ def _observation(
             tuple(a for a, _ in prep.spans),
             peak,
             friction=None if seen is model.friction else seen,
+            recording=recording_note(prep),
         )
 
     return in_file(path, run)

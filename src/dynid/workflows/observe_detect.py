@@ -36,6 +36,7 @@ from ..observer.carried_load import (
     LoadTorque,
     at_load_edge,
     carried_loads,
+    load_events,
 )
 from ..observer.events import ContactEvent, EventDetector, time_slack
 from ..observer.friction import DERIVED_CUTOFF_HZ
@@ -57,10 +58,15 @@ from ..observer.thresholds import Thresholds, threshold_series
 from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
-from ..observer.wrench_fit import off_frame_warning, unexplained_shares
+from ..observer.wrench_fit import (
+    force_peaks,
+    force_torques,
+    off_frame_warning,
+    unexplained_shares,
+)
 from ..signals import filtered_derivative
 from .data_files import in_file
-from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows
+from .observe_logs import ObservedBlock, PreparedLog, Series, observed_rows, recording_note
 
 __all__ = [
     "Labels",
@@ -96,10 +102,12 @@ class ResidualSink(Protocol):
         n: int,
         frame: str | None,
         kind: WrenchKind = FULL,
+        loads: Sequence[CarriedLoad] = (),
     ) -> AbstractContextManager[Callable[..., None]]:
         """A writer ``put(t, r, wrench, damped)`` of log ``index`` of ``paths`` (``rows``
-        samples, ``n`` joints, the estimate ``kind`` at ``frame`` or none), called for
-        consecutive blocks of samples."""
+        samples, ``n`` joints, the estimate ``kind`` at ``frame`` or none, the carried
+        ``loads`` whose torque the residual lacks), called for consecutive blocks of
+        samples."""
         ...
 
 
@@ -195,6 +203,7 @@ def _detected_once(
     carried: Sequence[CarriedLoad] = (),
     samples: LoadSamples | None = None,
     motion: tuple[NDArray, NDArray, NDArray, NDArray] | None = None,
+    picks: Sequence[ContactEvent] = (),
 ) -> LogObservation:
     """The events of one prepared log (module docstring; ``merge_s`` and ``min_duration_s``
     of :class:`~dynid.observer.events.EventDetector`), ``wants`` the residual's std and
@@ -207,7 +216,9 @@ def _detected_once(
     a load at the flange) are fed the samples under the contact threshold; ``carried``:
     loads whose torque is taken from the residual first; ``samples`` keeps the samples
     over the threshold for their fit; ``motion`` the log's accelerations beside
-    (:func:`_load_motion`), for their inertia."""
+    (:func:`_load_motion`), for their inertia; ``picks``: the loads' own events (level
+    ``load``, :func:`~dynid.observer.carried_load.load_events`), joined to the events and
+    scored with them (no wrench fit: NaN unexplained)."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
     steps = np.diff(log.t)
@@ -226,10 +237,7 @@ def _detected_once(
     strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
-    damped = None if frame is None else np.zeros(log.t.shape[0], dtype=bool)
-    left = None if frame is None else np.full(log.t.shape[0], np.nan)  # |r - J^T w|^2
-    rows = None if frame is None else np.full((log.t.shape[0], n), np.nan)
-    determined = n
+    fits = None if frame is None else _FrameFit(model, frame, log.t.shape[0])
     seen = model.friction
     if unmodelled is not None:
         unmodelled.new_log()
@@ -246,11 +254,8 @@ def _detected_once(
             w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame, kind)
             if put is not None:
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
-            if w is not None and damped is not None:
-                damped[a:b] = w.damped
-            if w is not None and left is not None and rows is not None:
-                left[a:b] = np.nan if w.unexplained is None else w.unexplained
-                rows[a:b], determined = blk.r, w.determined
+            if w is not None and fits is not None:
+                fits.add(a, log.q[a:b], blk.r, w)
             if w is not None and keep is not None:
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
@@ -267,9 +272,9 @@ def _detected_once(
             f"{prep.path.name}: {opposite}", DynidWarning, stacklevel=3
         )
     unexplained = None
-    if frame is not None and left is not None and rows is not None:
-        unexplained = _off_frame(prep, model, frame, kind, events, left, rows, thresholds,
-                                 determined)  # fmt: skip
+    if frame is not None and fits is not None:
+        unexplained = _off_frame(prep, model, frame, kind, events, fits, thresholds)
+    events, unexplained = _with_picks(events, unexplained, picks)
     return LogObservation(
         prep.path,
         log.t,
@@ -289,9 +294,10 @@ def _detected_once(
         score=scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived),
         dropped=det.dropped,
         dropped_count=det.dropped_count,
-        damped=None if damped is None else damped_shares(log.t, events, damped),
+        damped=None if fits is None else damped_shares(log.t, events, fits.damped),
         unexplained=unexplained,
         loads=tuple(carried),
+        recording=recording_note(prep),
     )
 
 
@@ -303,15 +309,19 @@ def detected_log(
     options: ObserverOptions,
     *,
     table: AbstractContextManager[Callable[..., None] | None] | None = None,
-    retable: Callable[[], AbstractContextManager[Callable[..., None] | None] | None] | None = None,
+    retable: Callable[..., AbstractContextManager[Callable[..., None] | None] | None] | None = None,
+    loads: bool = True,
     **kw: Any,
 ) -> LogObservation:
     """The events of one prepared log (:func:`_detected_once`, its keywords), and where
     an event is a load carried at the flange (:mod:`~dynid.observer.carried_load`), the
     detection run again on the residual without the load's torque: its events inside the
     load's window are the contacts on top of it, and the load is kept beside them
-    (:attr:`~dynid.observer.results.LogObservation.loads`), neither a contact nor a false
-    alarm. ``retable`` opens the residual table again for that second run."""
+    (:attr:`~dynid.observer.results.LogObservation.loads`); the load's own event (its
+    pick: an external force, a weight or a steady push along gravity alike) is kept with
+    the level ``load`` and scored as any event. ``retable`` opens the residual table
+    again for that second run (``retable(loads=...)``: its header names the loads);
+    ``loads`` False (``--no-loads``): no event is read as a load."""
     log = prep.log
     steps = np.diff(log.t)
     period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
@@ -321,22 +331,37 @@ def detected_log(
         first = _detected_once(
             prep, model, mapped, thresholds, options, table=table, samples=samples, **kw
         )
-    if not log.t.shape[0]:
+    if not log.t.shape[0] or not loads:
         _said_again(said)
         return first
     span = (float(log.t[0]), float(log.t[-1]))
     events = [(e.start, e.end) for e in first.events]
     long = any(b - a >= MIN_LOAD_S for a, b in events)
     motion = _load_motion(prep) if long else None
-    loads = carried_loads(model.robot, samples, events, options.gains(model.n), span, motion)
-    if not loads:
+    found = carried_loads(model.robot, samples, events, options.gains(model.n), span, motion)
+    if not found:
         _said_again(said)
         return first
     kw = {**kw, "unmodelled": None, "load": None, "motion": motion}  # fed once, by the first
-    again = None if retable is None else retable()
+    kw["picks"] = load_events(found, first.events)
+    again = None if retable is None else retable(loads=found)  # its header names them
     return _detected_once(
-        prep, model, mapped, thresholds, options, table=again, carried=loads, **kw
+        prep, model, mapped, thresholds, options, table=again, carried=found, **kw
     )
+
+
+def _with_picks(
+    events: list[ContactEvent], unexplained: Any, picks: Sequence[ContactEvent]
+) -> tuple[list[ContactEvent], Any]:
+    """The ``events`` with the loads' events ``picks`` joined in time order, and their
+    ``unexplained`` shares (None, or one per event) with NaN for the picks."""
+    if not picks:
+        return events, unexplained
+    both = [(e, u) for e, u in zip(events, unexplained or [None] * len(events), strict=True)]
+    both += [(p, float("nan")) for p in picks]
+    both.sort(key=lambda x: x[0].start)
+    joined = [e for e, _ in both]
+    return joined, None if unexplained is None else tuple(u for _, u in both)
 
 
 def _said_again(said: list[warnings.WarningMessage]) -> None:
@@ -409,26 +434,51 @@ def _tallied(
         samples.add(log.t[a:b], log.q[a:b], blk.r, contact)
 
 
+class _FrameFit:
+    """Per sample of a log of ``N``, what the wrench at ``frame`` leaves and says: the
+    flag ``damped`` (N,), ``left`` ``|r - J^T w|^2`` (N,) [N^2 m^2], the residual ``rows``
+    (N, n) [N m], the force part's torques ``pushed`` ``J_v^T f`` (N, n) [N m]
+    (:func:`~dynid.observer.wrench_fit.force_torques`) and the components ``determined``
+    (NaN where the observer did not run)."""
+
+    def __init__(self, model: ObserverModel, frame: str, N: int) -> None:
+        self.robot, self.frame, n = model.robot, frame, model.n
+        self.damped = np.zeros(N, dtype=bool)
+        self.left = np.full(N, np.nan)
+        self.rows = np.full((N, n), np.nan)
+        self.pushed = np.full((N, n), np.nan)
+        self.determined = n
+
+    def add(self, a: int, q: NDArray, r: NDArray, w: WrenchEstimate) -> None:
+        """The block from sample ``a``: positions ``q`` (m, n) [rad], residual ``r``
+        (m, n) [N m] and its estimate ``w``."""
+        b = a + r.shape[0]
+        self.damped[a:b] = w.damped
+        self.left[a:b] = np.nan if w.unexplained is None else w.unexplained
+        self.rows[a:b], self.determined = r, w.determined
+        self.pushed[a:b] = force_torques(self.robot, q, w.wrench, self.frame)
+
+
 def _off_frame(
     prep: PreparedLog,
     model: ObserverModel,
     frame: str,
     kind: Any,
     events: Sequence[ContactEvent],
-    left: NDArray[np.float64],
-    rows: NDArray[np.float64],
+    fits: _FrameFit,
     thresholds: Thresholds,
-    determined: int,
 ) -> Any:
     """Each event's share of the residual the wrench at ``frame`` leaves unexplained
     (:func:`unexplained_shares`), with the warning of contacts on a link before the frame
-    (:func:`off_frame_warning`) said."""
+    (:func:`off_frame_warning`) said; ``fits``: the estimate's series over the log."""
     t, contact = prep.log.t, thresholds.contact
-    shares, over = unexplained_shares(t, events, left, rows, contact, determined)
+    left, rows, pushed = fits.left, fits.rows, fits.pushed
+    shares, over = unexplained_shares(t, events, left, rows, contact, fits.determined)
     robot = model.robot
     said = off_frame_warning(
         prep.path.name, frame, kind.noun, events, shares, over, thresholds.contact,
         robot.joint_names, robot.link_names, int(robot.frame(frame).link),
+        force_peaks(t, events, pushed),
     )  # fmt: skip
     if said is not None:
         warnings.warn(said, DynidWarning, stacklevel=4)

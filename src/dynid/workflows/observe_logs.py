@@ -27,7 +27,14 @@ from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
-from ..identification.pieces import unwrapped, with_start_turns, wrappable, wrapped_finding
+from ..identification.pieces import (
+    recording_line,
+    timing_record,
+    unwrapped,
+    with_start_turns,
+    wrappable,
+    wrapped_finding,
+)
 from ..identification.prepare import states_in_step
 from ..observer.detection import (
     residual_std_blocks,
@@ -145,6 +152,19 @@ def prepared_log(
     elif cut != starts and log.dq_derived:  # derived again, never across a jump
         dq = _piece_velocities(log, cut)
     return PreparedLog(path, log, dq, _observed_spans(path, log, cut, abs(torque_delay_s)))
+
+
+def recording_note(prep: PreparedLog) -> str | None:
+    """The line ``identify``, ``validate``, ``friction`` and ``payload`` give a recording
+    whose stamps are jittered or miss samples of their grid
+    (:func:`~dynid.identification.pieces.recording_line`: ``rec4.csv: 1 piece, 10000
+    samples; stamps jittered, std 0.2 ms at a 2 ms period``); its gaps are warned apart
+    (the observer's cuts); None: uniform stamps."""
+    rec = timing_record((), None, prep.log.cleaning)
+    if not rec:
+        return None
+    head = {"file": prep.path.name, "pieces": len(prep.spans), "samples": prep.log.t.shape[0]}
+    return recording_line({**head, **rec})
 
 
 def observed_blocks(
