@@ -111,7 +111,7 @@ def test_the_search_on_exact_friction_free_data_keeps_no_friction(ratio):
     assert floor < 1e-10, floor  # the noise read is the rounding
     text = format_identification(model, verdict_below=True)  # the summary says it as done
     assert "every sample unfiltered" in text and "filtered and decimated" not in text, text
-    assert "after the no low-pass" not in text and "(1 in 1, unfiltered, after" in text, text
+    assert "after the no low-pass" not in text and "(every sample, unfiltered, after" in text, text
 
 
 def test_a_noisy_log_is_not_read_as_exact():

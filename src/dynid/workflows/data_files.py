@@ -395,11 +395,11 @@ def _joint_count_hint(log: TorqueLog, robot: Robot | None) -> str:
         return "hint: pass the robot the log was recorded with"
     if n_log > robot.n:
         return (
-            f"its chain runs from {robot.link_names[0]} through {robot.joint_names[0]}.."
-            f"{robot.joint_names[-1]} to {robot.link_names[-1]}: the log's "
-            f"{n_log - robot.n} more joint(s) lie outside it; hint: start the chain earlier "
-            f"with --base (a link below {robot.link_names[0]}) or end it later with --tip, "
-            "or pass the robot the log was recorded with"
+            "hint: pass the robot the log was recorded with (its chain runs from "
+            f"{robot.link_names[0]} through {robot.joint_names[0]}..{robot.joint_names[-1]} "
+            f"to {robot.link_names[-1]}; the log's {n_log - robot.n} more joint(s) lie "
+            f"outside it: a URDF's chain starts earlier with --base, a link below "
+            f"{robot.link_names[0]}, or ends later with --tip)"
         )
     k = robot.n - n_log
     tip = (
