@@ -431,6 +431,13 @@ def test_constants_given_at_the_motors_over_one_shared_gear_ratio_are_read_times
     assert msg[0] in got.model.info.notes
     held = got.heldout
     assert held is not None and held.verdict.ratio is not None and held.verdict.ratio < 1.5
+    from dynid.workflows.validate import ValidateOptions
+
+    with warnings.catch_warnings(record=True) as said:  # the drive file as written, given
+        warnings.simplefilter("always")  # to validate: read as identify read it
+        val = validate_files(got.model, current_log, ValidateOptions(drive=drive))
+    assert any("the gear ratio every joint shares, 100" in str(w.message) for w in said)
+    assert val.verdict.level == "good", val.verdict
     low = dataclasses.replace(drive, transmission=5.0 * np.eye(7), torque_constant=KT / 5)
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")

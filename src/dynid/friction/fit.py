@@ -46,6 +46,7 @@ from ..dynamics.rnea import rnea
 from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError, WrongTypeError
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.model import IdentifiedModel
+from ..identification.motor_constants import read_at_the_joints
 from ..identification.prepare import MEASURED, Preprocessing, prepare_log
 from ..identification.recordings import standstill_band
 from ..identification.structure import smooth_width
@@ -229,6 +230,16 @@ def same_drive(drive: Drive | None, own: Drive | None, whose: str, what: str) ->
     if mine != theirs:
         keys = sorted(k for k in {*mine, *theirs} if mine.get(k) != theirs.get(k))
         if set(keys) <= set(LOGGING_FIELDS):
+            if (g := read_at_the_joints(drive, own)) is not None:
+                warnings.warn(  # the drive file as identify corrected it: its reading kept
+                    f"the drive given holds the motors' torque constants; {whose} reads the "
+                    f"currents through them times the gear ratio every joint shares, {g:.4g}, "
+                    f"as identify did (torque_constant looks given at the motors): read so; "
+                    f"hint: put {whose}'s torque_constant in the drive file",
+                    DynidWarning,
+                    stacklevel=2,
+                )
+                return own
             if own.effort == "current" and own.torque_constant is not None:
                 warnings.warn(  # currents read through other constants than the fit's
                     f"the drive given reads the currents through torque_constant = "

@@ -45,6 +45,7 @@ __all__ = [
     "GearRatioPattern",
     "SharedGearRatio",
     "gear_ratio_pattern",
+    "read_at_the_joints",
     "shared_gear_ratio",
 ]
 
@@ -203,3 +204,25 @@ def shared_gear_ratio(
     if common.min() < _COMMON[0] or common.max() > _COMMON[1]:
         return None
     return SharedGearRatio(float(ratio[0]), common)
+
+
+def read_at_the_joints(given: Drive, own: Drive) -> float | None:
+    """The gear ratio ``own``'s torque constants are ``given``'s times, when a model's drive
+    ``own`` holds the constants its identification read times one shared gear ratio
+    (:func:`shared_gear_ratio`) and ``given`` is the drive file as written, the motors'
+    constants in it; None otherwise (other fields differ, or another factor)."""
+    if given.torque_constant is None or own.torque_constant is None:
+        return None
+    if own.effort != "current" or given.effort != "current" or own.side != "joint":
+        return None
+    mine, theirs = given.as_dict(), own.as_dict()
+    if any(mine.get(k) != theirs.get(k) for k in {*mine, *theirs} - {"torque_constant"}):
+        return None
+    ratio = np.abs(np.diag(np.asarray(own.transmission, dtype=np.float64)))
+    if own.is_coupled or not np.allclose(ratio, ratio[0], rtol=1e-9, atol=0.0):
+        return None
+    if ratio[0] <= SHARED_MIN:
+        return None
+    kt = np.asarray(own.torque_constant, dtype=np.float64)
+    given_kt = np.asarray(given.torque_constant, dtype=np.float64)
+    return float(ratio[0]) if np.allclose(kt, given_kt * ratio[0], rtol=1e-9) else None

@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.delay_check import validations_delay
-from ..friction.fit import same_drive, torques_through
+from ..friction.fit import model_drive, same_drive, torques_through
 from ..friction.heldout_torques import residual_gains, residual_springs, residual_tilt
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
 from ..friction.pooled import joined_validation
@@ -479,6 +479,8 @@ def _drives(
     if feasible is not None:
         held = load_feasible_drive(feasible)
         drive = same_drive(drive, held, Path(feasible).name, f"the one {Path(feasible).name} holds")
+    elif isinstance(model, IdentifiedModel) and drive is not None:  # read as the fit reads
+        drive = model_drive(model, drive)  # (constants identify read x a shared gear ratio)
     placed = model.drive if drive is None and isinstance(model, IdentifiedModel) else drive
     return drive, placed
 
