@@ -293,8 +293,21 @@ def test_a_recording_of_another_robot_is_named(panda, files, tmp_path):
     log = load_torque_log(files / "rec2.csv")
     far = type(log)(log.t, log.q + 3.0, log.dq, log.tau)
     rec = Recorded((log, far), (files / "rec2.csv", tmp_path / "far.csv"))
-    with pytest.warns(DynidWarning, match="far.csv: joint .* far outside the limits of robot"):
+    with pytest.warns(
+        DynidWarning, match="far.csv: joint .* far outside the limits of robot"
+    ) as said:
         check_limits(rec, panda)
+    assert "encoder counts" not in " ".join(str(w.message) for w in said)
+    # a servo's encoder counts (4096 a turn, about its middle) read as radians: every joint
+    # named, and the factor that reads counts in radians
+    counts = np.round(log.q * 4096 / (2 * np.pi)) + 2048
+    tick = type(log)(log.t, counts, log.dq, log.tau)
+    rec = Recorded((log, tick), (files / "rec2.csv", tmp_path / "tick.csv"))
+    with pytest.warns(DynidWarning, match="tick.csv: joint") as said:
+        check_limits(rec, panda)
+    text = " ".join(str(w.message) for w in said)
+    assert "outside theirs" in text and "joint7" in text, text
+    assert f"--units q={2 * np.pi / 4096:.10g}" in text, text
     save_torque_log(tmp_path / "deg.csv", type(log)(log.t, np.degrees(log.q), log.dq, log.tau))
     with pytest.raises(DataError, match="deg.csv: its positions look like degrees"):
         validate_files(panda, [files / "rec1.csv", tmp_path / "deg.csv"])

@@ -60,6 +60,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.derivative_columns import (
@@ -870,16 +871,34 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
     lo = np.asarray(robot.q_min) - LIMIT_MARGIN
     hi = np.asarray(robot.q_max) + LIMIT_MARGIN
     wrapped = rec.wrapped or ((),) * len(sides)
-    for name, log, turned in zip(rec.names, sides, wrapped, strict=True):
+    for name, log, turned, read in zip(rec.names, sides, wrapped, rec.logs, strict=True):
         q = log.q
         qmin, qmax = np.min(q, axis=0), np.max(q, axis=0)
         bad = np.setdiff1d(np.flatnonzero((qmin < lo) | (qmax > hi)), turned)  # said: wrapped
         if bad.size:
             j = int(bad[0])
+            more = [robot.joint_names[k] for k in bad[1:]]
+            also = f" (and {', '.join(more)} outside theirs)" if more else ""
             warnings.warn(
                 f"{name}: joint {robot.joint_names[j]} spans [{qmin[j]:.4g}, {qmax[j]:.4g}], "
                 f"far outside the limits of robot {robot.name!r} [{robot.q_min[j]:.4g}, "
-                f"{robot.q_max[j]:.4g}]: a recording of another robot, or in other units?",
+                f"{robot.q_max[j]:.4g}]{also}: a recording of another robot, or in other "
+                f"units?{_counts_hint(read.q[:, bad])}",
                 DynidWarning,
                 stacklevel=3,
             )
+
+
+def _counts_hint(q: NDArray[np.float64]) -> str:
+    """A hint for positions (as recorded) far outside the limits that are whole numbers
+    spanning more than a few units: an encoder's counts (a servo's 0..4095 for a turn),
+    read as radians; empty otherwise."""
+    if q.size == 0 or float(np.ptp(q)) < 8.0 or not np.all(q == np.round(q)):
+        return ""
+    turn = 2 ** int(np.ceil(np.log2(max(float(np.max(np.abs(q))) + 1.0, 2.0))))
+    return (
+        f"; the positions are whole numbers ({np.min(q):.0f} to {np.max(q):.0f}): encoder "
+        f"counts? --units q=FACTOR reads them in radians, 2 pi over the counts per turn "
+        f"(for {turn} counts: --units q={2 * np.pi / turn:.10g}; a joint's zero away from "
+        "count 0 is a drive file's offset)"
+    )
