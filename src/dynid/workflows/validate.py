@@ -32,6 +32,10 @@ with every policy the command applies, so that the Python API behaves as the com
   (:func:`~dynid.identification.low_speed.with_low_speed_hint`), and joints moved far
   faster than in an identified model's data
   (:func:`~dynid.identification.motion_range.with_motion_range_hint`).
+* An error above the noise that sits in a few short spans of a recording (a contact, a
+  logging fault) is said first, with the rest of the recording's error over the noise
+  (:func:`~dynid.identification.error_spans.error_spans`), and the residual is then not
+  diagnosed for a spring, a tilt or a load.
 """
 
 from __future__ import annotations
