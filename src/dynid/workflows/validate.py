@@ -32,6 +32,10 @@ with every policy the command applies, so that the Python API behaves as the com
   (:func:`~dynid.identification.low_speed.with_low_speed_hint`), and joints moved far
   faster than in an identified model's data
   (:func:`~dynid.identification.motion_range.with_motion_range_hint`).
+* An error above the noise that sits in a few short spans of a recording (a contact, a
+  logging fault) is said first, with the rest of the recording's error over the noise
+  (:func:`~dynid.identification.error_spans.error_spans`), and the residual is then not
+  diagnosed for a spring, a tilt or a load.
 """
 
 from __future__ import annotations
@@ -57,6 +61,7 @@ from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction, recorded_cutoff
 from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains
+from ..identification.error_spans import ErrorSpans, error_spans
 from ..identification.floor_verdict import (
     judged_prediction,
     opposite_sign,
@@ -287,6 +292,7 @@ class ValidateResult:
     gravity_tilt: GravityTilt | None = None
     gains: DriveGains | None = None
     flange_load: ResidualLoad | None = None
+    error_spans: ErrorSpans | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -342,6 +348,7 @@ class ValidateResult:
             **({"springs": self.springs.as_dict()} if self.springs is not None else {}),
             "gravity_tilt": None if self.gravity_tilt is None else self.gravity_tilt.as_dict(),
             "flange_load": None if self.flange_load is None else self.flange_load.as_dict(),
+            "error_spans": None if (b := self.error_spans) is None else b.as_dict(),
             **({"drive_gains": self.gains.as_dict()} if self.gains is not None else {}),
             **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
             **({"torque_delay_used": a.as_dict()} if (a := self.applied_delay) else {}),
@@ -428,8 +435,8 @@ def validate_files(
     inputs = _input_noise(model, val.friction, val)
     verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
     verdict = _worst_recording(val, verdict, rec.names, names, inputs)
-    speeds = _identified_speeds(model if own is None else own)
-    dq = [v.log.dq for v in val.parts]
+    burst = _error_spans(verdict, val, rec.logs, noise)  # a contact: not the model's
+    speeds, dq = _identified_speeds(model if own is None else own), [v.log.dq for v in val.parts]
     # a motion beyond the identification's is the likelier cause of what the residual follows
     beyond = motion_range_hint(speeds, dq, names) is not None
     # a torque of the opposite sign leaves twice the torque, which no term of the model
@@ -437,7 +444,7 @@ def validate_files(
     current = not beyond and placed is not None and placed.effort == "current"
     verdict, springs, gains, tilt, load = _with_hints(
         model, verdict, val, rec.logs, noise, names,
-        dependence=not beyond and not opposite and sign_map is None,
+        dependence=not beyond and not opposite and sign_map is None and burst is None,
         held=_terms_held(model, placed, label), gains_too=current,
         payload=_payload_command(model, data, label, feasible, source),
     )  # fmt: skip
@@ -446,6 +453,7 @@ def validate_files(
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s, named, own)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
     verdict = with_replaced_spikes(verdict, sum(spikes), f" before judging ({files})")
+    verdict = _spans_first(verdict, burst, names, len(rec.names))  # first, after a sign's
     verdict = _signs_first(verdict, opposite, sign_map)
     return ValidateResult(
         validation=val,
@@ -465,7 +473,7 @@ def validate_files(
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=springs, gains=gains, torque_delay=delay, applied_delay=applied,
-        gravity_tilt=tilt, flange_load=load,
+        gravity_tilt=tilt, flange_load=load, error_spans=burst,
     )  # fmt: skip
 
 
@@ -797,6 +805,39 @@ def _judged(
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
     return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios), fl.percent
+
+
+def _error_spans(
+    verdict: Verdict, val: RecordingsValidation, logs: Sequence[TorqueLog], noise: _Noise
+) -> ErrorSpans | None:
+    """Above the noise floor, the recording whose error above the noise sits in a few short
+    spans (:func:`~dynid.identification.error_spans.error_spans`, each recording's pieces
+    joined against the noise per joint), the largest error first; None: none."""
+    if verdict.level == "good":
+        return None
+    found = []
+    for k, name in enumerate(val.pieces.names):
+        mine = [v for v, r in zip(val.parts, val.pieces.recording, strict=True) if r == k]
+        if not mine:
+            continue
+        t = np.concatenate([np.asarray(v.log.t, dtype=np.float64) for v in mine])
+        e = np.concatenate([v.log.tau - v.tau_hat for v in mine])
+        t0 = float(logs[k].t[0]) if k < len(logs) and len(logs[k].t) else None
+        spans = error_spans(t, e, noise.total, name, t0)
+        if spans is not None:
+            found.append((float(np.sum(e**2)), spans))
+    return max(found, key=lambda f: f[0])[1] if found else None
+
+
+def _spans_first(
+    verdict: Verdict, burst: ErrorSpans | None, names: Sequence[str], files: int
+) -> Verdict:
+    """``verdict`` with where its error sits (:func:`_error_spans`) first in its reason,
+    naming the recording among ``files`` > 1."""
+    if burst is None:
+        return verdict
+    said = burst.sentence(tuple(names), named=files > 1)
+    return dataclasses.replace(verdict, reason=f"{said}; over every sample: {verdict.reason}")
 
 
 def _worst_recording(
