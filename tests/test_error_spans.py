@@ -51,6 +51,7 @@ def test_a_burst_on_one_joint_is_placed_in_its_span_and_the_rest_at_the_noise(tm
     assert "on joint2 (up to" in res.verdict.reason, res.verdict.reason
     assert "a contact or a logging fault there, not the model" in res.verdict.reason
     assert "follows its position" not in res.verdict.reason  # no term diagnosed from it
+    assert "the model misses effects" not in res.verdict.reason  # the span clears it
     record = json.loads(json.dumps(res.metadata()))["error_spans"]
     assert record["spans"][0]["joints"] == [JOINT] and record["file"] == "burst.csv"
 

@@ -837,7 +837,15 @@ def _spans_first(
     if burst is None:
         return verdict
     said = burst.sentence(tuple(names), named=files > 1)
-    return dataclasses.replace(verdict, reason=f"{said}; over every sample: {verdict.reason}")
+    rest = verdict.reason  # its remedy blames the model, which the span clears
+    for blame in (_MISSES, _MISSES.replace("show", "show there")):
+        rest = rest.replace(f": {blame}", "")
+    return dataclasses.replace(verdict, reason=f"{said}; over every sample: {rest}")
+
+
+#: The remedy of a poor verdict (:mod:`~dynid.identification.verdict`), left out after a
+#: span that holds the error.
+_MISSES = "the model misses effects the data show (model terms, excitation, the drive)"
 
 
 def _worst_recording(
