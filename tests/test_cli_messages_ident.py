@@ -34,6 +34,7 @@ def _error(argv, capsys):
         ["validate", "--model", "{d}/nope.json", "--data", "{d}/x.csv", "--out", "{d}/o"],
         ["observe", "--params", "panda", "--data", "{d}/x.csv", "--thresholds",
          "{d}/nope.json", "--out", "{d}/o"],
+        ["excite", "--robot", "panda", "--obstacles", "{d}/nope.json", "--out", "{d}/o"],
     ],
 )  # fmt: skip
 def test_a_missing_input_file_is_named_with_its_option(tmp_path, capsys, argv):

@@ -407,10 +407,9 @@ def _message(exc: BaseException, args: argparse.Namespace | None = None) -> str:
         return option_message(exc)
     from .common import cli_text, missing_input
 
-    if isinstance(exc, FileNotFoundError) and exc.filename is not None and args is not None:
-        said = missing_input(args, exc.filename)
-        if said is not None:
-            return said
+    if isinstance(exc, FileNotFoundError) and exc.filename is not None:
+        said = None if args is None else missing_input(args, exc.filename)
+        return said or f"{Path(exc.filename).name}: {exc.filename} does not exist"
     return cli_text(str(exc))
 
 

@@ -62,7 +62,10 @@ FLAGS: dict[str, str] = {
 
 
 #: The options that name input files (:func:`missing_input`).
-INPUT_FILES = ("data", "model", "thresholds", "validate_on")
+INPUT_FILES = (
+    "data", "model", "thresholds", "validate_on", "obstacles", "friction", "trajectory",
+    "params", "prior",
+)  # fmt: skip
 
 
 def missing_input(args: argparse.Namespace, filename: str | Path) -> str | None:
