@@ -158,6 +158,12 @@ FIGURE_POINTS = 20000
 OUTPUT = "folder"
 
 
+#: Help of the observer's options of discretisation (:mod:`dynid.observer.residual`).
+_GAIN = "the observer's gain per sample: exact, 1 - exp(-K T) (default), or euler, K T"
+_RULE = "a sample step's integral: the mean of its ends (trapezoid, default) or its new value"
+_MARGIN = "calibration: the contact threshold's factor over the largest |r| (default 1.5)"
+
+
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add the ``observe`` subcommand."""
     p = add_subcommand(
@@ -205,9 +211,9 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
             "two gains and compare the thresholds"
         ),
     )
-    p.add_argument("--discretisation", choices=("exact", "euler"), default="exact")
-    p.add_argument("--rule", choices=("trapezoid", "rectangle"), default="trapezoid")
-    p.add_argument("--margin", type=positive_type, default=1.5, help="factor over |r| (1.5)")
+    p.add_argument("--discretisation", choices=("exact", "euler"), default="exact", help=_GAIN)
+    p.add_argument("--rule", choices=("trapezoid", "rectangle"), default="trapezoid", help=_RULE)
+    p.add_argument("--margin", type=positive_type, default=1.5, help=_MARGIN)
     p.add_argument("--quantile", type=positive_type, default=1.0, help="of |r| (default 1: max)")
     p.add_argument("--collision-factor", type=positive_type, default=2.0, help="(default 2)")
     p.add_argument("--k-sigma", type=positive_type, default=3.0, help="uncertainty k (3)")
