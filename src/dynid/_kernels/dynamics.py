@@ -44,6 +44,7 @@ import numpy as np
 from .chain import (
     IDENTITY,
     angles,
+    called,
     compose,
     finite,
     fixed,
@@ -149,7 +150,7 @@ def carry(T, F, N):
     )
 
 
-@inline
+@called
 def _rnea_sample(C, A, dq, ddq, oq, ov, oa, tau, S):
     """RNEA of one sample into ``tau[oq : oq + n]``; scratch ``S`` (n, 21).
 
@@ -195,7 +196,7 @@ def _rnea_sample(C, A, dq, ddq, oq, ov, oa, tau, S):
             tau[oq + i] = N[0] * ex + N[1] * ey + N[2] * ez
 
 
-@inline
+@called
 def _rnea_few(C, q, dq, ddq, tau, sv, sa):
     """:func:`rnea` for a few samples: the scalar recursion per sample, no block scratch."""
     n = C.shape[0] - 1
@@ -483,7 +484,7 @@ def gravity_torques_one(C, q, tau):
     return True
 
 
-@inline
+@called
 def _crba_sample(C, A, o, M, S):
     """Mass matrix of a sample into ``M[o n : (o + n) n]`` (flat, row-major).
 

@@ -45,7 +45,19 @@ import numpy as np
 
 from .chain import SINCOS_MAX as _SINCOS_MAX
 from .chain import STACK as _STACK
-from .chain import angles, exact, finite, fixed, inline, jit, joint_at, joint_from, lean, stack
+from .chain import (
+    angles,
+    called,
+    exact,
+    finite,
+    fixed,
+    inline,
+    jit,
+    joint_at,
+    joint_from,
+    lean,
+    stack,
+)
 from .chain import sincos as _sincos
 from .dynamics import carry
 from .layout import C_AXIS, C_PHI, C_PRISMATIC
@@ -66,7 +78,7 @@ __all__ = [
 FRICTION_WIDTH = 15
 
 
-@inline
+@called
 def _terms_sample(C, n, A, dq, o, W, p, beta, po):
     """``p = M dq`` (links only) and ``g - C^T dq`` of one sample into ``p[po:po+n]`` and
     ``beta[po:po+n]``; ``A`` the angles of ``q``, ``dq[o:o+n]`` the rates, scratch W (n, 21)."""
@@ -182,7 +194,7 @@ def _law(F, m, v):
     return f
 
 
-@inline
+@called
 def _friction(D, n, dq, o, tf, V):
     """Joint friction ``K_f^T f(K_f dq[o:o+n])`` into ``tf[0:n]``; scratch ``V`` (n,)."""
     k = 2 * n + 1
