@@ -8,13 +8,13 @@ before the workers exist; they then load the kernels from the cache. Nothing her
 checked: a kernel left out is compiled by the first test that needs it, as before.
 
 Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (the kinematics, forward and
-inverse, the Jacobians and link poses, the regressors and the gravity torques, each for a
-batch and one sample: about 30 s of one core's time on a busy machine) or 1 (the rest of
-the dynamics and the momentum observer: about 30 s).
+inverse, the Jacobians and link poses and the regressors, each for a batch and one sample:
+about 23 s of one core's time) or 1 (the dynamics, the gravity torques included, and the
+momentum observer: about 23 s).
 No compiled function is called from both groups (the inverse kinematics' Jacobian is
-inlined, as are the dynamics' functions the observer and the one-sample forward dynamics
-share): two processes writing one
-function's cache index at once can lose an entry.
+inlined, the batch gravity torques call the RNEA kernel in its own group, and the
+helpers compiled on their own and called keep no disk cache of their own): two
+processes writing one function's cache index at once can lose an entry.
 """
 
 from __future__ import annotations
@@ -40,9 +40,9 @@ def warm(group: int) -> None:
             dynid.link_poses(robot, x)
             dynid.static_regressor(robot, x)
             dynid.torque_regressor(robot, x, v, v)
-            dynid.gravity_torques(robot, x)  # (here: it evens the groups' times)
             continue
         dynid.rnea(robot, x, v, v)
+        dynid.gravity_torques(robot, x)  # its batch calls the RNEA kernel
         dynid.mass_matrix(robot, x)
         dynid.coriolis(robot, x, v)
         dynid.forward_dynamics(robot, x, v, v)

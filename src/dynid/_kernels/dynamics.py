@@ -26,7 +26,12 @@ link about its origin
 Layout. :func:`rnea` works on blocks of ``BLOCK`` samples held in one scratch array
 ``X[link, row, sample]`` (link 0 the base, link ``n + 1`` a virtual identity link after
 the last one); the loop over the samples of a block is innermost, free of branches and
-calls, so that the compiler vectorises it (SIMD over samples). Revolute and prismatic
+calls, so that the compiler vectorises it (SIMD over samples): its helpers are inlined
+(called, they lose the vectorisation: the batch RNEA 2.6 x slower). The scalar recursions
+of one sample, :func:`_rnea_sample` and :func:`_crba_sample`, and the few-sample path
+:func:`_rnea_few` are compiled on their own and called (:func:`~dynid._kernels.chain.called`),
+once for the kernels that share them (the dynamics and the observer kernels compile in
+18.4 s of one core, from 22.9 s inlined; no measurable change in run time). Revolute and prismatic
 joints go through the same arithmetic with exact 0/1 selectors (a prismatic joint has
 ``sin = 0, cos = 1``, a revolute one no translation), which changes no rounding.
 
