@@ -9,8 +9,8 @@ checked: a kernel left out is compiled by the first test that needs it, as befor
 
 Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (the kinematics, forward and
 inverse, the Jacobians and link poses and the regressors, each for a batch and one sample:
-about 23 s of one core's time) or 1 (the dynamics, the gravity torques included, and the
-momentum observer: about 23 s).
+about 25 s of one core's time) or 1 (the dynamics, the gravity torques included, and the
+momentum observer: about 24 s).
 No compiled function is called from both groups (the inverse kinematics' Jacobian is
 inlined, the batch gravity torques call the RNEA kernel in its own group, and the
 helpers compiled on their own and called keep no disk cache of their own): two

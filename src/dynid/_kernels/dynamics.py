@@ -31,9 +31,10 @@ calls, so that the compiler vectorises it (SIMD over samples): its helpers are i
 of one sample, :func:`_rnea_sample` and :func:`_crba_sample`, and the few-sample path
 :func:`_rnea_few` are compiled on their own and called (:func:`~dynid._kernels.chain.called`),
 once for the kernels that share them (the dynamics and the observer kernels compile in
-18.4 s of one core, from 22.9 s inlined; no measurable change in run time). Revolute and prismatic
-joints go through the same arithmetic with exact 0/1 selectors (a prismatic joint has
-``sin = 0, cos = 1``, a revolute one no translation), which changes no rounding.
+about 20 s of one core, from 24 s inlined; no measurable change in run time). Revolute
+and prismatic joints go through the same arithmetic with exact 0/1 selectors (a
+prismatic joint has ``sin = 0, cos = 1``, a revolute one no translation), which changes
+no rounding.
 
 The joint transform is the chain core's (:mod:`dynid._kernels.chain`), as are the
 compiler settings (fused multiply-add only) and the sine and cosine (Cephes, vectorisable);

@@ -194,7 +194,7 @@ def _law(F, m, v):
     return f
 
 
-@called
+@inline
 def _friction(D, n, dq, o, tf, V):
     """Joint friction ``K_f^T f(K_f dq[o:o+n])`` into ``tf[0:n]``; scratch ``V`` (n,)."""
     k = 2 * n + 1
