@@ -192,18 +192,26 @@ def shared_gear_ratio(
         When every recording's torques over the gravity torques, times the gear ratio, lie
         within :data:`_COMMON`.
     """
-    if drive is None or drive.side != "joint" or drive.effort != "current" or drive.is_coupled:
-        return None
-    ratio = np.abs(np.diag(np.asarray(drive.transmission, dtype=np.float64)))
-    if not np.allclose(ratio, ratio[0], rtol=1e-9, atol=0.0) or ratio[0] <= SHARED_MIN:
+    if drive is None or (g := _shared(drive)) is None:
         return None
     scales = [gravity_torque_scale(robot, joint_side_log(log, drive)) for log in logs]
     if not scales or any(a is None or not a > 0 for a in scales):
         return None
-    common = np.asarray(scales, dtype=np.float64) * ratio[0]
+    common = np.asarray(scales, dtype=np.float64) * g
     if common.min() < _COMMON[0] or common.max() > _COMMON[1]:
         return None
-    return SharedGearRatio(float(ratio[0]), common)
+    return SharedGearRatio(g, common)
+
+
+def _shared(drive: Drive) -> float | None:
+    """The gear ratio every joint of a joint-side ``drive`` of currents without coupling
+    shares, when it is above :data:`SHARED_MIN`; None otherwise."""
+    if drive.side != "joint" or drive.effort != "current" or drive.is_coupled:
+        return None
+    ratio = np.abs(np.diag(np.asarray(drive.transmission, dtype=np.float64)))
+    if not np.allclose(ratio, ratio[0], rtol=1e-9, atol=0.0) or ratio[0] <= SHARED_MIN:
+        return None
+    return float(ratio[0])
 
 
 def read_at_the_joints(given: Drive, own: Drive) -> float | None:
@@ -213,16 +221,11 @@ def read_at_the_joints(given: Drive, own: Drive) -> float | None:
     constants in it; None otherwise (other fields differ, or another factor)."""
     if given.torque_constant is None or own.torque_constant is None:
         return None
-    if own.effort != "current" or given.effort != "current" or own.side != "joint":
-        return None
-    mine, theirs = given.as_dict(), own.as_dict()
+    mine, theirs = given.as_dict(), own.as_dict()  # effort and side alike, as every other
     if any(mine.get(k) != theirs.get(k) for k in {*mine, *theirs} - {"torque_constant"}):
         return None
-    ratio = np.abs(np.diag(np.asarray(own.transmission, dtype=np.float64)))
-    if own.is_coupled or not np.allclose(ratio, ratio[0], rtol=1e-9, atol=0.0):
-        return None
-    if ratio[0] <= SHARED_MIN:
+    if (g := _shared(own)) is None:
         return None
     kt = np.asarray(own.torque_constant, dtype=np.float64)
     given_kt = np.asarray(given.torque_constant, dtype=np.float64)
-    return float(ratio[0]) if np.allclose(kt, given_kt * ratio[0], rtol=1e-9) else None
+    return g if np.allclose(kt, given_kt * g, rtol=1e-9) else None
