@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "dynid"
@@ -51,8 +52,14 @@ def _module_layer(path: Path) -> int | None:
     return _layer(rel.parts[0])
 
 
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    """The parsed source of ``path`` (parsed once for every test of this file)."""
+    return ast.parse(path.read_text())
+
+
 def _imported_parts(path: Path) -> list[str]:
-    tree = ast.parse(path.read_text())
+    tree = _tree(path)
     rel = path.relative_to(SRC)
     pkg = list(rel.parts[:-1])
     out = []
@@ -89,8 +96,10 @@ FACADES = {
 def _facade_imports(path: Path) -> list[tuple[str, str]]:
     """(function, imported part) of the imports inside the listed facade functions."""
     rel = path.relative_to(SRC).as_posix()
-    out = []
-    for node in ast.walk(ast.parse(path.read_text())):
+    out: list[tuple[str, str]] = []
+    if rel not in {module for module, _ in FACADES}:
+        return out
+    for node in ast.walk(_tree(path)):
         if isinstance(node, ast.FunctionDef) and (rel, node.name) in FACADES:
             for sub in ast.walk(node):
                 if isinstance(sub, ast.ImportFrom) and sub.level and sub.module:
@@ -219,7 +228,7 @@ def _imports(path: Path, top_level_only: bool, type_only: bool = False) -> list[
             ):
                 visit(node.body)
 
-    visit(ast.parse(path.read_text()).body)
+    visit(_tree(path).body)
     return out
 
 
@@ -230,7 +239,7 @@ def test_no_function_over_120_lines_outside_the_compiled_kernels():
         f"{path.relative_to(SRC)}:{node.lineno} {node.name} ({node.end_lineno - node.lineno + 1})"
         for path in SRC.rglob("*.py")
         if path.relative_to(SRC).parts[0] != "_kernels"
-        for node in ast.walk(ast.parse(path.read_text()))
+        for node in ast.walk(_tree(path))
         if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)
         and node.end_lineno is not None
         and node.end_lineno - node.lineno + 1 > 120
