@@ -19,6 +19,7 @@ LAYERS = [
         "_times",
         "progress",
         "spatial",
+        "butterworth",
         "signals",
     },
     {"model"},

@@ -8,7 +8,8 @@ before the workers exist; they then load the kernels from the cache. Nothing her
 checked: a kernel left out is compiled by the first test that needs it, as before.
 
 Usage: ``python tests/warm_kernels.py GROUP`` with GROUP 0 (the kinematics, forward and
-inverse, the Jacobians and link poses and the regressors, each for a batch and one sample:
+inverse, the Jacobians and link poses and the regressors, each for a batch and one sample,
+and the low-pass filter's sections:
 about 25 s of one core's time) or 1 (the dynamics, the gravity torques included, and the
 momentum observer: about 24 s).
 No compiled function is called from both groups (the inverse kinematics' Jacobian is
@@ -35,6 +36,7 @@ def warm(group: int) -> None:
     Q = np.tile(q, (3, 1))
     for x, v in ((Q, Q), (q, q)):  # a batch first: it loads the kernels for single samples
         if group == 0:
+            dynid.signals.lowpass(np.tile(x, (64, 1)), 1000.0, 10.0)  # its sections' kernel
             dynid.ik(robot, dynid.fk(robot, x), q0=x)
             dynid.jacobian(robot, x)
             dynid.link_poses(robot, x)

@@ -10,9 +10,10 @@ Pipeline used for torque logs (Gaz et al. 2019, Sec. VI; Swevers et al. 1997):
    Hz is far below sensor noise. The recorded timestamps are taken as the true sample
    times.
 2. :func:`lowpass`: a Butterworth low-pass applied forward and backward
-   (``scipy.signal.sosfiltfilt``). The designed ``order`` (default 4, as in the paper)
-   is applied twice, so the magnitude response is the square of the order-4 response:
-   effectively order 8, -6 dB (not -3 dB) at the cutoff, zero phase (no lag).
+   (:mod:`dynid.butterworth`, as ``scipy.signal.sosfiltfilt``). The designed ``order``
+   (default 4, as in the paper) is applied twice, so the magnitude response is the square
+   of the order-4 response: effectively order 8, -6 dB (not -3 dB) at the cutoff, zero
+   phase (no lag).
 3. :func:`derivative`: second-order accurate central differences
    (``numpy.gradient(..., edge_order=2)``), valid on non-uniform grids, e.g. the
    acceleration from the filtered velocity.
@@ -32,12 +33,11 @@ Pipeline used for torque logs (Gaz et al. 2019, Sec. VI; Swevers et al. 1997):
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _checks
+from .butterworth import butter_sos, zero_phase
 from .exceptions import DataError, ShapeError
 
 __all__ = [
@@ -428,9 +428,7 @@ def lowpass(
         )
     if order < 1:
         raise DataError(f"order must be >= 1; got {order}")
-    import scipy.signal  # imported here: it costs most of ``import dynid`` otherwise
-
-    sos = _butter_sos(order, cutoff_hz, fs).copy()  # scipy's filter wants it writable
+    sos = butter_sos(order, cutoff_hz, fs)
     minimum = 3 * (2 * len(sos) + 1)
     N = x.shape[axis]
     if N <= minimum:
@@ -444,8 +442,7 @@ def lowpass(
     def filtered(cols: NDArray[np.float64]) -> NDArray[np.float64]:  # (N, k) -> (N, k)
         ext = ends.extended(cols)
         pad = min(ext.shape[0] - 1, padlen)
-        y = scipy.signal.sosfiltfilt(sos, ext, axis=0, padtype="odd", padlen=pad)
-        return np.asarray(y[ends.length : ends.length + N])
+        return zero_phase(sos, ext, pad)[ends.length : ends.length + N]
 
     if x.ndim < 2:
         return filtered(np.ravel(x)[:, None])[:, 0]
@@ -490,30 +487,16 @@ def lowpass_noise_gain(
     """
     if cutoff_hz is None or not 0 < cutoff_hz < fs / 2:
         return 1.0
-    import scipy.signal
-
-    sos = scipy.signal.butter(order, float(cutoff_hz), btype="low", fs=float(fs), output="sos")
+    sos = butter_sos(order, float(cutoff_hz), float(fs))
     half = max(64, int(np.ceil(40.0 * fs / cutoff_hz)))
-    impulse = np.zeros(2 * half + 1)
+    impulse = np.zeros((2 * half + 1, 1))
     impulse[half] = 1.0
-    h = scipy.signal.sosfiltfilt(sos, impulse, padtype=None)
+    h = zero_phase(sos, impulse, 0)
     return float(min(1.0, np.sqrt(np.sum(h * h))))
 
 
 #: Samples filtered at once by :func:`lowpass` (signals grouped up to this size).
 _FILTER_ELEMENTS = 1 << 18
-
-
-@functools.lru_cache(maxsize=64)
-def _butter_sos(order: int, cutoff_hz: float, fs: float) -> NDArray[np.float64]:
-    """The second-order sections of the low-pass Butterworth filter (read only), designed
-    once per order, cut-off [Hz] and rate [Hz]: the regressor's columns of one log are
-    filtered many times at the same ones."""
-    import scipy.signal  # imported here: it costs most of ``import dynid`` otherwise
-
-    sos = np.asarray(scipy.signal.butter(order, cutoff_hz, btype="low", fs=fs, output="sos"))
-    sos.flags.writeable = False
-    return sos
 
 
 class _CubicEnds:

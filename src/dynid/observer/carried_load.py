@@ -59,6 +59,7 @@ from ..feasibility.payload import link_params_from_frame
 from ..model.robot import Robot
 from ..regressors.torque import torque_regressor
 from .events import ContactEvent
+from .residual import first_order_filtered
 from .unmodelled_load import LOAD_FRAME, load_regressor
 
 __all__ = [
@@ -228,14 +229,12 @@ def _lag(
 ) -> NDArray[np.float64]:
     """``u`` (N, n, ...) through each joint's ``K/(s + K)`` (exact for a step held over
     a sample, ``dt`` [s]) from the output ``state`` (n, ...) before the first sample."""
-    from scipy.signal import lfilter
-
-    out = np.empty_like(u)
-    for j in range(u.shape[1]):
-        a = 1.0 - float(np.exp(-K[j] * dt))
-        zi = (1.0 - a) * state[j][None, ...]
-        out[:, j], _ = lfilter([a], [1.0, a - 1.0], u[:, j], axis=0, zi=zi)
-    return out
+    a = -np.expm1(-np.asarray(K, dtype=np.float64) * dt)
+    x = np.ascontiguousarray(u, dtype=np.float64).reshape(u.shape[0], u.shape[1], -1)
+    zi = (1.0 - a)[:, None] * np.asarray(state, dtype=np.float64).reshape(u.shape[1], -1)
+    out = np.empty_like(x)
+    first_order_filtered(a, x, zi, out)
+    return out.reshape(u.shape)
 
 
 #: Samples of the rigid load's regressor computed at a time (the torque regressor of a

@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks, _kernels
+from .. import _checks
 from ..exceptions import DataError, OptionError, ShapeError
 from .events import ContactEvent, EventDetector, detect
 from .friction import (
@@ -64,7 +64,7 @@ from .friction import (
     velocity_bands,
 )
 from .model import ObserverModel
-from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_lag
+from .residual import DEFAULT_OPTIONS, ObserverOptions, first_order_filtered, first_order_lag
 from .rest_margin import RestClock, RestTally, at_rest, settle_seconds
 from .terms import base_momentum_regressor
 from .thresholds import RestMargin, Thresholds, threshold_series
@@ -151,7 +151,6 @@ def residual_std_blocks(
     L = V * np.sqrt(np.clip(w, 0.0, None))  # Sigma = L L^T
     r = L.shape[0]
     zi = np.zeros((n, r))
-    mod = _kernels.load("observer")
     prev_p = prev_b = None
     for a in range(0, N, BLOCK):
         Yp, Yb = base_momentum_regressor(model, qa[a : a + BLOCK], dqa[a : a + BLOCK])
@@ -172,30 +171,9 @@ def residual_std_blocks(
         if prev_p is None:
             x[0] = 0.0  # r_0 = 0 whatever the parameters
         Z = np.empty_like(x)
-        if mod is not None:
-            mod.first_order_filter(gam, x, zi, Z)
-        else:
-            _lfiltered(gam, x, zi, Z)
+        first_order_filtered(gam, x, zi, Z)
         prev_p, prev_b = Yp[-1], Yb[-1]
         yield a, np.sqrt(np.sum((Z @ L) ** 2, axis=-1))
-
-
-def _lfiltered(
-    gam: NDArray[np.float64],
-    x: NDArray[np.float64],
-    zi: NDArray[np.float64],
-    out: NDArray[np.float64],
-) -> None:
-    """:func:`dynid._kernels.observer.first_order_filter` without the kernels: ``x`` (m, n,
-    r) through ``gam / (1 + (gam - 1) z^-1)`` per joint from the state ``zi`` (n, r)
-    (updated) into ``out``."""
-    import scipy.signal
-
-    for j in range(x.shape[1]):
-        out[:, j, :], zf = scipy.signal.lfilter(
-            [gam[j]], [1.0, gam[j] - 1.0], x[:, j, :], axis=0, zi=zi[j][None]
-        )
-        zi[j] = zf[0]
 
 
 def _covariance(model: ObserverModel) -> NDArray[np.float64]:

@@ -42,6 +42,7 @@ __all__ = [
     "MomentumObserver",
     "ObserverOptions",
     "ObserverResult",
+    "first_order_filtered",
     "first_order_lag",
     "observe",
 ]
@@ -398,3 +399,26 @@ def first_order_lag(
         xk = 0.5 * (xa[k] + xa[k - 1]) if rule == "trapezoid" else xa[k]
         out[k] = out[k - 1] + a * (xk - out[k - 1])
     return out
+
+
+def first_order_filtered(
+    gam: NDArray[np.float64],
+    x: NDArray[np.float64],
+    zi: NDArray[np.float64],
+    out: NDArray[np.float64],
+) -> None:
+    """``x`` (m, n, r) through ``gam / (1 + (gam - 1) z^-1)`` per joint (``gam`` (n,))
+    along its first axis, from the state ``zi`` (n, r) (updated) into ``out``: one compiled
+    pass (:func:`dynid._kernels.observer.first_order_filter`), else
+    ``scipy.signal.lfilter`` (the same numbers, bit for bit)."""
+    mod = _kernels.load("observer")
+    if mod is not None:
+        mod.first_order_filter(gam, x, zi, out)
+        return
+    import scipy.signal  # the reference path: numba missing or turned off
+
+    for j in range(x.shape[1]):
+        out[:, j, :], zf = scipy.signal.lfilter(
+            [gam[j]], [1.0, gam[j] - 1.0], x[:, j, :], axis=0, zi=zi[j][None]
+        )
+        zi[j] = zf[0]
