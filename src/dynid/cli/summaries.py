@@ -37,7 +37,7 @@ from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 from ..regressors.terms import LinearFriction
-from .structure_table import selection_lines, text_width
+from .structure_table import per_recording_lines, selection_lines, text_width
 
 __all__ = [
     "format_consistent",
@@ -116,6 +116,7 @@ def format_identification(
         + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
     )
     head += recordings_lines(info.recordings)
+    head += per_recording_lines(info.extra, given=True)  # a structure given (--terms)
     first = info.extra.get("gains_first")  # why the torque constants were judged first:
     head += [f"note: {first}"] if isinstance(first, str) else []  # before the table it explains
     gravity = info.extra.get("gravity_fitted")  # the gravity vector a tilted base reads

@@ -400,11 +400,13 @@ def _warn_outlying(
     per: tuple[tuple[str, float], ...],
     keep: bool | None = None,
     spans: dict[int, str] | None = None,
+    given: bool = False,
 ) -> None:
     """One warning naming the recordings ``skip`` left out of the judgement, their held-out
-    errors with the chosen structure against the others' (``per``), where in each the
-    residual stands off (``spans``: its text per recording, :func:`_outlying_where`) and
-    what the final fit does with them (``keep``, :func:`_final_fit`)."""
+    errors with the chosen structure (``given``: the structure given) against the others'
+    (``per``), where in each the residual stands off (``spans``: its text per recording,
+    :func:`_outlying_where`) and what the final fit does with them (``keep``,
+    :func:`_final_fit`)."""
     if not skip:
         return
     odd = [per[i] for i in skip]
@@ -414,15 +416,17 @@ def _warn_outlying(
     where = [f"{per[i][0]}'s at {spans[i]}" for i in skip if spans and spans.get(i)]
     warnings.warn(
         f"{', '.join(n for n, _ in odd)}: held-out error{'s' if len(odd) > 1 else ''} "
-        f"{errors} with the chosen structure, far above the other recordings' ({others}; "
-        "metadata.selection.heldout_per_recording): it holds torques the model does not "
+        f"{errors} with the {'structure given' if given else 'chosen structure'}, far above "
+        f"the other recordings' ({others}; metadata."
+        f"{'' if given else 'selection.'}heldout_per_recording): it holds torques the model "
+        "does not "
         "(contacts, a payload?)"
         + (
             f"; the residual (predicted by the fit of the others) stands off {'; '.join(where)}"
             if where
             else ""
         )
-        + "; the structure is chosen on the other recordings"
+        + ("" if given else "; the structure is chosen on the other recordings")
         + ("" if keep is None else f"; {_final_fit(keep, len(skip))}"),
         DynidWarning,
         stacklevel=3,
@@ -432,24 +436,37 @@ def _warn_outlying(
 def _outlying_where(
     k: int, chosen: Structure, off: _OffGrid, data: Recordings, robot: Robot
 ) -> str:
-    """Where recording ``k``'s residual stands off (:func:`~.outlying_spans.spans_text`):
-    its torques as measured less the prediction of ``chosen`` fitted on the other
-    recordings (its fold's training rows, in the regressor ``off.where`` says, of
-    ``off.groups``); empty where none stands off or its rows do not match its samples."""
+    """Where recording ``k``'s residual stands off (:func:`_residual_spans`) with
+    ``chosen`` fitted on the other recordings (its fold's training rows, in the regressor
+    ``off.where`` says, of ``off.groups``); empty where it has no regressor there."""
     key = off.where.get(chosen)
     if key is None:
         return ""
     model, terms = off.groups[key]
-    rtol = off.rtol
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     idx = np.flatnonzero(candidate_columns(chosen, model, terms) & np.asarray(fit.kept, bool))
+    return _residual_spans(k, model, tuple(t for t, _ in terms), idx, data, robot, off.rtol)
+
+
+def _residual_spans(
+    k: int,
+    model: IdentifiedModel,
+    terms: Sequence[ModelTerm],
+    idx: NDArray[np.intp],
+    data: Recordings,
+    robot: Robot,
+    rtol: float,
+) -> str:
+    """Where recording ``k``'s residual stands off (:func:`~.outlying_spans.spans_text`):
+    its torques as measured [N m] less the prediction of the columns ``idx`` of ``model``
+    (fitted with ``terms`` on ``data``, judged over one fold per recording) fitted on its
+    fold's training rows, the other recordings; empty where none stands off or its rows do
+    not match its samples."""
     held = heldout_of(model).restricted(idx)
     if held.folds != len(data.names):
         return ""
     x = held.train[k].solve(rtol)
-    columns = model_columns(
-        robot, data, drive=model.drive, terms=tuple(t for t, _ in terms), base=model.base
-    )
+    columns = model_columns(robot, data, drive=model.drive, terms=tuple(terms), base=model.base)
     labels, _ = data.fold_labels()
     e, o = [], 0
     for blk in data.measured_blocks(robot, columns):
@@ -635,21 +652,30 @@ def _per_recording_of(
     model: IdentifiedModel, selection: Selection, gone: tuple[int, ...] = ()
 ) -> Selection:
     """``selection`` with each recording's held-out error (:attr:`~.candidates.Selection.
-    per_recording`) that of ``model``, the chosen structure's final fit, over its own folds
+    per_recording`) that of ``model``, the chosen structure's final fit
+    (:func:`_per_recording_fitted`). The search's regressor holds every candidate's
+    columns, whose round-off on exact data (1e-6 % about another model's coefficients)
+    the summary printed beside the pooled 3.5e-12 % of the same structure."""
+    per = _per_recording_fitted(model, selection.per_recording, gone)
+    return replace(selection, per_recording=per)
+
+
+def _per_recording_fitted(
+    model: IdentifiedModel, per: tuple[tuple[str, float], ...], gone: tuple[int, ...] = ()
+) -> tuple[tuple[str, float], ...]:
+    """``per`` (each recording's name and held-out error [%]) with the errors of the
+    recordings ``model`` was fitted on those over its own folds
     (:func:`~.holdout.fold_errors_percent` of its kept columns, as its pooled held-out
-    error); the recordings ``gone`` (left out of the fit as outlying) keep theirs. The
-    search's regressor holds every candidate's columns, whose round-off on exact data
-    (1e-6 % about another model's coefficients) the summary printed beside the pooled
-    3.5e-12 % of the same structure."""
+    error); the recordings ``gone`` (left out of the fit as outlying) keep theirs, and
+    ``per`` is returned as it is where ``model``'s folds are not one per recording."""
     held = model.holdout
-    fitted = [k for k in range(len(selection.per_recording)) if k not in gone]
+    fitted = [k for k in range(len(per)) if k not in gone]
     if held is None or held.scheme != "recordings" or held.folds != len(fitted):
-        return selection
+        return per
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     errors = fold_errors_percent(held.restricted(np.flatnonzero(fit.kept)))
     folds = dict(zip(fitted, errors, strict=True))
-    per = tuple((name, folds.get(k, e)) for k, (name, e) in enumerate(selection.per_recording))
-    return replace(selection, per_recording=per)
+    return tuple((name, folds.get(k, e)) for k, (name, e) in enumerate(per))
 
 
 def _widths_per_joint(
@@ -1071,10 +1097,9 @@ def identify_recordings(
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
-    Each recording (and each piece of one between its gaps) is prepared on its own
-    (:func:`~dynid.identification.recordings.prepare_recordings`); the structure is chosen
-    on held-out data (:func:`select_structure`) unless given, then fitted on all the data
-    but the recordings found outlying there (the structure chosen without them).
+    Each recording (each piece between its gaps) prepared on its own (:func:`~.recordings.
+    prepare_recordings`), the structure chosen on held-out data (:func:`select_structure`)
+    or given (:func:`_fitted_given`) is fitted on all but the recordings found outlying.
 
     Parameters
     ----------
@@ -1117,8 +1142,8 @@ def identify_recordings(
     base : BaseParameters, optional
         The base parameters of a structure given (default: the structural ones).
     keep_outlying : bool
-        Fit the recordings the structure's choice found outlying too (default: left out,
-        ``left_out`` in their ``info.recordings`` entry, said in a warning).
+        Fit the recordings found outlying (structure chosen or given) too (default: left
+        out, ``left_out`` in their ``info.recordings`` entry, said in a warning).
 
     Returns
     -------
@@ -1155,18 +1180,102 @@ def identify_recordings(
             estimator=est, folds=folds, rtol=rtol, prep=prep,
         )  # fmt: skip
         selection = selection and replace(selection, notes=(*exact, *selection.notes))
-    with stage("the fit of the structure chosen" if selection else "the fit", rows=fitted.n_rows):
-        model, terms = _fitted(
-            robot, fitted, structure, drive, folds, validation, estimator=est, std=std,
-            base=base, max_std_percent=max_std_percent, rtol=rtol,
-        )  # fmt: skip
+    kw: dict[str, Any] = {"estimator": est, "std": std, "base": base, "rtol": rtol}
+    model, terms, fitted, odd, given = _fitted_given(
+        robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
+        judge=selection is None, max_std_percent=max_std_percent, **kw,
+    )  # fmt: skip
     warn_unphysical(model, terms)
     if selection is not None and structure == selection.chosen:
         selection = _per_recording_of(model, selection, gone)
     heldout = _heldout_record(model, fitted if validation is None else validation)
     combined = _combined(robot, fitted, structure, drive, model.base)
-    model = _recorded(model, exact, combined, heldout, structure, selection)
+    model = _recorded(model, exact, combined, heldout, structure, selection, given)
+    gone += odd  # left out by the choice (auto) or under the structure given
     return _with_left_out(model, data, gone, fitted) if gone else model
+
+
+def _fitted_given(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    data: Recordings,
+    structure: Structure,
+    drive: Drive | None,
+    folds: int,
+    validation: Recordings | None,
+    keep: bool,
+    prep: dict[str, Any],
+    *,
+    judge: bool,
+    **kw: Any,
+) -> tuple[IdentifiedModel, tuple[ModelTerm, ...], Recordings, tuple[int, ...], dict[str, Any]]:
+    """``structure`` fitted on ``data`` (:func:`_fitted` with ``kw``) and, given (``judge``:
+    not chosen on held-out data, which judged the recordings already) of three
+    recordings or more without a separate ``validation``, each recording judged under it
+    as the search judges them (:func:`_odd_under`, the fit's own folds: no other
+    structure fitted): one outlying is named in a warning with where its residual stands
+    off (:func:`_residual_spans`) and, unless ``keep``, left out, the others prepared
+    again on their own (``prep``, as :func:`_chosen_without` does) and fitted; the first
+    fit's warnings said only when it is kept. Returns the model, its terms, the
+    recordings it is fitted on, those left out and the record of the judgement
+    (``heldout_per_recording``, ``outlying_recordings``; empty when not judged).
+
+    Regression: a 6-DoF arm's three recordings, one with a 30 N m burst on joint 2 for
+    0.1 s, fitted all three with ``--terms`` (training error 15.4 %, 13.4 % on a fourth
+    recording for a 1.01 % floor) where the search left it out."""
+    if not judge or validation is not None or len(data.names) < 3:
+        with stage("the fit" if judge else "the fit of the structure chosen", rows=data.n_rows):
+            model, terms = _fitted(robot, data, structure, drive, folds, validation, **kw)
+        return model, terms, data, (), {}
+    with stage("the fit", rows=data.n_rows), warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        model, terms = _fitted(robot, data, structure, drive, folds, None, **kw)
+    rtol = 1e-10 if kw.get("rtol") is None else float(kw["rtol"])
+    skip, per = _odd_under(model, data.names, rtol)
+    if not skip or keep:
+        for w in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if skip:
+        fit = model.joint_fit if model.joint_fit is not None else model.fit
+        idx = np.flatnonzero(np.asarray(fit.kept, dtype=bool))
+        spans = {k: _residual_spans(k, model, terms, idx, data, robot, rtol) for k in skip}
+        _warn_outlying(skip, per, keep, spans, given=True)
+    record = {
+        "heldout_per_recording": [{"file": f, "heldout_error_percent": e} for f, e in per],
+        "outlying_recordings": [data.names[i] for i in skip],
+    }
+    if not skip or keep:
+        return model, terms, data, (), record if per else {}
+    kept = [i for i in range(len(logs)) if i not in skip]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the recordings' findings were said with all of them
+        clean, _ = _recordings(
+            robot, [logs[i] for i in kept], [data.names[i] for i in kept], None, drive, **prep
+        )  # fmt: skip
+    with stage("the fit without the outlying recording(s)", rows=clean.n_rows):
+        model, terms = _fitted(robot, clean, structure, drive, folds, None, **kw)
+    per = _per_recording_fitted(model, per, skip)
+    record["heldout_per_recording"] = [{"file": f, "heldout_error_percent": e} for f, e in per]
+    return model, terms, clean, skip, record
+
+
+def _odd_under(
+    model: IdentifiedModel, names: Sequence[str], rtol: float
+) -> tuple[tuple[int, ...], tuple[tuple[str, float], ...]]:
+    """The recordings (indices into ``names``) outlying under ``model``'s structure, fitted
+    with one fold per recording: :func:`~.candidates.recording_oddness` above
+    :data:`~.candidates.OUTLIER_RATIO`, at least two others left; and every recording's
+    name and held-out error [%] (fitted on the others). None and no errors where its folds
+    are not one per recording."""
+    held = model.holdout
+    if held is None or held.scheme != "recordings" or held.folds != len(names):
+        return (), ()
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    kept = np.asarray(fit.kept, dtype=bool)
+    errors = fold_errors_percent(held.restricted(np.flatnonzero(kept)), rtol)
+    scores = recording_oddness(np.ones(kept.size, dtype=bool), model, rtol)
+    skip = tuple(i for i, x in enumerate(scores) if x > OUTLIER_RATIO)
+    return (skip if len(names) - len(skip) >= 2 else ()), tuple(zip(names, errors, strict=True))
 
 
 def _choose(
@@ -1311,15 +1420,17 @@ def _recorded(
     heldout: Any,
     structure: Structure,
     selection: Selection | None,
+    given: dict[str, Any] | None = None,
 ) -> IdentifiedModel:
     """``model`` with its record completed: the note of exact logs (their cut-off source
     ``"exact"``: validate reads a noisy log's own), the combined coefficients, the held-out
-    record, the warned negative inertias, the terms and the structure's selection."""
+    record, the warned negative inertias, the terms and the structure's selection (or,
+    given, its recordings' judgement ``given``, :func:`_fitted_given`)."""
     notes = (*exact, *model.info.notes, *warned_negative_inertias(model))
     info = replace(model.info, combined=combined, heldout=heldout, notes=notes)
     if exact and info.log is not None:
         info = replace(info, log=replace(info.log, cutoff_source="exact"))
-    extra = {**model.info.extra, "terms": list(structure.terms)}
+    extra = {**model.info.extra, "terms": list(structure.terms), **(given or {})}
     info = replace(info, selection=None if selection is None else selection.as_dict(), extra=extra)
     return replace(model, info=info)
 
