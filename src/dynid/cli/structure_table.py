@@ -79,18 +79,21 @@ def selection_lines(selection: Any) -> list[str]:
 
 def per_recording_lines(record: Any, indent: str = "", given: bool = False) -> list[str]:
     """The structure's held-out error per recording, fitted on the others, those outlying
-    marked (``record``: ``metadata.selection``, or ``metadata`` of a structure ``given``);
+    marked, and those whose spans were cut out (``cut_out_spans``: the error of the rest)
+    (``record``: ``metadata.selection``, or ``metadata`` of a structure ``given``);
     none when it holds none."""
     per = record.get("heldout_per_recording") or () if isinstance(record, dict) else ()
     if not per:
         return []
     odd = set(record.get("outlying_recordings") or ())
+    cut = {c.get("file") for c in record.get("cut_out_spans") or () if isinstance(c, dict)}
     return [
         f"{indent}held-out error of the {'structure given' if given else 'chosen structure'} "
         "per recording (fitted on the others): "
         + ", ".join(
             f"{r['file']} {r['heldout_error_percent']:.3g} %"
-            + (" (outlying)" if r["file"] in odd else "")
+            + (" (outlying: its spans cut out)" if r["file"] in cut else "")
+            + (" (outlying)" if r["file"] in odd - cut else "")
             for r in per
         )
     ]

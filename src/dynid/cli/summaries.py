@@ -23,6 +23,7 @@ from ..identification.dissipation import SIGNIFICANCE, negative_viscous
 from ..identification.info import IdentificationInfo, LogInfo
 from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
+from ..identification.outlying_spans import cut_text
 from ..identification.pieces import gaps_text
 from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints, own_rotors
 from ..io.observer_files import log_labels
@@ -378,8 +379,23 @@ def recordings_lines(recordings: Any) -> list[str]:
         + ")"
         + _gaps(r)
         + _lost(r)
+        + _cut_out(r)
         for r in recs
     ]
+
+
+def _cut_out(rec: Any) -> str:
+    """``; t = 4.672 to 5.428 s cut out (outlying; ...)``: the intervals cut out of an
+    outlying recording's fit (``cut_out``), empty for none."""
+    cut = rec.get("cut_out") or ()
+    if not cut:
+        return ""
+    n = rec.get("cut_samples")
+    return (
+        f"; {cut_text(tuple((float(a), float(b)) for a, b in cut))} cut out"
+        + (f" ({n} more recorded)" if n else "")
+        + ": outlying there (with the filter's edge beside it; --keep-outlying fits it whole)"
+    )
 
 
 def _gaps(rec: Any) -> str:

@@ -902,10 +902,13 @@ def _per_recording_table(doc: dict, record: dict, what: str, judged: bool = Fals
     odd = set(record.get("outlying_recordings") or ())
     recs = _get(doc, "metadata", "recordings") or ()
     out = {r.get("file") for r in recs if isinstance(r, dict) and r.get("left_out")}
+    cut = {r.get("file") for r in recs if isinstance(r, dict) and r.get("cut_out")}
 
     def said(name: Any) -> str:
         if name not in odd:
             return ""
+        if name in cut:
+            return "outlying: its spans cut out of the fit, the rest fitted"
         if name in out:
             return f"outlying: left out of {'the judgement and of ' if judged else ''}the fit"
         return (
