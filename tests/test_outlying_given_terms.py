@@ -92,6 +92,7 @@ def test_a_given_structure_cuts_the_burst_out_and_names_its_span(arm, logs):
     (cut,) = fitted_logs(model, train)[1:2]
     assert not np.any((cut.t >= 2.0) & (cut.t < 2.1)) and cut.n_samples < train[1].n_samples
     assert not any(r.get("cut_out") for r in kept.info.recordings)
+    assert recs[1]["sha256"] == kept.info.recordings[1]["sha256"]  # the file as read
     assert model.info.extra["outlying_recordings"] == ["burst.csv"]
     per = {r["file"]: r["heldout_error_percent"] for r in model.info.extra["heldout_per_recording"]}
     assert list(per) == NAMES and per["burst.csv"] < 1.5 * max(per["a.csv"], per["c.csv"])

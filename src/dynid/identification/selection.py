@@ -1600,11 +1600,13 @@ def _with_left_out(
 def _cut_record(fitted: dict[str, Any], whole: dict[str, Any], cut: _Cut) -> dict[str, Any]:
     """A recording's record as fitted, and with the intervals ``cut`` out of it: those
     (``cut_out``, ``[t0, t1]`` [s] each) and the samples they held (``cut_samples``, of
-    ``whole``'s ``recorded``; ``recorded`` is what was left)."""
+    ``whole``'s ``recorded``; ``recorded`` is what was left), the ``sha256`` of the
+    recording as read (``whole``'s: ``payload --model`` knows the file by it)."""
     if not cut:
         return fitted
     gone = int(whole.get("recorded", 0)) - int(fitted.get("recorded", 0))
-    return {**fitted, "cut_out": [list(c) for c in cut], "cut_samples": gone}
+    out = {**fitted, "cut_out": [list(c) for c in cut], "cut_samples": gone}
+    return out | ({"sha256": whole["sha256"]} if "sha256" in whole else {})
 
 
 def _recorded(
