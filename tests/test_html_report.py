@@ -510,6 +510,19 @@ def test_model_structure_table_marks_the_chosen_candidate(runs, tmp_path):
     p.write_text(json.dumps(doc))
     page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))
     assert not any("candidate" in t[0] for t in page.tables)
+    # a structure given (--terms): its held-out error per recording, the outlying one
+    # left out of the fit (no judgement of structures to leave it out of)
+    doc["metadata"]["terms"] = ["viscous", "coulomb"]
+    doc["metadata"]["heldout_per_recording"] = [
+        {"file": "a.csv", "heldout_error_percent": 0.41},
+        {"file": "hit.csv", "heldout_error_percent": 7.5},
+    ]
+    doc["metadata"]["outlying_recordings"] = ["hit.csv"]
+    p.write_text(json.dumps(doc))
+    page = Page(render_html_report(RunSummary(command="identify"), {p.name: p}, out=tmp_path))
+    per = next(t for t in page.tables if t[0][0] == "recording")
+    assert per[1][:2] == ["a.csv", "0.41"] and per[2][2] == "outlying: left out of the fit"
+    assert "Structure given: viscous, coulomb." in " ".join(" ".join(page.text).split())
 
 
 def test_figures_left_out_are_said_in_the_first_lines(tmp_path):

@@ -58,3 +58,24 @@ def test_the_outlying_recording_s_warning_names_the_burst_s_time_and_joint():
     t0, t1 = (float(x) for x in warned.split(head)[1].split(" s ")[0].split(" to "))
     assert 1.95 <= t0 <= 2.05 and 2.1 <= t1 <= 2.25, (t0, t1)
     assert warned.split(head)[1].split(" on ")[1].startswith(f"{arm.joint_names[1]} (up to")
+
+
+def test_short_spans_that_hold_nearly_all_the_residual_are_cut_with_a_margin():
+    """Closed form: a recording 17.5 x the others' median with 99.8 % of its squared
+    residual in one 0.09 s span: cut, widened by the margin on both sides (the rest would
+    stand at 17.5 sqrt(0.002) = 0.78 x); with 90 % in it (rest 5.5 x), with the span over
+    most of the recording, or with an interval the preparation would bridge: not cut."""
+    from dynid.identification.outlying_spans import Span, cut_intervals, without_intervals
+
+    t = np.arange(0.0, 10.0, 0.005)
+    burst = (Span(5.005, 5.095, (1,), 30.0, 0.998),)
+    np.testing.assert_allclose(cut_intervals(burst, 17.5, t, 0.1, 0.0125), [[4.905, 5.195]])
+    assert cut_intervals((Span(5.005, 5.095, (1,), 30.0, 0.9),), 17.5, t, 0.1, 0.0125) == ()
+    assert cut_intervals((Span(1.0, 8.0, (1,), 30.0, 0.998),), 17.5, t, 0.1, 0.0125) == ()
+    assert cut_intervals(burst, 17.5, t, 0.1, 0.5) == ()
+    # two spans whose margins overlap are one interval; a noise span below 1 % stays
+    two = (Span(5.0, 5.05, (1,), 30.0, 0.6), Span(5.1, 5.15, (0,), 20.0, 0.399))
+    noise = Span(8.0, 8.0, (0,), 0.2, 1e-4)
+    np.testing.assert_allclose(cut_intervals((*two, noise), 10.0, t, 0.1, 0.0125), [[4.9, 5.25]])
+    keep = without_intervals(t, ((4.9, 5.25),))
+    assert keep.sum() == t.size - np.count_nonzero((t >= 4.9) & (t <= 5.25))

@@ -61,7 +61,11 @@ def test_a_recording_with_a_contact_is_named_and_does_not_decide_the_structure(p
     assert "viscous" in sel["chosen"]
     per = {r["file"]: r["heldout_error_percent"] for r in sel["heldout_per_recording"]}
     assert list(per) == ["a.csv", "b.csv", "c.csv", "hit.csv"]
-    assert per["hit.csv"] > max(per[f] for f in ("a.csv", "b.csv", "c.csv"))
+    # the contact (2.0 to 3.0 s) cut out with the filter's edge beside it, not the whole
+    # recording left out: what is left of it is predicted as the others are
+    ((a, b),) = next(c["intervals"] for c in sel["cut_out_spans"] if c["file"] == "hit.csv")
+    assert 1.8 < a < 2.0 and 3.0 < b < 3.2, (a, b)
+    assert per["hit.csv"] < 1.5 * max(per[f] for f in ("a.csv", "b.csv", "c.csv"))
 
 
 def test_alike_recordings_each_get_their_held_out_error_and_no_warning(panda, logs):

@@ -8,7 +8,7 @@ from typing import Any
 
 from ..identification.determined import determined_sentence
 
-__all__ = ["selection_lines", "text_width"]
+__all__ = ["per_recording_lines", "selection_lines", "text_width"]
 
 
 def text_width(header: str, cells: Any, least: int = 0) -> int:
@@ -72,19 +72,31 @@ def selection_lines(selection: Any) -> list[str]:
             + ": the table shows each law's best, of those skipped (x) too; "
             "metadata.selection.candidates holds every one)"
         )
-    per = selection.get("heldout_per_recording") or ()
-    if per:
-        odd = set(selection.get("outlying_recordings") or ())
-        out.append(
-            "  held-out error of the chosen structure per recording (fitted on the others): "
-            + ", ".join(
-                f"{r['file']} {r['heldout_error_percent']:.3g} %"
-                + (" (outlying)" if r["file"] in odd else "")
-                for r in per
-            )
-        )
+    out += per_recording_lines(selection, "  ")
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
+
+
+def per_recording_lines(record: Any, indent: str = "", given: bool = False) -> list[str]:
+    """The structure's held-out error per recording, fitted on the others, those outlying
+    marked, and those whose spans were cut out (``cut_out_spans``: the error of the rest)
+    (``record``: ``metadata.selection``, or ``metadata`` of a structure ``given``);
+    none when it holds none."""
+    per = record.get("heldout_per_recording") or () if isinstance(record, dict) else ()
+    if not per:
+        return []
+    odd = set(record.get("outlying_recordings") or ())
+    cut = {c.get("file") for c in record.get("cut_out_spans") or () if isinstance(c, dict)}
+    return [
+        f"{indent}held-out error of the {'structure given' if given else 'chosen structure'} "
+        "per recording (fitted on the others): "
+        + ", ".join(
+            f"{r['file']} {r['heldout_error_percent']:.3g} %"
+            + (" (outlying: its spans cut out)" if r["file"] in cut else "")
+            + (" (outlying)" if r["file"] in odd - cut else "")
+            for r in per
+        )
+    ]
 
 
 def _or_nan(x: float | None) -> float:

@@ -23,6 +23,7 @@ from ..identification.dissipation import SIGNIFICANCE, negative_viscous
 from ..identification.info import IdentificationInfo, LogInfo
 from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
+from ..identification.outlying_spans import cut_text
 from ..identification.pieces import gaps_text
 from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints, own_rotors
 from ..io.observer_files import log_labels
@@ -37,7 +38,7 @@ from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 from ..regressors.terms import LinearFriction
-from .structure_table import selection_lines, text_width
+from .structure_table import per_recording_lines, selection_lines, text_width
 
 __all__ = [
     "format_consistent",
@@ -116,6 +117,7 @@ def format_identification(
         + (f" ({', '.join(groups['unidentifiable'])})" if groups["unidentifiable"] else "")
     )
     head += recordings_lines(info.recordings)
+    head += per_recording_lines(info.extra, given=True)  # a structure given (--terms)
     first = info.extra.get("gains_first")  # why the torque constants were judged first:
     head += [f"note: {first}"] if isinstance(first, str) else []  # before the table it explains
     gravity = info.extra.get("gravity_fitted")  # the gravity vector a tilted base reads
@@ -377,8 +379,23 @@ def recordings_lines(recordings: Any) -> list[str]:
         + ")"
         + _gaps(r)
         + _lost(r)
+        + _cut_out(r)
         for r in recs
     ]
+
+
+def _cut_out(rec: Any) -> str:
+    """``; t = 4.672 to 5.428 s cut out (outlying; ...)``: the intervals cut out of an
+    outlying recording's fit (``cut_out``), empty for none."""
+    cut = rec.get("cut_out") or ()
+    if not cut:
+        return ""
+    n = rec.get("cut_samples")
+    return (
+        f"; {cut_text(tuple((float(a), float(b)) for a, b in cut))} cut out"
+        + (f" ({n} more recorded)" if n else "")
+        + ": outlying there (with the filter's edge beside it; --keep-outlying fits it whole)"
+    )
 
 
 def _gaps(rec: Any) -> str:

@@ -37,6 +37,7 @@ __all__ = [
     "Candidate",
     "Selection",
     "candidate_judged",
+    "cut_record",
     "heldout_of",
     "paired_fold_se",
     "paired_se",
@@ -233,6 +234,10 @@ class Selection:
         not miss (within one standard error of the lowest) but that the data determine
         (:data:`DETERMINED_STD_PERCENT`), kept: each one's label and relative standard
         deviation [%].
+    cut : tuple of (str, tuple of (float, float))
+        The outlying recordings whose residual stands off in short spans, each with the
+        intervals [s] cut out of it for the final fit (the spans with the filter's edge
+        beside them) in place of leaving it out whole.
     """
 
     candidates: tuple[Candidate, ...]
@@ -243,6 +248,7 @@ class Selection:
     per_recording: tuple[tuple[str, float], ...] = ()
     outlying: tuple[str, ...] = ()
     determined: tuple[tuple[str, float], ...] = ()
+    cut: tuple[tuple[str, tuple[tuple[float, float], ...]], ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready (``identification.json``'s ``metadata.selection``)."""
@@ -259,7 +265,17 @@ class Selection:
             "kept_determined": [
                 {"coefficient": lab, "std_percent": r} for lab, r in self.determined
             ],
+            "cut_out_spans": cut_record(self.cut),
         }
+
+
+def cut_record(
+    cut: Sequence[tuple[str, tuple[tuple[float, float], ...]]],
+) -> list[dict[str, Any]]:
+    """JSON-ready spans cut out of outlying recordings (:attr:`Selection.cut`): per
+    recording its ``file`` and ``intervals`` (``[t0, t1]`` [s] each, as the file holds the
+    times)."""
+    return [{"file": f, "intervals": [[a, b] for a, b in c]} for f, c in cut]
 
 
 #: A recording whose held-out error exceeds this multiple of the other recordings' median

@@ -13,6 +13,7 @@ holds them, torques [N m].
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,13 +22,18 @@ from numpy.typing import NDArray
 from .._times import offset_text, stamp_text
 
 __all__ = [
+    "CUT_MAX_TIME_SHARE",
+    "CUT_REST_RATIO",
     "JOIN_S",
     "MIN_SHARE",
     "OFF_SIGMAS",
     "SPANS_SHOWN",
     "Span",
+    "cut_intervals",
+    "cut_text",
     "outlying_spans",
     "spans_text",
+    "without_intervals",
 ]
 
 #: A residual sample this many robust levels of its joint off the joint's median stands off.
@@ -39,6 +45,12 @@ SPANS_SHOWN = 3
 #: A span holding less than this share of the recording's squared residual is not said [1]
 #: (a noise sample of 6 robust levels: 0.002 % beside a 50 N m burst).
 MIN_SHARE = 0.01
+#: An outlying recording's spans are cut out of it, not the whole recording left out,
+#: when the rest of it would stand at most this many times the other recordings' median
+#: held-out error (:func:`cut_intervals`; a recording is outlying above 3).
+CUT_REST_RATIO = 1.5
+#: ... and the spans cut, with their margins, hold at most this share of its duration [1].
+CUT_MAX_TIME_SHARE = 0.2
 _MAD_TO_STD = 1.4826  # a Gaussian's standard deviation over its median absolute deviation
 
 
@@ -134,3 +146,74 @@ def spans_text(
         )
     more = len(big) - len(said)
     return "; ".join(said) + (f"; and {more} more span(s)" if more > 0 else "")
+
+
+def cut_intervals(
+    spans: tuple[Span, ...],
+    ratio: float,
+    t: NDArray[np.float64],
+    margin_s: float,
+    bridged_s: float,
+) -> tuple[tuple[float, float], ...]:
+    """The time intervals [s] to cut out of an outlying recording instead of leaving it
+    out, or none.
+
+    Parameters
+    ----------
+    spans : tuple of Span
+        Where its residual stands off (:func:`outlying_spans`); those holding at least
+        :data:`MIN_SHARE` of its squared residual are cut.
+    ratio : float
+        Its held-out error over the other recordings' median (each fitted without it).
+    t : ndarray, shape (N,)
+        Its sample times [s] (as the spans').
+    margin_s : float
+        Widening of each span on both sides [s]: the filter's edge and a decimated step,
+        so that no sample of what stood off is left at a piece's end.
+    bridged_s : float
+        The longest gap the preparation bridges [s]: an interval no longer would be
+        bridged, not cut.
+
+    Returns
+    -------
+    tuple of (float, float)
+        The spans widened (joined where they overlap), ascending; none where the rest of
+        the recording (:data:`MIN_SHARE`'s spans' complement, ``ratio sqrt(1 - share)``)
+        would stand above :data:`CUT_REST_RATIO`, where they hold more than
+        :data:`CUT_MAX_TIME_SHARE` of its duration, or where one is no longer than
+        ``bridged_s``.
+    """
+    big = [s for s in spans if s.share >= MIN_SHARE]
+    share = sum(s.share for s in big)
+    if not big or ratio * math.sqrt(max(0.0, 1.0 - share)) > CUT_REST_RATIO:
+        return ()
+    out: list[list[float]] = []
+    for a, b in sorted((s.t0 - margin_s, s.t1 + margin_s) for s in big):
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    t = np.asarray(t, dtype=np.float64)
+    span = float(t[-1] - t[0]) if t.size > 1 else 0.0
+    if sum(b - a for a, b in out) > CUT_MAX_TIME_SHARE * span:
+        return ()
+    if any(b - a <= bridged_s for a, b in out):
+        return ()
+    return tuple((a, b) for a, b in out)
+
+
+def without_intervals(
+    t: NDArray[np.float64], intervals: tuple[tuple[float, float], ...]
+) -> NDArray[np.bool_]:
+    """The samples of ``t`` [s] outside every one of ``intervals`` (closed, [s]): the rows
+    a recording keeps once those are cut out."""
+    t = np.asarray(t, dtype=np.float64)
+    keep = np.ones(t.size, dtype=bool)
+    for a, b in intervals:
+        keep &= ~((t >= a) & (t <= b))
+    return keep
+
+
+def cut_text(intervals: tuple[tuple[float, float], ...]) -> str:
+    """``t = 4.672 to 5.428 s``: the intervals cut out, as the file holds the times."""
+    return ", ".join(f"t = {stamp_text(a)} to {stamp_text(b)} s" for a, b in intervals)

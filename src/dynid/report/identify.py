@@ -832,7 +832,7 @@ def _selection(doc: dict) -> Any:
 def _structure_section(doc: dict) -> str:
     sel = _selection(doc)
     if not isinstance(sel, dict) or not sel.get("candidates"):
-        return ""
+        return _given_section(doc)
     chosen = sel.get("chosen")
     rows, marked = [], []
 
@@ -872,32 +872,58 @@ def _structure_section(doc: dict) -> str:
     kept = determined_sentence(sel.get("kept_determined"))
     rule += "" if kept is None else f" {esc(capitalised(kept))}."
     parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
-    per = [r for r in sel.get("heldout_per_recording") or () if isinstance(r, dict)]
+    per = _per_recording_table(doc, sel, "chosen structure", judged=True)
     if per:
-        odd = set(sel.get("outlying_recordings") or ())
-        recs = _get(doc, "metadata", "recordings") or ()
-        out = {r.get("file") for r in recs if isinstance(r, dict) and r.get("left_out")}
-
-        def said(name: Any) -> str:
-            if name not in odd:
-                return ""
-            if name in out:
-                return "outlying: left out of the judgement and of the fit"
-            return "outlying: left out of the judgement, fitted (--keep-outlying)"
-
-        rows = [
-            [esc(r.get("file", "")), cell(r.get("heldout_error_percent"))]
-            + ([said(r.get("file"))] if odd else [])
-            for r in per
-        ]
-        head = ["recording", "held-out error [%]"] + (["judgement"] if odd else [])
-        parts.append(
-            "<p>Held-out error of the chosen structure per recording (fitted on the others).</p>"
-            + table(head, rows)
-        )
+        parts.append(per)
         disagree = [n for n in sel.get("notes") or () if str(n).startswith(DISAGREE_NOTE)]
         parts += [f"<p>{esc(capitalised(str(n)))}.</p>" for n in disagree]
     return section("structure", "Model structure", *parts)
+
+
+def _given_section(doc: dict) -> str:
+    """A structure given (``--terms``) over several recordings: its held-out error per
+    recording (``metadata.heldout_per_recording``), those outlying marked; empty without."""
+    meta = _get(doc, "metadata")
+    per = _per_recording_table(doc, meta, "structure given") if isinstance(meta, dict) else ""
+    if not per:
+        return ""
+    terms = ", ".join(str(t) for t in meta.get("terms") or ()) or "links"
+    return section("structure", "Model structure", f"<p>Structure given: {esc(terms)}.</p>", per)
+
+
+def _per_recording_table(doc: dict, record: dict, what: str, judged: bool = False) -> str:
+    """The table of the ``what`` structure's held-out error per recording (``record``'s
+    ``heldout_per_recording``), those outlying (``outlying_recordings``) said left out of
+    the fit or fitted, as ``doc``'s ``recordings`` mark them (``judged``: and left out of
+    the structure's judgement); empty without."""
+    per = [r for r in record.get("heldout_per_recording") or () if isinstance(r, dict)]
+    if not per:
+        return ""
+    odd = set(record.get("outlying_recordings") or ())
+    recs = _get(doc, "metadata", "recordings") or ()
+    out = {r.get("file") for r in recs if isinstance(r, dict) and r.get("left_out")}
+    cut = {r.get("file") for r in recs if isinstance(r, dict) and r.get("cut_out")}
+
+    def said(name: Any) -> str:
+        if name not in odd:
+            return ""
+        if name in cut:
+            return "outlying: its spans cut out of the fit, the rest fitted"
+        if name in out:
+            return f"outlying: left out of {'the judgement and of ' if judged else ''}the fit"
+        return (
+            f"outlying: {'left out of the judgement, ' if judged else ''}fitted (--keep-outlying)"
+        )
+
+    rows = [
+        [esc(r.get("file", "")), cell(r.get("heldout_error_percent"))]
+        + ([said(r.get("file"))] if odd else [])
+        for r in per
+    ]
+    head = ["recording", "held-out error [%]"] + (["judgement"] if odd else [])
+    return f"<p>Held-out error of the {what} per recording (fitted on the others).</p>" + table(
+        head, rows
+    )
 
 
 def _coefficients_section(doc: dict) -> str:

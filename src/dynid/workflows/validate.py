@@ -963,7 +963,7 @@ def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> 
     if odd := model.info.left_out_of(names):
         warnings.warn(
             f"{', '.join(odd)}: left out of the model's fit as outlying (its held-out error "
-            "far above the other recordings', metadata.selection.outlying_recordings): the "
+            "far above the other recordings', metadata.recordings[].left_out): the "
             "errors below are what it holds beyond the others (a payload, contacts?), not "
             "the model's error on data like its own",
             DynidWarning,
