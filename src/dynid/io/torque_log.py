@@ -457,8 +457,9 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
         hint = _annotated_hint(names) or import_hint(names, path.name)
         time = "t" if "t" in names else time_column(names)
         if not hint and time is not None and (k := position_count(names)):
-            signals = [s for s in ("q", "tau") if f"{s}1" not in names]
-            optional = ["dq"] if "dq1" not in names else []
+            named = {s: all(f"{s}{j}" in names for j in range(1, k + 1)) for s in _SIGNALS}
+            signals = [s for s in ("q", "tau") if not named[s]]  # q0..q6 counts from 0
+            optional = ["dq"] if not named["dq"] else []
             unit = re.search(r"(ms|us|ns)$", time.lower())
             hint = column_hint(names, k, signals, {time}, optional).split("; hint: ", 1)[-1]
             if not signals and time != "t":  # the joints' columns named right, not the time
