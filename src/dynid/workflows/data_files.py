@@ -26,6 +26,7 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
+from .. import _checks
 from ..exceptions import DataError, DynidError, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
@@ -552,6 +553,31 @@ def _read_with(columns: str | None, units: str | None) -> str:
     return ", ".join(given) or "the default column names and units"
 
 
+def _bag_hint(folder: Path) -> str:
+    """``; ...``: the ROS bag a folder is or holds, and the ``dynid import`` that converts
+    it into a torque log; empty when there is none."""
+    stores = sorted(f.name for f in folder.iterdir() if f.suffix.lower() in (".db3", ".mcap"))
+    if (folder / "metadata.yaml").exists() or stores:
+        held = ", ".join(["metadata.yaml"] * (folder / "metadata.yaml").exists() + stores[:3])
+        return (
+            f": it is a ROS 2 bag ({held}); convert it into a torque log with "
+            f"'dynid import {folder.name} --robot ROBOT --out {folder.name}.csv' and give "
+            "that file to --data"
+        )
+    bags = sorted(
+        f.name
+        for f in folder.iterdir()
+        if f.suffix.lower() == ".bag" or (f.is_dir() and (f / "metadata.yaml").exists())
+    )
+    if not bags:
+        return ""
+    return (
+        f": it holds ROS bag(s) {_checks.names(bags[:5])}; convert each into a torque log "
+        f"with 'dynid import {folder.name}/{bags[0]} --robot ROBOT --out {Path(bags[0]).stem}.csv' "
+        "and give those files to --data"
+    )
+
+
 def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
     """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
     and ``.npz`` files in name order (its other files, hidden ones and folders apart,
@@ -569,7 +595,9 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
         if p.is_dir():
             found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
             if not found:
-                raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
+                raise DataError(
+                    f"{p.name}: the folder holds no .csv or .npz data file{_bag_hint(p)}"
+                )
             other = sorted(
                 f.name
                 for f in p.iterdir()
