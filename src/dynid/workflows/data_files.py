@@ -473,16 +473,18 @@ def recorded_columns(
     """The ``--columns`` and ``--units`` to read a log with for a model identified with
     the column map ``recorded`` (its ``info.column_map``): each as given, else as recorded
     (another file may be written in other units or with other names); logged where the
-    recorded one is used or one given differs from it, not where the recorded map is a
-    file's own entries (``rec3.csv:tau6=-1``) naming none of the ``files`` read (nothing
-    of it applies to them)."""
+    recorded one is used (a note when it holds sign flips alone, ``--units tau2=-1``: the
+    arm's convention, which every log of it shares) or one given differs from it, not
+    where the recorded map is a file's own entries (``rec3.csv:tau6=-1``) naming none of
+    the ``files`` read (nothing of it applies to them)."""
     if recorded is None:
         return columns, units
     rec = (recorded.get("columns"), recorded.get("units"))
     given = (columns, units)
     used = tuple(g if g is not None else r for g, r in zip(given, rec, strict=True))
     if used == rec and used != given and _applies(rec, files):
-        _log.warning(
+        _log.log(  # sign flips alone: the arm's own convention, reused as it should be
+            NOTE if rec[0] is None and _signs_only(str(rec[1] or "")) else logging.WARNING,
             "reading the data as the model's data were read (%s); a file of other names or "
             "units is read with its own --columns/--units (%s)",
             _read_with(*used),
@@ -495,6 +497,12 @@ def recorded_columns(
             _read_with(*rec),
         )
     return used[0], used[1]
+
+
+def _signs_only(units: str) -> bool:
+    """True when a ``--units`` text holds sign flips alone (``tau2=-1,rec2.csv:tau=-1``)."""
+    entries = [e.split("=", 1) for e in units.split(",") if e.strip()]
+    return bool(entries) and all(len(e) == 2 and e[1].strip() in ("-1", "1", "+1") for e in entries)
 
 
 def _reads_alike(
