@@ -406,3 +406,38 @@ def test_merged_keep_leaves_the_fingers(tmp_path):
     patch = patch_urdf_inertials(text, chain, base="panda_link0", tip="panda_hand", merged="keep")
     for finger in ("panda_leftfinger", "panda_rightfinger"):
         assert _link_inertial(patch, finger) == _link_inertial(text, finger)
+
+
+def test_a_branch_off_an_earlier_body_keeps_its_inertial():
+    """Only links past the tip are the identified last body's: a slider on link a (moving
+    on its own while the chain is recorded) keeps its inertial, the finger on link b loses
+    its own; Pinocchio's total mass is the identified one plus the slider's."""
+    pin = pytest.importorskip("pinocchio")
+    inertial = '<inertial><mass value="{m}"/><inertia ixx="0.01" iyy="0.01" izz="0.01"/></inertial>'
+    slider = '<limit lower="0" upper="0.1" effort="1" velocity="1"/>'
+    hinge = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    text = f"""<robot name="r">
+  <link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+    <axis xyz="0 0 1"/>{hinge}</joint>
+  <link name="a">{inertial.format(m=2.0)}</link>
+  <joint name="s" type="prismatic"><parent link="a"/><child link="slide"/>
+    <origin xyz="0 0.2 0"/><axis xyz="1 0 0"/>{slider}</joint>
+  <link name="slide">{inertial.format(m=0.5)}</link>
+  <joint name="j2" type="revolute"><parent link="a"/><child link="b"/>
+    <origin xyz="0.5 0 0"/><axis xyz="0 1 0"/>{hinge}</joint>
+  <link name="b">{inertial.format(m=1.0)}</link>
+  <joint name="f" type="prismatic"><parent link="b"/><child link="finger"/>
+    <origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>{slider}</joint>
+  <link name="finger">{inertial.format(m=0.1)}</link>
+</robot>
+"""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        chain = robot_from_urdf_string(text, "base", "b")
+    new = chain.with_params(chain.phi * np.array([[1.2], [1.3]]))
+    out = patch_urdf_inertials(text, new, base="base", tip="b")
+    assert '<link name="slide"><inertial>' in out and '<link name="finger"></link>' in out
+    model = pin.buildModelFromXML(out)
+    total = sum(model.inertias[j].mass for j in range(1, model.njoints))
+    np.testing.assert_allclose(total, new.phi[:, 0].sum() + 0.5, rtol=1e-12)

@@ -21,11 +21,13 @@ hand) into body ``k`` (:mod:`dynid.io.robot.urdf_parse`). Three ways to write bo
   ``phi_k``: for a body identified without them (a Panda identified without its hand,
   exported into the vendor's URDF with the hand).
 
-Links moving below body ``k`` on joints of their own (a gripper's fingers) are not in the
-chain, but a body identified from torques with them on the arm holds them (they moved with
-it, at whatever opening they had). With ``subtract`` and ``move`` their ``<inertial>`` is
-removed, so that the file counts them once and its total mass is the identified one, and a
-note names them; with ``keep`` (a body identified without the hand) they stay.
+Links moving below the last body on joints of their own, past the tip (a gripper's
+fingers), are not in the chain, but a body identified from torques with them on the arm
+holds them (they moved with it, at whatever opening they had). With ``subtract`` and
+``move`` their ``<inertial>`` is removed, so that the file counts them once and its total
+mass is the identified one, and a note names them; with ``keep`` (a body identified
+without the hand) they stay. Branches off earlier bodies (another arm on a torso) move on
+their own and stay.
 
 With ``subtract`` and ``move`` the template read back between the same ``base`` and ``tip``
 gives exactly the robot's ``phi``; with ``keep``, the robot's ``phi`` plus the fixed links'
@@ -267,9 +269,10 @@ def _bodies(
     patched template's chain must read back as (its branches left out, as a reader does).
 
     ``subtract`` and ``move`` take the identified body ``k`` to hold everything that moved
-    with it on the arm: the fixed links merged into it and the branches hanging off it
-    (fingers); the branches' inertials are removed, so that the file counts them once;
-    ``keep`` holds neither."""
+    with it on the arm: the fixed links merged into it and, for the last body, the
+    branches hanging off it past the tip (fingers), whose inertials are removed so that
+    the file counts them once; ``keep`` holds neither. A branch off an earlier body
+    (another arm on a torso) moves on its own while the chain is recorded and stays."""
     new_xml: dict[str, NDArray[np.float64] | None] = {}
     expected = np.array(robot.phi, dtype=float)
     moving = set(chain.link_names[1:])
@@ -291,7 +294,7 @@ def _bodies(
             new_xml.update(dict.fromkeys(fixed))
         else:  # keep: the fixed links stay, the body goes on the moving link
             expected[k - 1] += chain.phi[k - 1] - own
-        if merged != "keep":  # the body holds what moved below it: counted once
+        if merged != "keep" and k == robot.n:  # past the tip (a gripper): counted once
             below = [b for b in branches if _body_of(chain, b.parent) == k]
             carried = [x for b in below for x in b.links if elems[x].find("inertial") is not None]
             new_xml.update(dict.fromkeys(carried))
@@ -307,16 +310,17 @@ def _body_of(chain: Robot, link: str) -> int:
 
 
 def _branches_line(branches: tuple[Branch, ...], chain: Robot, source: str) -> str | None:
-    """The note naming the branches an identified body held, and what was done with them."""
-    held = [b for b in branches if b.mass > 0]
+    """The note naming the branches past the tip the identified last body held, and what
+    was done with them; None when there are none with mass."""
+    held = [b for b in branches if b.mass > 0 and _body_of(chain, b.parent) == chain.n]
     if not held:
         return None
     names = ", ".join(f"{b.links[0]} ({b.mass:.4g} kg, joint {b.joint!r})" for b in held)
-    bodies = sorted({chain.link_names[_body_of(chain, b.parent)] for b in held})
     total = sum(b.mass for b in held)
     return (
-        f"{source}: links moving on joints of their own below the identified "
-        f"{_checks.short(bodies)} written without their inertials ({total:.4g} kg in all: "
+        f"{source}: links moving on joints of their own past the tip, below the identified "
+        f"{_checks.short(chain.link_names[-1])}, written without their inertials "
+        f"({total:.4g} kg in all: "
         f"{names}): the identified body already holds them, as they were on the arm when it "
         "was recorded, so the file counts them once and its total mass is the identified "
         "one; for a body identified without them, --merged keep leaves them as they are"
