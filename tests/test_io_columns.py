@@ -6,6 +6,8 @@ back to them), the closed-form derivative of a sinusoid, the error messages docu
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import pytest
 
@@ -412,6 +414,38 @@ def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
     assert "None" not in caplog.text
     assert "(--units q=deg)" in caplog.text
     assert "with --units tau=Nm; the model's data were read with --units q=deg" in caplog.text
+
+
+def test_the_recorded_sign_flips_reused_are_a_note(caplog):
+    """Regression: validate and payload warned "reading the data as the model's data were
+    read (--units tau2=-1,tau5=-1)", though reusing the arm's sign convention is right; it
+    is a note, while a recorded unit (mN m: a new file in SI would read 1000 x off) and a
+    map given that differs from the recorded one stay warnings."""
+    from dynid.progress import NOTE
+    from dynid.workflows.data_files import recorded_columns
+
+    cases = {
+        "tau2=-1,tau5=-1": NOTE,
+        "rec2.csv:tau=-1,tau3=1": NOTE,
+        "tau=mNm,tau2=-1": logging.WARNING,
+        "tau=-0.001": logging.WARNING,
+    }
+    for units, level in cases.items():
+        caplog.clear()
+        with caplog.at_level(NOTE):
+            assert recorded_columns({"columns": None, "units": units}, None, None) == (
+                None,
+                units,
+            )
+        (record,) = caplog.records
+        assert record.levelno == level and f"(--units {units})" in record.getMessage(), units
+    caplog.clear()
+    with caplog.at_level(NOTE):
+        recorded_columns({"columns": None, "units": "tau2=-1"}, None, "tau2=-1,tau3=-1")
+    (record,) = caplog.records
+    assert record.levelno == logging.WARNING and "the model's data were read with" in (
+        record.getMessage()
+    )
 
 
 def test_a_training_files_own_flips_do_not_make_a_held_out_files_units_differ(caplog):

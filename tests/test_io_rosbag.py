@@ -360,3 +360,50 @@ def test_an_ambiguous_or_missing_match_says_what_to_pass():
         match_joints(("joint1", "joint2"), ["a_joint1", "b_joint1", "joint2"])
     with pytest.raises(DataError, match=r"e.g. --joints A,B$"):
         match_joints(("shoulder", "elbow"), ["A", "B", "C"])
+
+
+def test_a_bag_folder_given_to_data_names_the_import_that_converts_it(
+    tmp_path, capsys, monkeypatch
+):
+    """Regression: identify --data on a ROS 2 bag folder said only "the folder holds no .csv
+    or .npz data file"; it names the bag and the dynid import that converts it, and that
+    command, run as given, writes the log the bag holds."""
+    robot = dynid.panda()
+    log = _small(robot, N=60, seed=9)
+    write_bag(tmp_path / "rec_a", "sqlite3", _shuffled(log, robot, 10))
+    monkeypatch.chdir(tmp_path)
+    assert main(["identify", "--robot", "panda", "--data", "rec_a", "--out", "o"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        "rec_a: the folder holds no .csv or .npz data file: it is a ROS 2 bag (metadata.yaml" in err
+    )
+    command = err.split("'dynid ")[1].split("'")[0].replace("ROBOT", "panda")
+    assert command == "import rec_a --robot panda --out rec_a.csv", err
+    assert main(command.split()) == 0
+    back = load_torque_log(tmp_path / "rec_a.csv")
+    np.testing.assert_array_equal(back.tau, log.tau)
+    np.testing.assert_allclose(back.t, log.t, atol=1e-9)
+
+
+def test_import_labels_the_effort_with_the_drives_unit(tmp_path, capsys):
+    """Regression: dynid import wrote 'tau [N m]' on the units line of motor currents; with
+    a --drive whose effort is current it writes 'tau [A]' (which identify refuses to read
+    without such a drive), and says so; without one 'tau [N m]'."""
+    from dynid.io.torque_log import declared_tau_unit
+
+    robot = dynid.panda()
+    log = _small(robot, N=40, seed=12)
+    write_bag(tmp_path / "b.bag", "ros1", _shuffled(log, robot, 13))
+    drive = tmp_path / "drive.toml"
+    drive.write_text(
+        'schema = "dynid-drive/1"\nside = "joint"\neffort = "current"\n'
+        "gear_ratio = [100, 100, 100, 100, 100, 100, 100]\n"
+        "torque_constant = [0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1]\n"
+    )
+    argv = ["import", str(tmp_path / "b.bag"), "--robot", "panda"]
+    assert main([*argv, "--drive", str(drive), "--out", str(tmp_path / "a.csv")]) == 0
+    assert main([*argv, "--out", str(tmp_path / "t.csv")]) == 0
+    assert declared_tau_unit(tmp_path / "a.csv") == "A"
+    assert declared_tau_unit(tmp_path / "t.csv") == "N m"
+    np.testing.assert_array_equal(load_torque_log(tmp_path / "a.csv").tau, log.tau)
+    assert "tau in A: motor currents" in capsys.readouterr().out

@@ -150,3 +150,48 @@ def test_names_in_messages_are_plain_unless_plain_text_would_garble_them():
     assert names(["tau6", "tau7"]) == "tau6, tau7"
     assert names(["a,b", "tau 6", "x\ny"]) == "'a,b', 'tau 6', 'x\\ny'"
     assert names([f"c{k}" for k in range(10)]) == "c0, c1, c2, c3, c4, c5, c6, c7 and 2 more"
+
+
+def _libfranka(path, seed):
+    """A libfranka-style log (time, q0.., dq0.., tau_J0.., tau_J_d0..: measured and desired
+    torques, joints from 0); its arrays."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(50) / 1000.0
+    q, dq, tau, tau_d = (rng.uniform(-1, 1, (50, N)) for _ in range(4))
+    header = ["time", *_cols("q", 0), *_cols("dq", 0), *_cols("tau_J", 0), *_cols("tau_J_d", 0)]
+    np.savetxt(path, np.column_stack([t, q, dq, tau, tau_d]), delimiter=",",
+               header=",".join(header), comments="", fmt="%.17g")  # fmt: skip
+    return {"t": t, "q": q, "dq": dq, "tau": tau}
+
+
+def test_a_libfranka_header_gets_the_whole_map_with_the_measured_torques(tmp_path):
+    """Regression: time, q0.., dq0.., tau_J0.., tau_J_d0.. gave --columns
+    't=time,tau=tau_J{i0}' (q1..q6 are there, so q and dq were taken as named right), and
+    the next run failed on q7; the hint maps all four, the measured torques tau_J (not the
+    desired tau_J_d), and reads the values written."""
+    path = tmp_path / "franka.csv"
+    arrays = _libfranka(path, seed=6)
+    with pytest.raises(DataError, match="header must name columns") as err:
+        load_torque_log(path)
+    spec = str(err.value).split("--columns '")[1].split("'")[0]
+    assert spec == "t=time,q=q{i0},dq=dq{i0},tau=tau_J{i0}", str(err.value)
+    log = load_mapped_torque_log(path, parse_column_map(spec)).log
+    for k in ("t", "q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(log, k), arrays[k])
+
+
+def test_a_map_that_counts_the_joints_from_1_gets_the_map_from_0(tmp_path):
+    """Regression: --columns 't=time,tau=tau_J{i0}' on q0..q6 said only "missing column(s)
+    q7 for 'q'"; the error now gives the whole map with q and dq counted from 0, which
+    reads the values written."""
+    path = tmp_path / "franka.csv"
+    arrays = _libfranka(path, seed=7)
+    with pytest.raises(DataError, match=r"missing column\(s\) q7") as err:
+        load_mapped_torque_log(path, parse_column_map("t=time,tau=tau_J{i0}"), n=N)
+    said = str(err.value)
+    assert "hint: the file numbers the joints from 0: --columns " in said, said
+    spec = said.split("--columns '")[1].split("'")[0]
+    assert spec == "t=time,q=q{i0},dq=dq{i0},tau=tau_J{i0}", said
+    log = load_mapped_torque_log(path, parse_column_map(spec)).log
+    for k in ("q", "dq", "tau"):
+        np.testing.assert_array_equal(getattr(log, k), arrays[k])

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import logging
 import warnings
 
 import numpy as np
@@ -17,6 +16,7 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning
 from dynid.io.torque_log import save_torque_log
+from dynid.progress import NOTE
 from dynid.simulation.measurement import SensorNoise
 from dynid.workflows.validate import ValidateOptions, validate_files
 
@@ -135,12 +135,15 @@ def test_a_model_identified_with_a_files_own_flip_validates_other_files(panda_lo
         model = identify_files(robot, [d / "a.csv", d / "flip.csv"], opts).model
     for name in ("a.csv", "flip.csv"):
         caplog.clear()
-        with caplog.at_level(logging.WARNING):
+        with caplog.at_level(NOTE):
             result, said = _validate(model, d / name)
         assert not any("opposite" in s for s in said), said
         np.testing.assert_allclose(result.validation.errors.rms, NOISE, rtol=0.25)
         # the recorded entry is said where it applies, not on another file
-        told = any("as the model's data were read" in r.getMessage() for r in caplog.records)
+        told = any(
+            "as the model's data were read" in r.getMessage() and r.levelno == NOTE
+            for r in caplog.records
+        )
         assert told is (name == "flip.csv")
 
 

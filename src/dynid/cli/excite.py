@@ -166,7 +166,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--criterion", choices=("cond", "logdet"), default=d.criterion)
     p.add_argument("--max-iter", type=int, default=d.max_iter, help="optimiser iterations (60)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--no-figure", action="store_true", help="do not write excitation.png")
+    p.add_argument(
+        "--no-figures",
+        "--no-figure",
+        dest="no_figure",
+        action="store_true",
+        help="do not write excitation.png",
+    )
     p.add_argument("--out", type=output_path, required=True, help="output folder")
     return p
 

@@ -15,7 +15,11 @@ inertials and the moving link gets the rest of the identified body (--merged sub
 default: the body was identified with them); they keep their inertials and the moving link
 gets the whole identified body (--merged keep: identified without them, such as a Panda
 identified without its hand exported into the vendor's URDF with the hand); or the moving
-link gets the whole body and they lose their inertials (--merged move).
+link gets the whole body and they lose their inertials (--merged move). Links moving on
+joints of their own past the tip (a gripper's fingers) were on the arm when it was
+recorded, so the identified last body holds them: with subtract and move their inertials
+are removed (a note names them; the file's total mass is the identified one); with keep
+they stay.
 
 MJCF (MuJoCo): bodies, hinge/slide joints with ranges, full inertials, gravity, motors, and
 the friction as frictionloss + damping: the linear friction a consistent identification

@@ -14,7 +14,10 @@ said so), in seconds from the first message, read to the nanosecond. Messages on
 topics, missing joints or fields, NaN, out-of-order and repeated stamps are handled and
 counted. Without velocities in the recording the log holds positions and torques only
 (said so): every command derives the velocities from the positions at its own cut-off,
-and none takes them for measured ones.
+and none takes them for measured ones. A JointState's effort is whatever its driver puts
+there: with a --drive whose effort is "current" the log's units line gives the tau columns
+as motor currents (tau [A]), which identify and validate then read through that drive;
+without one, as joint torques (tau [N m]).
 
 Writes the torque log (--out .csv or .npz) that identify, friction and validate read.
 
@@ -34,7 +37,14 @@ from ..io.joint_states import JointStateImport
 from ..io.ros_recordings import load_joint_state_recording
 from ..io.torque_log import save_torque_log
 from .applies import urdf_chain
-from .common import add_robot_options, add_subcommand, load_robot, output_path
+from .common import (
+    add_drive_option,
+    add_robot_options,
+    add_subcommand,
+    load_drive_arg,
+    load_robot,
+    output_path,
+)
 from .console import Console
 
 NAME = "import"
@@ -67,6 +77,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="JointState topic (of a bag or a PlotJuggler export; default /joint_states)",
     )
     add_robot_options(p)
+    add_drive_option(p)
     p.add_argument(
         "--joints",
         default=None,
@@ -81,20 +92,26 @@ def run(args: argparse.Namespace, console: Console) -> int:
     robot = load_robot(args)
     joints = None if args.joints is None else [s.strip() for s in args.joints.split(",")]
     res = load_joint_state_recording(args.bag, robot.joint_names, topic=args.topic, joints=joints)
-    path = save_torque_log(args.out, res.log)
+    drive = load_drive_arg(args, robot.n)
+    unit = "N m" if drive is None else drive.effort_unit
+    path = save_torque_log(args.out, res.log, tau_unit=unit)
     if args.json:
-        console.json(_summary(args.bag, res, robot.joint_names, path))
+        console.json(_summary(args.bag, res, robot.joint_names, path, unit))
         return 0
-    print_import(console, res, robot.joint_names, path)
+    print_import(console, res, robot.joint_names, path, unit)
     return 0
 
 
-def _summary(bag: Path, res: JointStateImport, names: Sequence[str], path: Path) -> dict[str, Any]:
-    """What ``--json`` prints: the bag, the topic, the log written and what the reading found."""
+def _summary(
+    bag: Path, res: JointStateImport, names: Sequence[str], path: Path, tau_unit: str
+) -> dict[str, Any]:
+    """What ``--json`` prints: the bag, the topic, the log written (its ``tau`` columns'
+    unit) and what the reading found."""
     return {
         "bag": str(bag.name),
         "topic": res.topic,
         "out": str(path),
+        "tau_unit": tau_unit,
         "samples": res.log.n_samples,
         "duration_s": res.log.duration,
         "sample_rate_hz": res.log.sample_rate,
@@ -113,8 +130,15 @@ def _summary(bag: Path, res: JointStateImport, names: Sequence[str], path: Path)
     }
 
 
-def print_import(console: Console, res: JointStateImport, names: Sequence[str], path: Path) -> None:
-    """Samples, duration and rate, the time source, the joint map, the notes, the file."""
+def print_import(
+    console: Console,
+    res: JointStateImport,
+    names: Sequence[str],
+    path: Path,
+    tau_unit: str = "N m",
+) -> None:
+    """Samples, duration and rate, the time source, the joint map, the notes, the file
+    (with its torques' unit when they are motor currents)."""
     console.print(
         f"{res.log.n_samples} samples, {res.log.duration:.3f} s at "
         f"{res.log.sample_rate:.1f} Hz from {res.n_messages} messages on {res.topic}; "
@@ -130,4 +154,5 @@ def print_import(console: Console, res: JointStateImport, names: Sequence[str], 
         console.print(f"  {rj} <- {bj}")
     for note in res.notes:
         console.print(f"note: {note}")
-    console.print(f"wrote {path}")
+    currents = " (tau in A: motor currents, as the drive's effort is current)"
+    console.print(f"wrote {path}" + (currents if tau_unit == "A" else ""))

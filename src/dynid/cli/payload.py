@@ -163,6 +163,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_drive_option(p)
     add_q_start_option(p)
     add_log_options(p)
+    p.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="accepted as every command with an output folder accepts it; payload writes "
+        "no figures",
+    )
     p.add_argument("--out", type=output_path, required=True, help="output folder")
     return p
 

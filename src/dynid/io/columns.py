@@ -574,7 +574,8 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
         return None
     if missing:
         raise DataError(
-            f"missing column(s) {_checks.names(missing)} for {quantity!r} ({tpl!r})",
+            f"missing column(s) {_checks.names(missing)} for {quantity!r} ({tpl!r})"
+            + _recount_hint(table, cmap, n),
             file=table.name,
         )
     group = table.groups.get(quantity)
@@ -585,6 +586,26 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
     else:
         a = np.stack([table.columns[c] for c in names], axis=1) * f
     return _flipped(a, cmap, quantity, table.name)
+
+
+def _recount_hint(table: _Table, cmap: ColumnMap, n: int) -> str:
+    """``; hint: --columns '...'``: the whole map, with each joint quantity whose columns
+    are there numbered the other way (``q0..q6`` for ``q{i}``: ``q=q{i0}``); empty when
+    none is."""
+    spec = dict(cmap.columns)
+    for quantity in ("q", "dq", "tau", "ddq"):
+        tpl = cmap.template(quantity)
+        other = tpl.replace("{i}", "{i0}") if "{i}" in tpl else tpl.replace("{i0}", "{i}")
+        if other == tpl or "{j" in tpl:
+            continue
+        have = [_fill(tpl, i) in table.columns for i in range(n)]
+        if not all(have) and all(_fill(other, i) in table.columns for i in range(n)):
+            spec[quantity] = other
+    if spec == dict(cmap.columns):
+        return ""
+    text = ",".join(f"{k}={spec[k]}" for k in _DEFAULT if k in spec)
+    first = 0 if any("{i0}" in spec[k] and spec[k] != cmap.columns.get(k) for k in spec) else 1
+    return f"; hint: the file numbers the joints from {first}: --columns '{text}' reads them"
 
 
 def _flipped(a: NDArray, cmap: ColumnMap, quantity: str, name: str) -> NDArray:

@@ -114,12 +114,14 @@ def torque_log_columns(n: int, *, with_ddq: bool = False, with_dq: bool = True) 
     return cols
 
 
-def save_torque_log(path: str | Path, log: TorqueLog) -> Path:
+def save_torque_log(path: str | Path, log: TorqueLog, *, tau_unit: str = "N m") -> Path:
     """Write ``log`` to ``path`` (``.csv`` or ``.npz``, by suffix); returns the path.
 
     A log whose velocities were derived from its positions (``log.dq_derived``) is written
     without them, positions and torques only: a reader derives them again at its own
-    cut-off (every command does), never taking them for measured ones.
+    cut-off (every command does), never taking them for measured ones. ``tau_unit``: the
+    unit a CSV's units line gives the ``tau`` columns (``"N m"``, or ``"A"`` for motor
+    currents, :attr:`~dynid.model.drive.Drive.effort_unit`).
 
     Raises
     ------
@@ -133,6 +135,7 @@ def save_torque_log(path: str | Path, log: TorqueLog) -> Path:
         n_rows=log.n_samples,
         with_ddq=log.ddq is not None,
         with_dq=not log.dq_derived,
+        tau_unit=tau_unit,
     )
 
 
@@ -457,8 +460,9 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
         hint = _annotated_hint(names) or import_hint(names, path.name)
         time = "t" if "t" in names else time_column(names)
         if not hint and time is not None and (k := position_count(names)):
-            signals = [s for s in ("q", "tau") if f"{s}1" not in names]
-            optional = ["dq"] if "dq1" not in names else []
+            named = {s: all(f"{s}{j}" in names for j in range(1, k + 1)) for s in _SIGNALS}
+            signals = [s for s in ("q", "tau") if not named[s]]  # q0..q6 counts from 0
+            optional = ["dq"] if not named["dq"] else []
             unit = re.search(r"(ms|us|ns)$", time.lower())
             hint = column_hint(names, k, signals, {time}, optional).split("; hint: ", 1)[-1]
             if not signals and time != "t":  # the joints' columns named right, not the time

@@ -26,6 +26,7 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
+from .. import _checks
 from ..exceptions import DataError, DynidError, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
@@ -472,16 +473,18 @@ def recorded_columns(
     """The ``--columns`` and ``--units`` to read a log with for a model identified with
     the column map ``recorded`` (its ``info.column_map``): each as given, else as recorded
     (another file may be written in other units or with other names); logged where the
-    recorded one is used or one given differs from it, not where the recorded map is a
-    file's own entries (``rec3.csv:tau6=-1``) naming none of the ``files`` read (nothing
-    of it applies to them)."""
+    recorded one is used (a note when it holds sign flips alone, ``--units tau2=-1``: the
+    arm's convention, which every log of it shares) or one given differs from it, not
+    where the recorded map is a file's own entries (``rec3.csv:tau6=-1``) naming none of
+    the ``files`` read (nothing of it applies to them)."""
     if recorded is None:
         return columns, units
     rec = (recorded.get("columns"), recorded.get("units"))
     given = (columns, units)
     used = tuple(g if g is not None else r for g, r in zip(given, rec, strict=True))
     if used == rec and used != given and _applies(rec, files):
-        _log.warning(
+        _log.log(  # sign flips alone: the arm's own convention, reused as it should be
+            NOTE if rec[0] is None and _signs_only(str(rec[1] or "")) else logging.WARNING,
             "reading the data as the model's data were read (%s); a file of other names or "
             "units is read with its own --columns/--units (%s)",
             _read_with(*used),
@@ -494,6 +497,12 @@ def recorded_columns(
             _read_with(*rec),
         )
     return used[0], used[1]
+
+
+def _signs_only(units: str) -> bool:
+    """True when a ``--units`` text holds sign flips alone (``tau2=-1,rec2.csv:tau=-1``)."""
+    entries = [e.split("=", 1) for e in units.split(",") if e.strip()]
+    return bool(entries) and all(len(e) == 2 and e[1].strip() in ("-1", "1", "+1") for e in entries)
 
 
 def _reads_alike(
@@ -552,6 +561,31 @@ def _read_with(columns: str | None, units: str | None) -> str:
     return ", ".join(given) or "the default column names and units"
 
 
+def _bag_hint(folder: Path) -> str:
+    """``; ...``: the ROS bag a folder is or holds, and the ``dynid import`` that converts
+    it into a torque log; empty when there is none."""
+    stores = sorted(f.name for f in folder.iterdir() if f.suffix.lower() in (".db3", ".mcap"))
+    if (folder / "metadata.yaml").exists() or stores:
+        held = ", ".join(["metadata.yaml"] * (folder / "metadata.yaml").exists() + stores[:3])
+        return (
+            f": it is a ROS 2 bag ({held}); convert it into a torque log with "
+            f"'dynid import {folder.name} --robot ROBOT --out {folder.name}.csv' and give "
+            "that file to --data"
+        )
+    bags = sorted(
+        f.name
+        for f in folder.iterdir()
+        if f.suffix.lower() == ".bag" or (f.is_dir() and (f / "metadata.yaml").exists())
+    )
+    if not bags:
+        return ""
+    return (
+        f": it holds ROS bag(s) {_checks.names(bags[:5])}; convert each into a torque log "
+        f"with 'dynid import {folder.name}/{bags[0]} --robot ROBOT --out {Path(bags[0]).stem}.csv' "
+        "and give those files to --data"
+    )
+
+
 def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
     """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
     and ``.npz`` files in name order (its other files, hidden ones and folders apart,
@@ -569,7 +603,9 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
         if p.is_dir():
             found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
             if not found:
-                raise DataError(f"{p.name}: the folder holds no .csv or .npz data file")
+                raise DataError(
+                    f"{p.name}: the folder holds no .csv or .npz data file{_bag_hint(p)}"
+                )
             other = sorted(
                 f.name
                 for f in p.iterdir()

@@ -82,7 +82,7 @@ from .urdf_tree import (
     _subtree_leaves,
 )
 
-__all__ = ["load_urdf", "robot_from_urdf_string"]
+__all__ = ["chain_with_branches", "load_urdf", "robot_from_urdf_string"]
 
 _log = logging.getLogger(__name__)
 
@@ -267,6 +267,37 @@ def robot_from_urdf_string(
         rounding is a note, as are angles snapped).
     """
     return _robot_from_text(text, base_link, tip_link, source, snap_angles, note_angles)
+
+
+def chain_with_branches(
+    text: str | bytes,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    *,
+    source: str = "URDF text",
+) -> tuple[Robot, OffChain]:
+    """The chain (angles as written, nothing said) and what it leaves out or merges.
+
+    Parameters
+    ----------
+    text, base_link, tip_link, source
+        As :func:`robot_from_urdf_string`.
+
+    Returns
+    -------
+    robot : Robot
+        The chain, read as :func:`robot_from_urdf_string` reads it.
+    off : OffChain
+        The branches left out (links hanging off a moving body through moving joints:
+        fingers) and the fixed links merged
+        (:func:`~dynid.io.robot.urdf_branches.off_chain`).
+
+    Raises
+    ------
+    ModelError, UnknownNameError
+        As :func:`robot_from_urdf_string`.
+    """
+    return _read_chain(text, base_link, tip_link, source, AngleRounding())
 
 
 def _chain_ends(

@@ -12,20 +12,28 @@ hand) into body ``k`` (:mod:`dynid.io.robot.urdf_parse`). Three ways to write bo
 * ``merged="subtract"`` (default): the fixed links keep their inertials and the moving
   link gets the rest, ``phi_k - sum(phi_fixed)``. When that rest is not physically
   consistent (a positive mass, positive principal moments meeting the triangle
-  inequality) the identified body did not hold those fixed links (a link 7 identified
-  without the hand), and nothing is written: a :class:`~dynid.exceptions.ModelError`
-  names the link, the fixed links and the other two policies;
+  inequality) nothing is written: a :class:`~dynid.exceptions.ModelError` names the link,
+  the fixed links, both masses and the other two policies, each with the recording it
+  fits (the arm recorded with them: ``move``; without them: ``keep``);
 * ``merged="move"``: the moving link gets all of ``phi_k`` and the ``<inertial>`` of each
   fixed link merged into body ``k`` is removed;
 * ``merged="keep"``: the fixed links keep their inertials and the moving link gets all of
   ``phi_k``: for a body identified without them (a Panda identified without its hand,
   exported into the vendor's URDF with the hand).
 
+Links moving below the last body on joints of their own, past the tip (a gripper's
+fingers), are not in the chain, but a body identified from torques with them on the arm
+holds them (they moved with it, at whatever opening they had). With ``subtract`` and
+``move`` their ``<inertial>`` is removed, so that the file counts them once and its total
+mass is the identified one, and a note names them; with ``keep`` (a body identified
+without the hand) they stay. Branches off earlier bodies (another arm on a torso) move on
+their own and stay.
+
 With ``subtract`` and ``move`` the template read back between the same ``base`` and ``tip``
 gives exactly the robot's ``phi``; with ``keep``, the robot's ``phi`` plus the fixed links'
 (checked before returning). A fixed link of negative mass merged into a body is refused
-(the template is wrong). Links fixed to the base, and links reached through joints off the
-chain (fingers), are left as they are.
+(the template is wrong). Links fixed to the base, and links reached through joints off
+the chain from the base, are left as they are.
 
 Inertials are written as ``<origin xyz="c" rpy="0 0 0"/>`` (CoM in the link frame [m]),
 ``<mass>`` [kg] and ``<inertia>`` about the CoM in link axes [kg m^2].
@@ -40,6 +48,7 @@ its two attributes set to 0 when it holds others); every other byte is kept.
 from __future__ import annotations
 
 import html
+import logging
 import re
 import warnings
 import xml.etree.ElementTree as ET
@@ -51,7 +60,9 @@ from ... import _checks, spatial
 from ...exceptions import DynidWarning, ModelError
 from ...model.inertia import inertia6_from_matrix, inertial_from_phi, phi_from_inertial
 from ...model.robot import Robot
-from .urdf_parse import robot_from_urdf_string
+from ...progress import NOTE
+from .urdf_branches import Branch
+from .urdf_parse import chain_with_branches, robot_from_urdf_string
 
 __all__ = ["MERGED_POLICIES", "patch_urdf_dynamics", "patch_urdf_inertials"]
 
@@ -63,6 +74,7 @@ _COMMENT = re.compile(r"<!--.*?-->", re.S)
 _JOINT = re.compile(r"<joint\b[^>]*?\bname\s*=\s*([\"'])(.*?)\1[^>]*?(/?)>", re.S)
 _DYNAMICS = re.compile(r"<dynamics\b[^>]*?/>|<dynamics\b[^>]*?>.*?</dynamics>", re.S)
 _FRICTION_ATTR = re.compile(r"\s+(damping|friction)\s*=\s*([\"']).*?\2", re.S)
+_log = logging.getLogger(__name__)
 _ATTRS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
@@ -195,33 +207,12 @@ def patch_urdf_inertials(
         raise ModelError(f"merged must be one of {MERGED_POLICIES}; got {merged!r}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)  # the template's own inertials
-        chain = robot_from_urdf_string(template, base, tip, source=source, note_angles=False)
+        chain, off = chain_with_branches(template, base, tip, source=source)
     _check_same_chain(robot, chain, source)
     root = ET.fromstring(template)
     elems = {el.get("name"): el for el in root if el.tag.rsplit("}", 1)[-1] == "link"}
     spans = _link_spans(template, [el.get("name", "") for el in root.iter("link")])
-    moving = set(chain.link_names[1:])
-    new_xml: dict[str, NDArray[np.float64] | None] = {}  # link -> phi, None: remove
-    expected = np.array(robot.phi, dtype=float)  # what the patched template must read back as
-    for k in range(1, robot.n + 1):
-        link = chain.link_names[k]
-        own = _own_phi(elems[link])
-        fixed = [
-            name
-            for name, fr in chain.frames.items()
-            if fr.link == k and name in elems and name not in moving
-            and elems[name].find("inertial") is not None
-        ]  # fmt: skip
-        _check_masses(fixed, elems, source)
-        phi: NDArray[np.float64] = np.array(robot.phi[k - 1])
-        if merged == "subtract":
-            phi = robot.phi[k - 1] - (chain.phi[k - 1] - own)
-            _check_consistent(link, phi, fixed, source)
-        elif merged == "move":
-            new_xml.update(dict.fromkeys(fixed))
-        else:  # keep: the fixed links stay, the body goes on the moving link
-            expected[k - 1] += chain.phi[k - 1] - own
-        new_xml[link] = phi
+    new_xml, expected = _bodies(robot, chain, off.branches, elems, merged, source)
     edits: list[tuple[int, int, str]] = []
     for link, new in new_xml.items():
         start, open_end, end, closed = spans[link]
@@ -261,7 +252,79 @@ def patch_urdf_inertials(
     scale = max(float(np.max(np.abs(expected))), 1e-300)
     if not np.allclose(back.phi, expected, rtol=1e-9, atol=1e-12 * scale):
         raise ModelError("the patched inertials do not read back as the robot's", file=source)
+    if merged != "keep" and (said := _branches_line(off.branches, chain, source)):
+        _log.log(NOTE, "%s", said)
     return out
+
+
+def _bodies(
+    robot: Robot,
+    chain: Robot,
+    branches: tuple[Branch, ...],
+    elems: dict,
+    merged: str,
+    source: str,
+) -> tuple[dict[str, NDArray[np.float64] | None], NDArray[np.float64]]:
+    """The inertials to write (link -> phi (10,), None: remove) and the ``phi`` (n, 10) the
+    patched template's chain must read back as (its branches left out, as a reader does).
+
+    ``subtract`` and ``move`` take the identified body ``k`` to hold everything that moved
+    with it on the arm: the fixed links merged into it and, for the last body, the
+    branches hanging off it past the tip (fingers), whose inertials are removed so that
+    the file counts them once; ``keep`` holds neither. A branch off an earlier body
+    (another arm on a torso) moves on its own while the chain is recorded and stays."""
+    new_xml: dict[str, NDArray[np.float64] | None] = {}
+    expected = np.array(robot.phi, dtype=float)
+    moving = set(chain.link_names[1:])
+    for k in range(1, robot.n + 1):
+        link = chain.link_names[k]
+        own = _own_phi(elems[link])
+        fixed = [
+            name
+            for name, fr in chain.frames.items()
+            if fr.link == k and name in elems and name not in moving
+            and elems[name].find("inertial") is not None
+        ]  # fmt: skip
+        _check_masses(fixed, elems, source)
+        phi: NDArray[np.float64] = np.array(robot.phi[k - 1])
+        if merged == "subtract":
+            phi = robot.phi[k - 1] - (chain.phi[k - 1] - own)
+            _check_consistent(link, phi, fixed, robot.phi[k - 1], source)
+        elif merged == "move":
+            new_xml.update(dict.fromkeys(fixed))
+        else:  # keep: the fixed links stay, the body goes on the moving link
+            expected[k - 1] += chain.phi[k - 1] - own
+        if merged != "keep" and k == robot.n:  # past the tip (a gripper): counted once
+            below = [b for b in branches if _body_of(chain, b.parent) == k]
+            carried = [x for b in below for x in b.links if elems[x].find("inertial") is not None]
+            new_xml.update(dict.fromkeys(carried))
+        new_xml[link] = phi
+    return new_xml, expected
+
+
+def _body_of(chain: Robot, link: str) -> int:
+    """The body (0 the base) that a link of the chain or fixed to it moves with."""
+    if link in chain.link_names:
+        return chain.link_names.index(link)
+    return chain.frames[link].link
+
+
+def _branches_line(branches: tuple[Branch, ...], chain: Robot, source: str) -> str | None:
+    """The note naming the branches past the tip the identified last body held, and what
+    was done with them; None when there are none with mass."""
+    held = [b for b in branches if b.mass > 0 and _body_of(chain, b.parent) == chain.n]
+    if not held:
+        return None
+    names = ", ".join(f"{b.links[0]} ({b.mass:.4g} kg, joint {b.joint!r})" for b in held)
+    total = sum(b.mass for b in held)
+    return (
+        f"{source}: links moving on joints of their own past the tip, below the identified "
+        f"{_checks.short(chain.link_names[-1])}, written without their inertials "
+        f"({total:.4g} kg in all: "
+        f"{names}): the identified body already holds them, as they were on the arm when it "
+        "was recorded, so the file counts them once and its total mass is the identified "
+        "one; for a body identified without them, --merged keep leaves them as they are"
+    )
 
 
 def _indent_step(indent: str, link_indent: str) -> str:
@@ -269,20 +332,32 @@ def _indent_step(indent: str, link_indent: str) -> str:
     return step or "  "
 
 
-def _check_consistent(link: str, phi: NDArray[np.float64], fixed: list[str], source: str) -> None:
-    """Raise when the rest of body ``link`` after subtracting ``fixed`` is not a body."""
+def _check_consistent(
+    link: str,
+    phi: NDArray[np.float64],
+    fixed: list[str],
+    identified: NDArray[np.float64],
+    source: str,
+) -> None:
+    """Raise when the rest of body ``link`` after subtracting its ``fixed`` links is not a
+    body; the message gives both masses and the remedy for each way the arm was recorded."""
     m, _, I = inertial_from_phi(phi)
     lam = np.linalg.eigvalsh(I)
     if m > 0 and lam[0] >= 0 and lam[0] + lam[1] >= lam[2]:
         return
+    them = float(identified[0] - m)
+    hint = (
+        f"the identified body is {float(identified[0]):.6g} kg, they are {them:.6g} kg; if "
+        "the arm was recorded with them on it (the identified body holds them), export with "
+        "--merged move (the whole identified body on the moving link, the fixed links' "
+        "inertials removed); if it was recorded without them, with --merged keep (the "
+        "template's links stay as they are, the identified body goes on the moving link)"
+    )
     raise ModelError(
         f"link {_checks.short(link)}: the identified body minus the template's "
         f"fixed links {_checks.short(fixed)} is not physically consistent (mass "
         f"{float(m):.6g} kg, principal moments {[float(f'{x:.4g}') for x in lam]} kg m^2), "
-        "so --merged subtract cannot split it: if the identified data did not include those "
-        "bodies, export with --merged keep (the template's fixed links stay as they are, the "
-        "identified body goes on the moving link); with --merged move the whole body goes on "
-        "the moving link and the fixed links lose their inertials",
+        f"so --merged subtract cannot split it: {hint}",
         file=source,
     )
 
