@@ -8,16 +8,26 @@ the log to its noise. Only something outside the log tells: the robot descriptio
 masses. Its gravity torques at the logged configurations ``g_d(q)`` against the identified
 model's ``g_m(q)``, per joint that gravity loads
 (:func:`~dynid.identification.model_sign.gravity_loaded`): the least-squares factor ``r_j`` of
-``g_m ~ r_j g_d``. A description's masses are off
-joint by joint (a cable, a motor left out of the CAD); a factor that is the same on every
-loaded joint (within :data:`UNIFORM`) and at least :data:`OFF` away from 1, with the
-shapes agreeing (correlation at least :data:`SHAPE`), is a scale: the finding names it and
-what to change, for the user to judge (the description may be uniformly off instead).
+``g_m ~ r_j g_d``, linear in the identified base parameters, so that the fit's parameter
+covariance gives theirs (:func:`gravity_ratio_covariance`). A factor at least :data:`OFF`
+away from 1 on average (``1 + OFF`` or more, or its inverse or less), with the shapes
+agreeing (correlation at least :data:`SHAPE`), is judged against one factor on every
+joint: the factors' chi-square about their weighted common factor, over their covariance
+plus :data:`DESCRIBED` of the factor per joint (the error even a good description's masses
+keep). Within :data:`LEVEL` of the chi-square's tail, and within :data:`UNIFORM` of their
+mean, it is a scale (a sensor's, a torque constant's): the finding
+(:func:`gravity_scale_words`) names it with its standard deviation and what to change, for
+the user to judge (the description may be uniformly off instead). Factors that differ by
+more are the description's masses, off joint by joint (a cable, a motor left out of the
+CAD, a URDF's inertials not its arm's), where a torque scale is one factor on every joint:
+the model, fitted to the torques as logged, is right as it is, and a note says so
+(:func:`gravity_masses_words`), offering no scale.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,15 +35,21 @@ from numpy.typing import NDArray
 from ..dynamics.terms import gravity_torques
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..regressors.torque import torque_regressor
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded
 
 __all__ = [
+    "DESCRIBED",
     "GRAVITY_SCALE",
+    "GravityRatios",
+    "LEVEL",
     "OFF",
     "SHAPE",
     "UNIFORM",
     "at_the_motors",
+    "gravity_masses_words",
+    "gravity_ratio_covariance",
     "gravity_ratios",
     "gravity_scale_factor",
     "gravity_scale_finding",
@@ -41,12 +57,18 @@ __all__ = [
     "recorded_scale",
 ]
 
-#: Relative distance from 1 of the common factor that makes a finding.
+#: Relative distance from 1 of the common factor that makes a finding (above ``1 + OFF`` or
+#: below its inverse: a factor and its inverse alike).
 OFF = 0.10
 #: Largest relative spread of the loaded joints' factors about their mean for "the same".
 UNIFORM = 0.05
 #: Smallest correlation of a loaded joint's identified and described gravity torques.
 SHAPE = 0.98
+#: Relative standard deviation [-] of a joint's factor added to the fit's: the error of a
+#: description's masses even a good one keeps (a scale is named through it): 0.5 %.
+DESCRIBED = 0.005
+#: Chi-square tail probability below which the joints' factors are not one factor.
+LEVEL = 1e-3
 #: Configurations used at most (spread over the logs).
 _SAMPLES = 2_000
 #: The key of an identified model's metadata that records the finding (``factor`` [-] and
@@ -89,13 +111,96 @@ def gravity_ratios(
     return r, c, loaded
 
 
+@dataclass(frozen=True)
+class GravityRatios:
+    """The identified model's gravity torques over the description's, per loaded joint,
+    judged against one factor on every joint (module docstring).
+
+    Attributes
+    ----------
+    factor : float
+        The common factor [-], weighted by the joints' covariance (plus :data:`DESCRIBED`).
+    factor_std : float
+        Its standard deviation [-] from the fit's parameter covariance; NaN without one.
+    ratios : ndarray, shape (n,)
+        Each joint's factor [-]; NaN on the joints gravity does not load.
+    ratio_std : ndarray, shape (n,)
+        Their standard deviations [-] from the fit's covariance; NaN without one, and off
+        the loaded joints.
+    joints : ndarray of int
+        The loaded joints (from 0).
+    chi2 : float
+        The ratios' chi-square about ``factor`` (``len(joints) - 1`` degrees of freedom).
+    one_factor : bool
+        Whether they are one factor: chi-square within :data:`LEVEL`, spread within
+        :data:`UNIFORM`.
+    """
+
+    factor: float
+    factor_std: float
+    ratios: NDArray[np.float64]
+    ratio_std: NDArray[np.float64]
+    joints: NDArray[np.intp]
+    chi2: float
+    one_factor: bool
+
+
+def gravity_ratio_covariance(
+    model: IdentifiedModel, q: NDArray[np.float64], gd: NDArray[np.float64], js: NDArray[np.intp]
+) -> NDArray[np.float64] | None:
+    """The covariance (k, k) [-] of the loaded joints' ``js`` (k,) factors
+    (:func:`gravity_ratios`) at the configurations ``q`` (N, n) [rad], the description's
+    gravity torques there ``gd`` (N, n) [N m]: each factor is ``a_j . beta`` with ``a_j =
+    g_d,j^T Y_g,j / |g_d,j|^2`` (``Y_g``: the gravity rows of the base regressor), so its
+    covariance is ``A Sigma A^T`` over the fit's (``Sigma``); None without it."""
+    cov = model.fit.covariance
+    if cov is None:
+        return None
+    robot = model.robot
+    Y = torque_regressor(robot, q, np.zeros_like(q), np.zeros_like(q))  # (N, n, 10 n)
+    ind = np.asarray(model.base.independent)
+    links = ind < 10 * robot.n  # the base's rotor inertias carry no gravity
+    A = np.zeros((js.size, ind.size))
+    for i, j in enumerate(js):
+        d = gd[:, j]
+        A[i, links] = d @ Y[:, j, ind[links]] / (d @ d)
+    return A @ np.asarray(cov, dtype=np.float64) @ A.T
+
+
+def _one_factor(
+    r: NDArray[np.float64], C: NDArray[np.float64] | None
+) -> tuple[float, float, float, bool]:
+    """The common factor of the ratios ``r`` (k,) [-] of covariance ``C`` (k, k) (None:
+    unknown, :data:`DESCRIBED` alone), its standard deviation from ``C`` (NaN without),
+    their chi-square about it, and whether they are one factor (module docstring)."""
+    import scipy.linalg  # here: the command's start loads no scipy
+    import scipy.stats
+
+    k = r.size
+    known = np.zeros((k, k)) if C is None else C
+    ceff = known + (DESCRIBED * float(np.mean(r))) ** 2 * np.eye(k)
+    fac = scipy.linalg.cho_factor(ceff)
+    w = scipy.linalg.cho_solve(fac, np.ones(k))
+    w = w / w.sum()
+    factor = float(w @ r)
+    d = r - factor
+    chi2 = float(d @ scipy.linalg.cho_solve(fac, d))
+    std = float(np.sqrt(max(w @ known @ w, 0.0))) if C is not None else float("nan")
+    agree = chi2 <= scipy.stats.chi2.isf(LEVEL, k - 1) and np.max(np.abs(r - np.mean(r))) <= (
+        UNIFORM * np.mean(r)
+    )
+    return factor, std, chi2, bool(agree)
+
+
 def gravity_scale_factor(
     robot: Robot, model: IdentifiedModel, q: Sequence[NDArray[np.float64]]
-) -> tuple[float, NDArray[np.float64], NDArray[np.intp]] | None:
-    """The common factor [-] of ``model``'s gravity torques to ``robot``'s description's
-    (module docstring), each joint's (n,) and the loaded joints (indices), at the
-    configurations ``q`` (one (N, n) array [rad] per log); None where
-    :func:`gravity_scale_finding` finds none."""
+) -> GravityRatios | None:
+    """``model``'s gravity torques over ``robot``'s description's (module docstring) at
+    the configurations ``q`` (one (N, n) array [rad] per log), judged against one factor
+    (:attr:`GravityRatios.one_factor`); None where there is nothing to say: no inertial
+    parameters in the description, fewer than 2 loaded joints, shapes that differ or
+    factors not positive, factors within :data:`OFF` of 1 on average (between ``1 / (1 +
+    OFF)`` and ``1 + OFF``)."""
     if not np.any(robot.phi) or not q:
         return None
     every = np.concatenate([np.asarray(a, dtype=np.float64) for a in q])
@@ -104,10 +209,14 @@ def gravity_scale_factor(
     js = np.flatnonzero(loaded)
     if js.size < 2 or np.any(c[js] < SHAPE) or np.any(r[js] <= 0):
         return None
-    mean = float(np.mean(r[js]))
-    if np.max(np.abs(r[js] - mean)) > UNIFORM * mean or abs(mean - 1.0) < OFF:
+    if abs(np.log(float(np.mean(r[js])))) < np.log1p(OFF):
         return None
-    return mean, r, js
+    C = gravity_ratio_covariance(model, qs, gravity_torques(robot, qs), js)
+    factor, std, chi2, agree = _one_factor(r[js], C)
+    se = np.full(robot.n, np.nan)
+    if C is not None:
+        se[js] = np.sqrt(np.clip(np.diag(C), 0.0, None))
+    return GravityRatios(factor, std, r, se, js, chi2, agree)
 
 
 def gravity_scale_finding(
@@ -119,26 +228,31 @@ def gravity_scale_finding(
     """The finding (module docstring) of ``model`` identified from logs at the
     configurations ``q`` (one (N, n) array per log) of ``robot``, or None: no inertial
     parameters in the description, fewer than 2 loaded joints, factors that differ between
-    joints or lie within :data:`OFF` of 1. ``drive``: the drive the log was read through (a
-    log of currents: its torque constant is named)."""
+    joints (:func:`gravity_masses_words` says those) or lie within :data:`OFF` of 1.
+    ``drive``: the drive the log was read through (a log of currents: its torque constant
+    is named)."""
     found = gravity_scale_factor(robot, model, q)
-    return None if found is None else gravity_scale_words(robot, found, drive)
+    if found is None or not found.one_factor:
+        return None
+    return gravity_scale_words(robot, found, drive)
 
 
-def gravity_scale_words(
-    robot: Robot,
-    found: tuple[float, NDArray[np.float64], NDArray[np.intp]],
-    drive: Drive | None = None,
-) -> str:
+def _std(x: float) -> str:
+    """`` (std 0.0012)``, or nothing for a standard deviation not known (NaN)."""
+    return "" if not np.isfinite(x) else f" (std {x:.2g})"
+
+
+def gravity_scale_words(robot: Robot, found: GravityRatios, drive: Drive | None = None) -> str:
     """:func:`gravity_scale_finding`'s sentence of the factor :func:`gravity_scale_factor`
-    ``found`` (common factor, each joint's, the loaded joints) of ``robot``."""
-    mean, r, js = found
+    ``found`` (one factor on every loaded joint) of ``robot``."""
+    mean, r, js = found.factor, found.ratios, found.joints
     names = ", ".join(robot.joint_names[j] for j in js)
     said = (
-        f"the identified gravity torques are {mean:.3g} times the robot description's on "
-        f"every joint gravity loads ({names}: {r[js].min():.3g} to {r[js].max():.3g}): one "
-        "factor on every joint is a scale the fit cannot see (it predicts the log as well "
-        "with it; its masses and inertias carry it)"
+        f"the identified gravity torques are {mean:.3g}{_std(found.factor_std)} times the "
+        f"robot description's on every joint gravity loads ({names}: {r[js].min():.3g} to "
+        f"{r[js].max():.3g}, one factor within their uncertainty): one factor on every "
+        "joint is a scale the fit cannot see (it predicts the log as well with it; its "
+        "masses and inertias carry it)"
     )
     if drive is not None and drive.effort == "current":
         return (
@@ -155,6 +269,28 @@ def gravity_scale_words(
     return (
         f"{said}; if the description's masses are right, the torques are {1 / mean:.3g} "
         f"times too small (a sensor scale: --units tau={1 / mean:.3g}){currents}"
+    )
+
+
+def gravity_masses_words(robot: Robot, found: GravityRatios) -> str:
+    """The note of factors :func:`gravity_scale_factor` ``found`` that differ between the
+    loaded joints of ``robot`` (not one factor): the description's masses are off joint by
+    joint, and the model, fitted to the torques as logged, needs no change."""
+    r, se, js = found.ratios, found.ratio_std, found.joints
+    each = ", ".join(
+        f"{robot.joint_names[j]} {r[j]:.4g}"
+        + ("" if not np.isfinite(se[j]) else f" +- {se[j]:.1g}")
+        for j in js
+    )
+    return (
+        f"the identified gravity torques are {r[js].min():.3g} to {r[js].max():.3g} times the "
+        f"robot description's on the joints gravity loads ({each}): factors that differ "
+        f"between joints beyond their uncertainty (chi-square {found.chi2:.3g} on "
+        f"{js.size - 1} degrees of freedom, {100 * DESCRIBED:.3g} % of the factor per joint "
+        "added for the description's own error), where a scale of the torques (a sensor's, "
+        "a torque constant's) is one factor on every joint: the description's link masses "
+        "look off (its inertials not the arm's); the identified model, fitted to the torques "
+        "as logged, is right as it is and needs no change"
     )
 
 

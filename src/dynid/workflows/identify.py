@@ -34,6 +34,7 @@ option's field; the command line names it by its flag.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -55,6 +56,7 @@ from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.estimators import ESTIMATORS, EstimatorName
 from ..identification.gravity_scale import (
     GRAVITY_SCALE,
+    gravity_masses_words,
     gravity_scale_factor,
     gravity_scale_words,
 )
@@ -69,6 +71,7 @@ from ..identification.structure import Structure
 from ..identification.torque_delay import TorqueDelay
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import NOTE
 from .data_files import (
     ColumnSpec,
     check_file_entries,
@@ -118,6 +121,8 @@ __all__ = [
     "identify_logs",
     "parsed_terms",
 ]
+
+_log = logging.getLogger(__name__)
 
 
 def _columns(spec: ColumnSpec | None, cutoff_hz: Cutoff, drive: Drive | None) -> Any:
@@ -655,9 +660,12 @@ def _say_gravity_scale(
 ) -> IdentifiedModel:
     """``model``, warned about and recording it when its gravity torques are one factor off
     the description's on every loaded joint
-    (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`: a note, and
+    (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`: a warning, and
     ``gravity_scale`` in its metadata, ``factor`` and ``finding``, which ``payload`` reads:
-    a load weighed through the model carries the factor); not when the held-out verdict
+    a load weighed through the model carries the factor); with a note in its notes when the
+    joints' factors differ beyond their uncertainty
+    (:func:`~dynid.identification.gravity_scale.gravity_masses_words`: the description's
+    masses, not the torques, are off; nothing to change); not when the held-out verdict
     names a factor per motor (``held.gains``, which holds the common one too): one
     judgement of the efforts' scale."""
     if held is not None and held.gains is not None and held.gains.named:
@@ -666,12 +674,17 @@ def _say_gravity_scale(
     factor = gravity_scale_factor(robot, model, q)
     if factor is None:
         return model
+    if not factor.one_factor:
+        said = gravity_masses_words(robot, factor)
+        _log.log(NOTE, "%s", said)
+        info = dataclasses.replace(model.info, notes=(*model.info.notes, said))
+        return dataclasses.replace(model, info=info)
     found = gravity_scale_words(robot, factor, drive)
     warnings.warn(found, DynidWarning, stacklevel=4)
     info = dataclasses.replace(
         model.info,
         notes=(*model.info.notes, found),
-        extra={**model.info.extra, GRAVITY_SCALE: {"factor": factor[0], "finding": found}},
+        extra={**model.info.extra, GRAVITY_SCALE: {"factor": factor.factor, "finding": found}},
     )
     return dataclasses.replace(model, info=info)
 
