@@ -284,3 +284,30 @@ def test_a_gain_loose_over_the_folds_is_said_beside_a_named_one(panda):
     assert said is not None and "joint 4's 1.13 (spread 0.17 over the folds)" in said, said
     own = dataclasses.replace(found, floor=True)  # its own spread: named
     assert own.vague == () and 3 in own.named
+
+
+def test_a_gain_the_error_ignores_is_said_and_its_scale_unknown(panda):
+    """Regression: joint 7 logged through 0.87 beside joint 2 through 1.5 (1 % noise, three
+    recordings); given a held-out error that holding joint 7's gain at 1 leaves as it is
+    (as a simulated xArm7's wrist motor 6, whose own friction and rotor took its factor
+    1.12: 1.10 +- 0.012 in-sample), it was neither named nor said at all. It is now said
+    not named, with its std and spread over the folds, and its scale is unknown."""
+    rng = np.random.default_rng(13)
+    W, G, gd, tau = _panda_columns(panda, 13)
+    labels = np.repeat(np.arange(3), tau.shape[0] // 3)
+    truth = np.array([1.0, 1.5, 1.0, 1.0, 1.0, 1.0, 0.87])
+    noise = 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    found = drive_gains(
+        W, tau / truth + rng.normal(size=tau.shape) * noise, noise, None, G, gd, labels
+    )
+    assert found is not None and found.ratio_held is not None
+    np.testing.assert_allclose(found.factor[[1, 6]], truth[[1, 6]], rtol=0.02)
+    assert found.named == (1, 6) and found.unknown_scale == ()
+    held = found.ratio_held.copy()
+    held[6] = found.ratio_fitted  # its own terms take the factor: the error does not move
+    ignored = dataclasses.replace(found, ratio_held=held)
+    assert ignored.named == (1,) and ignored.quiet == (6,) and ignored.unknown_scale == (6,)
+    said = ignored.sentence()
+    assert said is not None and re.search(r"joint 7's 0\.8\d+ \(std 0\.0\d+, 0\.0\d+ over", said)
+    assert "not named: holding it at 1 leaves the error as it is" in said, said
+    assert ignored.as_dict()["unknown_scale"] == [6]

@@ -12,6 +12,7 @@ Panda's true parameters at random states, joint 7 still over most of them.
 from __future__ import annotations
 
 import dataclasses
+import json
 import warnings
 
 import numpy as np
@@ -469,3 +470,30 @@ def test_the_gear_ratio_pattern_needs_gains_that_follow_the_gear_ratios(factor, 
     )
     assert (gear_ratio_pattern(gains, drive) is not None) is found
     assert gear_ratio_pattern(gains, dataclasses.replace(drive, side="motor")) is None
+
+
+def test_constants_the_data_leave_unknown_are_recorded_beside_the_named(guessed, tmp_path):
+    """Regression: where the constants were judged off on joints 2 and 4, the wrist's
+    joint 7, whose gain the 5 s log does not determine, was said only in the verdict's
+    words; identification.json, feasible.json and the robot files carried no caveat. The
+    model's metadata (``unknown_scale``), its notes, the consistent fit's notes,
+    feasible.json and the top of robot.urdf now name it; every joint not named there reads
+    through its true constant within 1 %."""
+    model = guessed.model
+    unknown = model.info.extra["unknown_scale"]
+    assert unknown["motors"] == [7] and unknown["joints"] == ["joint7"], unknown
+    assert unknown["finding"] in model.info.notes
+    assert f"note: {unknown['finding']}" in format_identification(model)
+    assert guessed.consistent is not None and unknown["finding"] in guessed.consistent.notes
+    assert model.drive is not None and model.drive.torque_constant is not None
+    np.testing.assert_allclose(model.drive.torque_constant[:6], KT[:6], rtol=0.01)
+    cmap = {"columns": None, "units": "tau2=-1"}
+    with warnings.catch_warnings():  # the export's notes on the robot files
+        warnings.simplefilter("ignore")
+        files = save_feasible_bundle(
+            tmp_path, guessed.consistent, column_map=cmap, unknown_scale=unknown
+        )
+    doc = json.loads(files[0].read_text())
+    assert doc["unknown_scale"]["motors"] == [7] and doc["column_map"] == cmap
+    urdf = next(p for p in files if p.suffix == ".urdf").read_text()
+    assert "UNKNOWN SCALE: the torque_constant of joint(s) 7" in urdf

@@ -8,6 +8,7 @@ concatenated per-sample errors, and the friction the logs were simulated with.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 import warnings
@@ -19,6 +20,7 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.exceptions import DataError, DynidWarning, OptionError
 from dynid.friction.model import ClassicalFriction
+from dynid.io.feasible import save_feasible_json
 from dynid.io.static_data import save_static_data
 from dynid.io.torque_log import load_torque_log, save_torque_log
 from dynid.simulation.measurement import SensorNoise, sample_times, simulate_measurement
@@ -379,6 +381,27 @@ def test_a_load_is_identified_from_several_recordings_with_gaps(loaded_files, tm
         r"t = 3\.000 s \(0\.5 s long\)",
         out,
     )
+
+
+def test_payload_params_reads_the_logs_as_the_fit_read_its_own(loaded_files, tmp_path):
+    """Regression: with --params feasible.json the sign flips the fit's data were read
+    with were forgotten (with --model identification.json they are reused), and a log of
+    the same controller, joint 2 logged negated, was refused for its sign. feasible.json
+    records them (``column_map``) and payload reads the log through them: the mass and
+    CoM within four standard deviations of the truth."""
+    arm, d = loaded_files
+    log = load_torque_log(d / "load41.csv")
+    flipped = log.tau.copy()
+    flipped[:, 1] *= -1.0
+    save_torque_log(tmp_path / "flipped.csv", dataclasses.replace(log, tau=flipped))
+    feasible = save_feasible_json(
+        tmp_path / "feasible.json", arm, column_map={"columns": None, "units": "tau2=-1"}
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)  # the reuse is said
+        est = identify_payload_files(arm, tmp_path / "flipped.csv", feasible=feasible).estimate
+    assert abs(est.mass - LOAD_MASS) < 4 * est.std_mass + 1e-3, est.mass
+    assert np.all(np.abs(est.com - LOAD_COM) < 4 * est.std_com + 1e-3), est.com
 
 
 def test_payload_static_data_stay_one_file(tmp_path):

@@ -100,3 +100,22 @@ def test_a_flipped_joint_whose_friction_outweighs_gravity_is_found(panda):
         assert said is not None and "tau2=-1" in said, said
         m = said.split("Coulomb ")[1].split(" N m")[0]
         assert abs(float(m) + FC) < 0.1 * FC, said
+
+
+def test_every_flipped_joint_is_named_at_once(panda):
+    """Regression: a log flipped on a shoulder and on a wrist joint gravity barely loads
+    was refused naming the shoulder alone, and the wrist only on the next run (by the
+    fit's friction that puts energy into the arm); beside a joint found opposite, the
+    joints the model's torques do not tell are asked of their friction too, and both
+    flips are named in one hint. The right-signed log names none."""
+    friction = ClassicalFriction(np.full(7, 2.0), np.full(7, 2.0), np.zeros(7))
+    (log,) = recordings(
+        panda,
+        (65,),
+        friction=friction,
+        duration=6.0,
+        noise=SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3),
+    )
+    assert opposite_sign(panda, log) is None
+    said = opposite_sign(panda, _negated(_negated(log, 1), 6))
+    assert said is not None and "tau2=-1,tau7=-1" in said, said

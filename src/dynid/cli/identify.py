@@ -347,7 +347,14 @@ def run(args: argparse.Namespace, console: Console) -> int:
     if result.consistent is not None:
         # every recording fitted, not the first alone; none left out as outlying
         sources = [str(p) for p in fitted_logs(result.model, args.data)]
-        files += save_feasible_bundle(args.out, result.consistent, sources=sources)
+        info = result.model.info  # how its data were read, the scales they leave unknown
+        files += save_feasible_bundle(
+            args.out,
+            result.consistent,
+            column_map=info.column_map,
+            unknown_scale=info.extra.get("unknown_scale"),
+            sources=sources,
+        )
         files += [] if args.no_figures else save_retrieval_figure(args.out, result.consistent)
         text += ["", format_consistent(result.consistent)]
     console.print(*text)

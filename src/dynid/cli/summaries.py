@@ -120,6 +120,8 @@ def format_identification(
     head += per_recording_lines(info.extra, given=True)  # a structure given (--terms)
     first = info.extra.get("gains_first")  # why the torque constants were judged first:
     head += [f"note: {first}"] if isinstance(first, str) else []  # before the table it explains
+    unknown = info.extra.get("unknown_scale")  # the motors whose constants the data leave unknown
+    head += [f"note: {unknown['finding']}"] if isinstance(unknown, dict) else []
     gravity = info.extra.get("gravity_fitted")  # the gravity vector a tilted base reads
     head += [f"note: {gravity['note']}"] if isinstance(gravity, dict) and "note" in gravity else []
     head += selection_lines(info.selection)

@@ -283,10 +283,39 @@ class DriveGains:
         wide = self.determined & (d >= OFF) & (spread >= OFF * np.abs(self.factor))
         return tuple(int(k) for k in np.flatnonzero(wide) if int(k) not in said)
 
+    @property
+    def quiet(self) -> tuple[int, ...]:
+        """The determined motors (from 0) neither :attr:`named`, :attr:`unconfirmed` nor
+        :attr:`vague` whose gain reads at least :data:`OFF` from 1 by :data:`SIGNIFICANT`
+        in-sample standard deviations: left out by the error's indifference to them
+        (holding the gain at 1 raises it by less than :data:`RAISE`, the joints' own
+        friction and rotor taking the factor) or, at the floor, by their spread over the
+        folds; determined too loosely to be a finding, too loosely to vouch for the
+        constant (a simulated xArm7's wrist motor 6 through a constant 1/1.12 times the
+        true one: 1.10, std 0.012 in-sample, 0.045 over the folds, holding it at 1 left
+        the error as it was)."""
+        if not (self.uneven and self.explains):
+            return ()
+        said = set(self.named) | set(self.unconfirmed) | set(self.vague)
+        d = np.abs(np.nan_to_num(self.factor, nan=1.0) - 1.0)
+        off = self.determined & (d >= OFF) & (d >= SIGNIFICANT * self.std)
+        return tuple(int(k) for k in np.flatnonzero(off) if int(k) not in said)
+
+    @property
+    def unknown_scale(self) -> tuple[int, ...]:
+        """The motors (from 0) whose effort's scale the data leave unknown: not
+        :attr:`determined`, or read at least :data:`OFF` from 1 and not named
+        (:attr:`unconfirmed`, :attr:`vague`, :attr:`quiet`); their joints' torques, and
+        the rotor inertias and friction fitted to them, carry that unknown factor."""
+        loose = set(np.flatnonzero(~self.determined).tolist())
+        off = set(self.unconfirmed) | set(self.vague) | set(self.quiet)
+        return tuple(sorted(int(k) for k in loose | off))
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: ``factor`` and ``std`` per motor (null where left out), ``scaled``,
         ``ratio_fixed``, ``ratio_fitted``, ``ratio_held`` (per motor), ``determined`` and
-        ``named`` (the motors' indices from 0), ``heldout_gain``, ``heldout_se`` and
+        ``named`` (the motors' indices from 0), ``unknown_scale`` (the motors, from 0,
+        whose effort's scale the data leave unknown), ``heldout_gain``, ``heldout_se`` and
         ``heldout_std`` (per motor; null without folds), ``effort``, ``per``,
         ``applied`` (the model was fitted to the efforts the factors correct) and ``floor``
         (judged at the noise floor)."""
@@ -305,6 +334,7 @@ class DriveGains:
             "ratio_held": listed(self.ratio_held),
             "determined": [int(k) for k in np.flatnonzero(self.determined)],
             "named": list(self.named),
+            "unknown_scale": list(self.unknown_scale),
             "heldout_gain": listed(self.heldout_gain),
             "heldout_se": listed(self.heldout_se),
             "heldout_std": listed(self.heldout_std),
@@ -375,6 +405,27 @@ class DriveGains:
                 " not named either: the data leave it that uncertain, so its torque_constant "
                 "may be off by that much unseen"
             )
+        quiet = self.quiet
+        if quiet:
+            spread = self.heldout_std
+            said += "; " + ", ".join(
+                f"{unit} {k + 1}'s {self.factor[k]:.3g} (std {std[k]:.2g}"
+                + ("" if spread is None else f", {spread[k]:.2g} over the folds")
+                + ")"
+                for k in quiet
+            )
+            held = self.ratio_held
+            indifferent = held is not None and all(
+                held[k] ** 2 - self.ratio_fitted**2 < RAISE for k in quiet
+            )
+            said += " not named: " + (
+                "holding it at 1 leaves the error as it is (its joints' own friction and "
+                "rotor take the factor)"
+                if indifferent
+                else f"over the folds it lies within {SIGNIFICANT:g} spreads of 1"
+            )
+            said += ", so its torque_constant may be off by that much unseen"
+
         loose = ", ".join(str(k + 1) for k in np.flatnonzero(~self.determined))
         if loose:
             said += f"; the data do not determine the gain of {unit}(s) {loose}"

@@ -21,7 +21,8 @@ of the joint's own position and friction, far better than the negated ones
 flipped sign would; the samples whose velocity is within its noise left out, where a
 Coulomb friction of 80 N m steps). Where friction outweighs a loaded joint's rigid bodies
 the correlations cannot see a flip: a joint whose negated torques are so explained while
-its friction as read pushes is called opposite (:func:`_pushing_as_read`). A robot's joint
+its friction as read pushes is called opposite (:func:`_pushing_as_read`; of a joint gravity
+does not load, only beside another found opposite). A robot's joint
 spring (:attr:`~dynid.model.robot.Robot.spring`) is part of its torques at rest and in
 motion. Not judged on a joint whose gravity torques span less than
 :data:`GRAVITY_RANGE_SHARE` of the log's largest (a short stretch, whose torque variations
@@ -208,8 +209,14 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
         strong &= ~_reads_right(log, at, whole[0], whole[1], strong)
     if not strong.any():
         return None
+    if whole is not None:  # refused anyway: the joints gravity does not load, told at once
+        pushing |= _pushing_as_read(log, at, whole[0], whole[1], ~(loaded | right | strong))
+        strong = strong | np.isin(np.arange(robot.n), list(pushing))
     if right.any() or not loaded.any() or not bool(np.all(every[loaded] < 0)):
-        return _opposite(corr, strong, loaded | right, robot.joint_names, closer, pushing, file)
+        told = whole is not None
+        return _opposite(
+            corr, strong, loaded | right, robot.joint_names, closer, pushing, file, told
+        )
     names = robot.joint_names
     j = int(np.flatnonzero(strong)[np.argmin(corr[strong])])
     said = (
@@ -339,8 +346,12 @@ def _pushing_as_read(
     coefficient), with that coefficient [N m]: a flipped sign where friction outweighs
     the rigid bodies, which the correlations cannot see (a UR5 shoulder with 80 N m of
     Coulomb friction, flipped, correlated +0.52 with its model's torques). Asked of the
-    joints gravity loads: the sign of one it does not is judged by the identification's
-    dissipation check, which offers the structure without its friction as the way on."""
+    joints gravity loads, and of the others once a joint is found opposite (the log is
+    refused anyway, so every flipped joint is named at once: a simulated xArm7 logged with
+    joints 2 and 5 flipped was refused naming joint 2 alone, and joint 5 only on the next
+    run, by the fit's friction); alone, the sign of a joint gravity does not load is judged
+    by the identification's dissipation check, which offers the structure without its
+    friction as the way on (a controller's compensation)."""
     fits = _sign_fits(log, at, model, ok, asked)
     return {
         j: fc
@@ -480,6 +491,7 @@ def _opposite(
     closer: dict[int, tuple[float, float]] | None = None,
     pushing: dict[int, float] | None = None,
     file: str | None = None,
+    dissipating: bool = False,
 ) -> str | None:
     """The finding of the joints ``strong`` (n,) anti-correlated with the model's torques
     (``corr``, n), or closer to its negated torques (``closer``: the RMS distances from
@@ -487,7 +499,8 @@ def _opposite(
     coefficient [N m] of friction that pushes as read, :func:`_pushing_as_read`), while
     others the checks judge (``judged``) are not: named, with the ``--units`` entries
     that flip their columns alone (``tau2=-1``; of ``file`` alone: ``rec2.csv:tau2=-1``),
-    and the joints neither check judges."""
+    and the joints neither check judges (``dissipating``: whose friction as read was
+    asked and does not push)."""
     rest = np.flatnonzero(judged & ~strong)
     free = np.flatnonzero(~judged & ~strong)
     bad = np.flatnonzero(strong)
@@ -528,7 +541,8 @@ def _opposite(
         + f": the torque sign of {which} is probably opposite to the model's"
         + (
             f" (the sign of {', '.join(names[k] for k in free)}, whose torques the model's "
-            "do not explain, is not told by this check)"
+            "do not explain, is not told by this check"
+            + (", though their friction as read does not push the arm)" if dissipating else ")")
             if free.size
             else ""
         )

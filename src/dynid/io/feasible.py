@@ -25,6 +25,11 @@ and was not on a torque log; the friction identified with the links in ``linear_
          identified model's coefficients: which values the prior sets, not the data),
      "spring": {"k": [...], "q0": [...]} (only with a spring term: the stiffnesses
          identified with the links, :mod:`dynid.io.spring_record`),
+     "column_map": {"columns": ..., "units": "tau2=-1"} (how the fit's data were read;
+         ``payload --params`` reads its logs so unless given --columns/--units),
+     "unknown_scale": {"motors": [6, 7], "joints": [...], "factor": [1.10, null],
+         "finding": ...} (the motors whose torque constants the data leave unknown beside
+         those judged off; the robot files written of it say so at their top),
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
      "violated": [...], "heldout": {...}, "units": {...}, "conventions": {...}}
 
@@ -158,13 +163,21 @@ FEASIBLE = Format(
             "combined": Field("object"),
             "set_by_prior": Field("object"),
             "spring": SPRING_FIELD,
+            "column_map": Field("object"),
+            "unknown_scale": Field("object"),
         }
     ),
     "feasible-parameter file",
 )
 
 
-def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None) -> dict[str, Any]:
+def feasible_to_dict(
+    source: FeasibleResult | Robot,
+    *,
+    seed: int | None = None,
+    column_map: Mapping[str, Any] | None = None,
+    unknown_scale: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
     """The link parameters (and kinematics, friction) of a consistent result or a robot.
 
     Parameters
@@ -249,6 +262,10 @@ def feasible_to_dict(source: FeasibleResult | Robot, *, seed: int | None = None)
             "(no data tell them apart), not their own values alone: "
             + "; ".join(f"{lab} holds {expr}" for lab, expr in combined.items())
         )
+    if column_map is not None:  # how the data were read: payload reads its logs so
+        d["column_map"] = dict(column_map)
+    if unknown_scale is not None:
+        d["unknown_scale"] = dict(unknown_scale)
     if result is None:
         return d if seed is None else d | {"seed": seed}
     marks = prior_marks_record(result)
@@ -382,15 +399,16 @@ def _at_motors(friction: Friction) -> bool:
     return friction.drive is not None and friction.drive.friction_place == "motor"
 
 
-def save_feasible_json(path: str | Path, source: FeasibleResult | Robot) -> Path:
-    """Write ``feasible.json`` (see :func:`feasible_to_dict`); returns the path.
+def save_feasible_json(path: str | Path, source: FeasibleResult | Robot, **recorded: Any) -> Path:
+    """Write ``feasible.json`` (see :func:`feasible_to_dict`, whose ``column_map`` and
+    ``unknown_scale`` ``recorded`` passes on); returns the path.
 
     Raises
     ------
     NonFiniteError
         A NaN or infinite number in the parameters (named).
     """
-    return save_document(path, FEASIBLE, feasible_to_dict(source))
+    return save_document(path, FEASIBLE, feasible_to_dict(source, **recorded))
 
 
 def robot_from_feasible_dict(
@@ -505,6 +523,25 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
             stacklevel=2,
         )
     return out
+
+
+def unknown_scale_caveat(finding: str) -> str:
+    """The comment at the top of a robot file whose fit's efforts carry an unknown scale on
+    some joints (``finding``: ``unknown_scale.finding`` of ``feasible.json``)."""
+    return f"UNKNOWN SCALE: {finding}"
+
+
+def load_unknown_scale_caveat(path: str | Path) -> str | None:
+    """:func:`unknown_scale_caveat` of the file ``path``'s ``unknown_scale``, or None."""
+    found = load_document(path, FEASIBLE).get("unknown_scale")
+    return None if not found else unknown_scale_caveat(str(found.get("finding", "")))
+
+
+def load_feasible_column_map(path: str | Path) -> dict[str, Any] | None:
+    """How the data of the fit ``feasible.json`` holds were read: its ``column_map``
+    (``columns`` and ``units``, as ``identification.json`` records it), or None."""
+    found = load_document(path, FEASIBLE).get("column_map")
+    return None if found is None else dict(found)
 
 
 def load_fit_rejection(path: str | Path) -> str | None:

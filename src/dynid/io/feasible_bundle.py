@@ -10,6 +10,7 @@ motors, or both), none when it fitted a torque log without friction, else the in
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +23,7 @@ from .feasible import (
     rejection_caveat,
     result_rejection,
     save_feasible_json,
+    unknown_scale_caveat,
 )
 from .report_json import save_report_json
 
@@ -38,7 +40,12 @@ FEASIBLE_BUNDLE = (
 
 
 def save_feasible_bundle(
-    folder: str | Path, result: FeasibleResult, **report_extra: Any
+    folder: str | Path,
+    result: FeasibleResult,
+    *,
+    column_map: Mapping[str, Any] | None = None,
+    unknown_scale: Mapping[str, Any] | None = None,
+    **report_extra: Any,
 ) -> list[Path]:
     """Write :data:`FEASIBLE_BUNDLE` for ``result`` into ``folder``.
 
@@ -50,6 +57,13 @@ def save_feasible_bundle(
         A retrieval (penalty method, :class:`~dynid.feasibility.penalty.result.RetrievalResult`)
         or a convex retrieval / one-step consistent fit
         (:class:`~dynid.feasibility.convex.result.ConsistentResult`).
+    column_map : mapping, optional
+        How the fit's data were read (``identification.json``'s ``column_map``), recorded
+        in ``feasible.json``.
+    unknown_scale : mapping, optional
+        The motors whose torque constants the data leave unknown
+        (:meth:`~dynid.workflows.gains_first.UnknownScale.as_dict`), recorded in
+        ``feasible.json`` and said at the top of the robot files.
     **report_extra
         Extra keys of ``report.json`` (``source``, ``seed``), JSON values.
 
@@ -64,11 +78,14 @@ def save_feasible_bundle(
         A NaN or infinite number in a JSON file (named).
     """
     folder = Path(folder)
-    files = [save_feasible_json(folder / "feasible.json", result)]
+    recorded = {"column_map": column_map, "unknown_scale": unknown_scale}
+    files = [save_feasible_json(folder / "feasible.json", result, **recorded)]
     friction: Any = True if result.friction is None else result.friction
     reason = result_rejection(result)
     notes = combined_notes(combined_coefficients(result))  # not the motors' own friction alone
     caveats = ([] if reason is None else [rejection_caveat(reason)]) + list(notes[:1])
+    if unknown_scale is not None:
+        caveats.append(unknown_scale_caveat(str(unknown_scale.get("finding", ""))))
     options = ExportOptions(
         friction=friction,
         drive=result.drive,

@@ -32,7 +32,7 @@ from ..friction.model import Friction, sigmoid_parameters
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
 from ..io.drive_file import load_drive
 from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
-from ..io.feasible import load_fit_rejection, rejection_caveat
+from ..io.feasible import load_fit_rejection, load_unknown_scale_caveat, rejection_caveat
 from ..io.robot.export_options import ExportOptions
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..io.robot_file import ROBOT_FILE_SUFFIXES, load_robot
@@ -176,7 +176,7 @@ def export_robot(
         all_frames=opt.all_frames,
         drive=drive,
         source=_friction_source(params, linear is not None and opt.friction),
-        caveat=None if rejected is None else rejection_caveat(rejected),
+        caveat=_caveat(params, rejected),
     )
     approx = None
     sigmoid = sigmoid_parameters(robot.friction)
@@ -225,6 +225,17 @@ def _friction_source(params: str | Path, identified: bool) -> str | None:
     None for a URDF, an MJCF or a built-in robot."""
     suffix = Path(params).suffix.lower()
     return Path(params).name if identified or suffix == ".toml" else None
+
+
+def _caveat(params: str | Path, rejected: str | None) -> str | None:
+    """The comment at the top of the robot file: why the fit was not accepted
+    (``rejected``) and the joints whose torques carry an unknown scale (a
+    ``feasible.json``'s ``unknown_scale``), or None."""
+    path = Path(params)
+    said = [] if rejected is None else [rejection_caveat(rejected)]
+    if path.suffix.lower() == ".json" and path.exists():
+        said += [c for c in (load_unknown_scale_caveat(path),) if c is not None]
+    return "; ".join(said) or None
 
 
 def _check_accepted(params: str | Path, allowed: bool) -> str | None:

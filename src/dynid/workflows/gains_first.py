@@ -48,10 +48,13 @@ from ..model.drive import Drive
 
 __all__ = [
     "FIRST_RATIO",
+    "UNKNOWN_SCALE",
     "CorrectedSearch",
+    "UnknownScale",
     "gains_first",
     "reason_to_judge_first",
     "richest_structure",
+    "unknown_scale",
 ]
 
 #: Largest ratio [-] of the chosen structure's held-out error to the noise floor, and of the
@@ -257,3 +260,86 @@ def gains_first(
         warnings.simplefilter("always")
         searched = fit("auto", corrected)
     return CorrectedSearch(gains, corrected, searched, why, tuple(said), richest, pattern)
+
+
+#: The key of ``identification.json``'s metadata and of ``feasible.json`` that names the
+#: motors whose effort's scale the data leave unknown (:meth:`UnknownScale.as_dict`).
+UNKNOWN_SCALE = "unknown_scale"
+
+
+@dataclass(frozen=True, slots=True)
+class UnknownScale:
+    """The motors of a log whose torque constants (torque sensors' scales) were judged off
+    on some motors and which the data leave unknown on others
+    (:attr:`~dynid.identification.drive_gains.DriveGains.unknown_scale`): their joints'
+    torques, and the rotor inertias and friction fitted to them, carry that unknown factor.
+
+    Attributes
+    ----------
+    motors : tuple of int
+        The motors (from 0).
+    joints : tuple of str
+        The joints they act on.
+    factor : tuple of float or None
+        Each motor's factor as read (None: not determined) [-].
+    effort : {"current", "torque"}
+        What the log holds.
+    per : {"joint", "motor"}
+        Whose efforts the factors scale.
+    """
+
+    motors: tuple[int, ...]
+    joints: tuple[str, ...]
+    factor: tuple[float | None, ...]
+    effort: str = "current"
+    per: str = "motor"
+
+    def sentence(self) -> str:
+        """In words, for the model's notes and the summary."""
+        which = ", ".join(str(k + 1) for k in self.motors)
+        read = "; ".join(
+            f"{self.per} {k + 1}'s "
+            + ("not determined" if f is None else f"reads {f:.3g}, not named")
+            for k, f in zip(self.motors, self.factor, strict=True)
+        )
+        what = "torque_constant" if self.effort == "current" else "torque scale"
+        return (
+            f"the {what} of {self.per}(s) {which} is not known from the data ({read}; "
+            "the held-out verdict says why): the torques of "
+            f"{', '.join(self.joints)}, and the rotor inertias and friction fitted there, "
+            "carry that unknown factor (metadata unknown_scale)"
+        )
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready: ``motors`` (from 1), ``joints``, ``factor`` (null: not determined),
+        ``effort``, ``per`` and ``finding`` (:meth:`sentence`)."""
+        return {
+            "motors": [k + 1 for k in self.motors],
+            "joints": list(self.joints),
+            "factor": list(self.factor),
+            "effort": self.effort,
+            "per": self.per,
+            "finding": self.sentence(),
+        }
+
+
+def unknown_scale(
+    gains: DriveGains | None, drive: Drive | None, joint_names: Sequence[str]
+) -> UnknownScale | None:
+    """The motors whose effort's scale the data leave unknown where the gains judged some
+    motors off (:attr:`~dynid.identification.drive_gains.DriveGains.named`, or applied by
+    :func:`gains_first`): a drive file found wrong on some motors vouches for none of its
+    other guesses; None otherwise (nothing named: the constants stand as given)."""
+    if gains is None or not (gains.named or gains.applied):
+        return None
+    motors = gains.unknown_scale
+    if not motors:
+        return None
+    K = np.eye(len(joint_names)) if drive is None else np.asarray(drive.transmission)
+    acts = np.abs(K[list(motors)]) > 0
+    joints = tuple(joint_names[int(j)] for j in np.flatnonzero(acts.any(axis=0)))
+    factor = tuple(
+        float(gains.factor[k]) if gains.determined[k] and np.isfinite(gains.factor[k]) else None
+        for k in motors
+    )
+    return UnknownScale(motors, joints, factor, gains.effort, gains.per)

@@ -82,7 +82,13 @@ from .data_files import (
     read_static_file,
     read_torque_log,
 )
-from .gains_first import CorrectedSearch, gains_first, reason_to_judge_first
+from .gains_first import (
+    UNKNOWN_SCALE,
+    CorrectedSearch,
+    gains_first,
+    reason_to_judge_first,
+    unknown_scale,
+)
 from .gravity_refit import FittedGravity, refit_gravity
 from .options import (
     Cutoff,
@@ -601,6 +607,7 @@ def _fit_logs(
         model = dataclasses.replace(model, info=info)
     logs = fitted_logs(model, logs)  # without the recordings found outlying
     model = _say_gravity_scale(robot, model, logs, opt.drive, held)
+    model = _with_unknown_scale(model, held, robot.joint_names)
     if opt.consistent:
         result = _consistent_of(robot, model, held, first, opt, prior)
         return IdentifyResult(model, result, (), held, None, gravity)
@@ -629,7 +636,28 @@ def _consistent_of(
     )
     if first is not None:
         result = dataclasses.replace(result, notes=(first.consistent_note(), *result.notes))
+    unknown = model.info.extra.get(UNKNOWN_SCALE)
+    if unknown is not None:  # fitted to the same efforts: the same unknown factors
+        result = dataclasses.replace(result, notes=(*result.notes, unknown["finding"]))
     return _with_outside_model_note(result, held, robot.joint_names)
+
+
+def _with_unknown_scale(
+    model: IdentifiedModel, held: HeldOutTorques | None, joint_names: Sequence[str]
+) -> IdentifiedModel:
+    """``model`` with a note and its metadata's ``unknown_scale`` naming the motors whose
+    effort's scale the data leave unknown beside those judged off
+    (:func:`~dynid.workflows.gains_first.unknown_scale`); as it was otherwise."""
+    found = unknown_scale(None if held is None else held.gains, model.drive, joint_names)
+    if found is None:
+        return model
+    said = found.sentence()
+    info = dataclasses.replace(
+        model.info,
+        notes=(*model.info.notes, said),
+        extra={**model.info.extra, UNKNOWN_SCALE: found.as_dict()},
+    )
+    return dataclasses.replace(model, info=info)
 
 
 def _predicted_heldout(

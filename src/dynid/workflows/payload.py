@@ -40,7 +40,11 @@ from ..identification.model import IdentifiedModel
 from ..identification.pieces import recording_line
 from ..identification.spikes import SPIKES_BEFORE_FIT
 from ..identification.structure import Structure
-from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
+from ..io.feasible import (
+    load_feasible_column_map,
+    load_feasible_drive,
+    load_feasible_linear_friction,
+)
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
@@ -148,7 +152,7 @@ def identify_payload_files(
         As :func:`~dynid.feasibility.payload.identify_payload`.
     columns : (str or None, str or None), optional
         ``--columns`` and ``--units`` of files of another tool (default: an identified
-        model's recorded ones).
+        model's recorded ones, or those a ``feasible`` file records).
     drop_invalid : bool
         Drop invalid rows (counted) instead of failing.
     cutoff_hz : float or "none", optional
@@ -209,7 +213,7 @@ def identify_payload_files(
     if gravity_only:
         raise DataError("--gravity-only applies to static data (q, g), not to a torque log")
     read_as: dict[str, Any] = dict(
-        recorded=arm.info.column_map if isinstance(arm, IdentifiedModel) else None,
+        recorded=_recorded_columns(arm, feasible),
         columns=columns,
         drop_invalid=drop_invalid,
         cutoff_hz=known,
@@ -294,3 +298,16 @@ def _static(
         ),
     )
     return PayloadFileResult(est, "static")
+
+
+def _recorded_columns(
+    arm: Robot | IdentifiedModel, feasible: str | Path | None
+) -> dict[str, Any] | None:
+    """How the arm's own data were read: an identified model's recorded column map, else
+    the one a ``feasible.json`` records (its fit's: the sign flips and units reused as
+    with ``--model``), else None."""
+    if isinstance(arm, IdentifiedModel):
+        return None if arm.info.column_map is None else dict(arm.info.column_map)
+    if feasible is None or Path(feasible).suffix.lower() != ".json":
+        return None
+    return load_feasible_column_map(feasible)
