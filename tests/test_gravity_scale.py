@@ -164,3 +164,34 @@ def test_identify_notes_masses_off_and_records_no_scale(caplog):
     assert "gravity_scale" not in got.model.info.extra
     notes = [n for n in got.model.info.notes if "link masses look off" in n]
     assert len(notes) == 1 and notes[0] in caplog.text
+
+
+def test_a_hand_the_description_lacks_is_named_as_a_mass_at_the_flange():
+    """A Panda carrying a 0.73 kg hand the built-in description lacks (the truth: the
+    description with the hand added to link 7, as the Franka Hand rides the flange): the
+    joints' factors differ, and the note names the mass at the flange that makes up the
+    difference, the hand's mass and centre of mass to round-off on exact torques; the last
+    links heavier than described read as such a mass too (said as the other reading), the
+    last links lighter name none (noisy logs)."""
+    robot = dynid.panda()
+    hand = robot.with_tool(
+        np.eye(4), mass=0.73, com=(0.0, 0.0, 0.06),
+        inertia=(0.0025, 0.0, 0.0, 0.0025, 0.0, 0.0017), name="hand",
+    )  # fmt: skip
+    (log,) = recordings(hand, [1], friction=None, duration=3.0)  # exact torques
+    found = gravity_scale_factor(robot, _fitted(robot, log), [log.q])
+    assert found is not None and not found.one_factor and found.flange is not None
+    m, c = found.flange
+    flange_com = (hand.phi[6, 1:4] - robot.phi[6, 1:4]) / 0.73  # in link 7's frame
+    assert m == pytest.approx(0.73, rel=1e-9) and np.allclose(c, flange_com, atol=1e-9)
+    assert f"a mass of about {m:.3g} kg" in gravity_masses_words(robot, found)
+    heavier = _logged(robot.with_params(robot.phi * MASS_FACTORS[:, None]))  # links 5-7 too
+    said = gravity_masses_words(
+        robot, gravity_scale_factor(robot, _fitted(robot, heavier), [heavier.q])
+    )
+    assert "a mass of about" in said and "or its last links heavier" in said
+    lighter = np.array([1.2, 1.2, 1.2, 1.0, 0.8, 0.8, 0.8])  # the last links lighter
+    off = _logged(robot.with_params(robot.phi * lighter[:, None]))
+    other = gravity_scale_factor(robot, _fitted(robot, off), [off.q])
+    assert other is not None and not other.one_factor and other.flange is None
+    assert "mass of" not in gravity_masses_words(robot, other)

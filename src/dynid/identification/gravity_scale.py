@@ -49,6 +49,7 @@ __all__ = [
     "UNIFORM",
     "at_the_motors",
     "gravity_masses_words",
+    "flange_mass",
     "gravity_ratio_covariance",
     "gravity_ratios",
     "gravity_scale_factor",
@@ -143,6 +144,35 @@ class GravityRatios:
     joints: NDArray[np.intp]
     chi2: float
     one_factor: bool
+    flange: tuple[float, NDArray[np.float64]] | None = None
+
+
+def flange_mass(
+    robot: Robot, model: IdentifiedModel, q: NDArray[np.float64]
+) -> tuple[float, NDArray[np.float64]] | None:
+    """The point mass [kg] and its position (3,) [m, last link's frame] at the last link
+    whose gravity torques make up the model's less the description's at the
+    configurations ``q`` (N, n) [rad] (least squares of the last link's mass and first
+    moment columns over the joints gravity loads), or None: a mass not positive, or one
+    that leaves over a tenth of that difference's energy. A hand or a tool the description
+    lacks reads so (a Panda carrying its 0.73 kg hand, which the built-in description
+    holds not), and so do its last links heavier than described (its links 5-7 16 % so:
+    0.63 kg near link 7's origin leaves 0.2 % of the difference), which gravity torques
+    alone cannot tell apart."""
+    loaded = gravity_loaded(robot, q)
+    diff = (model.gravity_torques(q) - gravity_torques(robot, q))[:, loaded].ravel()
+    last = 10 * (robot.n - 1)
+    zero = np.zeros_like(q)
+    Y = torque_regressor(robot, q, zero, zero)[:, loaded, last : last + 4].reshape(-1, 4)
+    x, *_ = np.linalg.lstsq(Y, diff, rcond=None)
+    rest = diff - Y @ x
+    if not x[0] > 0 or float(rest @ rest) > _FLANGE_REST * float(diff @ diff):
+        return None
+    return float(x[0]), np.asarray(x[1:] / x[0], dtype=np.float64)
+
+
+#: The share of the difference a mass at the flange may leave (:func:`flange_mass`).
+_FLANGE_REST = 0.1
 
 
 def gravity_ratio_covariance(
@@ -216,7 +246,8 @@ def gravity_scale_factor(
     se = np.full(robot.n, np.nan)
     if C is not None:
         se[js] = np.sqrt(np.clip(np.diag(C), 0.0, None))
-    return GravityRatios(factor, std, r, se, js, chi2, agree)
+    flange = None if agree else flange_mass(robot, model, qs)
+    return GravityRatios(factor, std, r, se, js, chi2, agree, flange)
 
 
 def gravity_scale_finding(
@@ -290,7 +321,22 @@ def gravity_masses_words(robot: Robot, found: GravityRatios) -> str:
         "added for the description's own error), where a scale of the torques (a sensor's, "
         "a torque constant's) is one factor on every joint: the description's link masses "
         "look off (its inertials not the arm's); the identified model, fitted to the torques "
-        "as logged, is right as it is and needs no change"
+        f"as logged, is right as it is and needs no change{_at_the_flange(robot, found)}"
+    )
+
+
+def _at_the_flange(robot: Robot, found: GravityRatios) -> str:
+    """A clause naming the mass at the flange that makes up the difference
+    (:func:`flange_mass`), or nothing."""
+    if found.flange is None:
+        return ""
+    m, c = found.flange
+    at = ", ".join(f"{v:+.3f}" for v in c)
+    return (
+        f"; a mass of about {m:.3g} kg at ({at}) m in {robot.link_names[-1]}'s frame makes up the "
+        "difference: a hand or a tool the description lacks (the built-in panda and fr3 "
+        "hold none), or its last links heavier than described (gravity alone cannot tell "
+        "them apart), which the fit carries in its parameters"
     )
 
 
