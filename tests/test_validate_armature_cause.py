@@ -21,7 +21,8 @@ from dynid.identification.residual_dependence import (
 )
 from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import SensorNoise
-from dynid.workflows.validate import URDF_INERTIA, ValidateOptions, validate_files
+from dynid.workflows.validate import ValidateOptions, validate_files
+from dynid.workflows.validate_hints import URDF_INERTIA
 
 from conftest import recordings
 

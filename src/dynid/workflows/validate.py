@@ -54,12 +54,9 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.delay_check import validations_delay
 from ..friction.fit import model_drive, same_drive, torques_through
-from ..friction.heldout_torques import residual_gains, residual_springs, residual_tilt
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
-from ..friction.pooled import joined_validation
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction, recorded_cutoff
-from ..identification.derived_cutoff import derived_cutoff_hint, with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains
 from ..identification.error_spans import ErrorSpans, error_spans
 from ..identification.floor_verdict import (
@@ -71,19 +68,11 @@ from ..identification.floor_verdict import (
 from ..identification.gravity_scale import recorded_scale
 from ..identification.gravity_tilt import GravityTilt
 from ..identification.log import TorqueLog
-from ..identification.low_speed import with_low_speed_hint
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
 from ..identification.pieces import check_below_nyquist
 from ..identification.recorded_signs import SignFinding
-from ..identification.residual_dependence import (
-    dependence_hint,
-    friction_left_out,
-    held_terms,
-    offsets_of,
-    with_dependence_hint,
-)
 from ..identification.residual_spring import ResidualSpring
 from ..identification.spikes import SPIKES_BEFORE_JUDGING
 from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_delay
@@ -94,7 +83,7 @@ from ..io.model_json import load_model_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
-from ..observer.residual_load import ResidualLoad, load_hint, residual_load
+from ..observer.residual_load import ResidualLoad
 from ..progress import NOTE
 from .data_files import ColumnSpec, in_file
 from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
@@ -106,6 +95,7 @@ from .recordings import (
     unwrapped_recorded,
     warn_signs,
 )
+from .validate_hints import JudgedNoise, residual_hints, terms_held
 
 __all__ = ["ValidateOptions", "ValidateResult", "identification_beside", "validate_files"]
 
@@ -442,13 +432,13 @@ def validate_files(
     # a torque of the opposite sign leaves twice the torque, which no term of the model
     # explains: what the residual follows is not diagnosed (a current log's gains are)
     current = not beyond and placed is not None and placed.effort == "current"
-    verdict, springs, gains, tilt, load = _with_hints(
+    hints = residual_hints(
         model, verdict, val, rec.logs, noise, names,
         dependence=not beyond and not opposite and sign_map is None and burst is None,
-        held=_terms_held(model, placed, label), gains_too=current,
+        held=terms_held(model, placed, label), gains_too=current,
         payload=_payload_command(model, data, label, feasible, source),
     )  # fmt: skip
-    verdict = with_motion_range_hint(verdict, speeds, dq, names)
+    verdict, gains = with_motion_range_hint(hints.verdict, speeds, dq, names), hints.gains
     named = gains is not None and bool(gains.named)  # a scale off leaves no lag to name
     verdict, delay, applied = _with_delay(model, verdict, val, opt.torque_delay_s, named, own)
     files = ", ".join(f"{n} {c}" for n, c in zip(rec.names, spikes, strict=True) if c)
@@ -472,8 +462,8 @@ def validate_files(
         sign_map=sign_map,
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
-        springs=springs, gains=gains, torque_delay=delay, applied_delay=applied,
-        gravity_tilt=tilt, flange_load=load, error_spans=burst,
+        springs=hints.springs, gains=gains, torque_delay=delay, applied_delay=applied,
+        gravity_tilt=hints.tilt, flange_load=hints.load, error_spans=burst,
     )  # fmt: skip
 
 
@@ -589,142 +579,12 @@ def _with_delay(
     return verdict, delay, applied
 
 
-#: The remedy of a residual that follows a joint's acceleration, of a robot read from a
-#: URDF without a drive's rotor inertias: the file cannot hold them.
-URDF_INERTIA = (
-    "a URDF holds no armature: dynid's URDF export leaves it out, and warns so; validate "
-    "the MJCF export (robot.xml), which holds it as armature, or give --drive a drive file "
-    "with rotor_inertia"
-)
-
-
-def _terms_held(
-    model: IdentifiedModel | Robot, drive: Drive | None, label: str | None
-) -> tuple[frozenset[str], str | None]:
-    """The terms ``model`` holds beside the rigid bodies
-    (:func:`~dynid.identification.residual_dependence.held_terms`; ``armature`` too where
-    the ``drive`` placed has rotor inertias), and the remedy of a residual that follows
-    a joint's acceleration: :data:`URDF_INERTIA` for a robot read from a URDF (``label``
-    naming it) without an armature, else None (the remedy by the terms)."""
-    rotors = drive is not None and drive.rotor_inertia is not None
-    terms = held_terms(model) | ({"armature"} if rotors else frozenset())
-    urdf = isinstance(model, Robot) and (label or "").lower().endswith(".urdf")
-    return terms, URDF_INERTIA if urdf and "armature" not in terms else None
-
-
 def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
     """Each joint's largest speed [rad/s] over the identification's samples, or None (a
     robot, a model of static data)."""
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         return model.info.log.speed_max
     return None
-
-
-def _with_hints(
-    model: IdentifiedModel | Robot,
-    verdict: Verdict,
-    val: RecordingsValidation,
-    logs: Sequence[TorqueLog],
-    noise: _Noise,
-    names: Sequence[str],
-    *,
-    dependence: bool = True,
-    held: tuple[frozenset[str], str | None] = (frozenset(), None),
-    gains_too: bool = False,
-    payload: str = "`dynid payload`",
-) -> tuple[
-    Verdict, ResidualSpring | None, DriveGains | None, GravityTilt | None, ResidualLoad | None
-]:
-    """``verdict`` with what the residual of each joint above its noise follows
-    (:func:`~dynid.identification.residual_dependence.with_dependence_hint`; not with
-    ``dependence`` False: a recording that moves beyond the identification's data, where
-    any residual follows the motion; ``held`` the model's terms, which its remedies leave
-    out, and the remedy of a residual that follows a joint's acceleration
-    (:func:`_terms_held`); the model's offset per joint, with which a constant residual is
-    told, and its friction coefficients left out per joint, named where the residual
-    follows the velocity;
-    first the tilt of the gravity vector the residual points to, when it explains it:
-    :func:`~dynid.friction.heldout_torques.residual_tilt` of ``model``; a spring's joint
-    with its stiffness, :func:`~dynid.friction.heldout_torques.residual_springs`; in
-    their place, a gain per motor of the logged efforts that explains the residual,
-    :func:`~dynid.friction.heldout_torques.residual_gains`, judged with ``dependence``
-    False too where ``gains_too``: a current log, whose factors a sign finding does not
-    explain, and judged at the noise floor too, named there only clear of 1 over the time
-    blocks as well, :attr:`~dynid.identification.drive_gains.DriveGains.floor`), the hint
-    of a cut-off too high for derived states, and that of an error at low speed; and the
-    springs, the gains and the tilt fitted (None: not judged)."""
-    terms, inertia = held
-    offsets, left_out = offsets_of(model), friction_left_out(model)
-    error = [v.log.tau - v.tau_hat for v in val.parts]
-    dq = [v.log.dq for v in val.parts]
-    q = [v.log.q for v in val.parts]
-    springs = tilt = load = None
-    floor = verdict.level == "good"  # a current log's constants judged at the floor too
-    judged = (dependence or gains_too) and (not floor or gains_too)
-    whole = joined_validation(val.parts) if judged else None
-    gains = (  # at the floor, named only clear of 1 over the time blocks too
-        None
-        if whole is None
-        else residual_gains(model, whole, noise.total, described=floor, floor=floor)
-    )
-    said = None if gains is None else gains.sentence()
-    if said is not None and floor:  # at the floor, the factors said
-        verdict = dataclasses.replace(verdict, reason=f"{verdict.reason}; {said}")
-    elif said is not None:  # the efforts' scale per motor explains it: no spring, no tilt
-        verdict = with_hint(verdict, said)
-    elif dependence:
-        whole = None if floor else whole  # springs and a tilt: above the floor only
-        springs = None if whole is None else residual_springs(model, whole, noise.total)
-        tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
-        tau = [v.log.tau for v in val.parts]
-        got = [v.log.ddq for v in val.parts]
-        ddq = [a for a in got if a is not None] if all(a is not None for a in got) else None
-        tilted = tilt is not None and tilt.named  # a tilt named is said first, as before
-        load = None if whole is None or tilted else _fitted_load(model, val, ddq, noise)
-        if load is not None and load.named:  # the joints diagnosed on what it leaves
-            verdict = with_hint(verdict, load_hint(load, payload))
-            rest = dependence_hint(
-                q, dq, load.residual, noise.total, names, terms, offsets=offsets,
-                left_out=left_out, ddq=ddq, inertia=inertia,
-            )  # fmt: skip
-            verdict = with_hint(verdict, None if rest is None else f"what it leaves: {rest}")
-            springs = None  # the load, not a spring, is what the residual follows
-        else:
-            verdict = with_dependence_hint(
-                verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
-                tau, offsets, left_out, ddq, inertia,
-            )  # fmt: skip
-    verdict = with_derived_cutoff_hint(verdict, logs, val.pieces.cutoff_hz)
-    high = derived_cutoff_hint(logs, val.pieces.cutoff_hz)
-    if verdict.level == "good" and high is not None and noise.inputs is not None:
-        # at a floor the derived states raise: a lower cut-off lowers it
-        verdict = dataclasses.replace(
-            verdict, reason=f"{verdict.reason}; a floor raised because {high}"
-        )
-    # the low-speed hint's "above the noise": the sensors' (its module docstring)
-    verdict = with_low_speed_hint(verdict, dq, error, noise.sensor, names)
-    return verdict, springs, gains, tilt, load
-
-
-def _fitted_load(
-    model: IdentifiedModel | Robot,
-    val: RecordingsValidation,
-    ddq: Sequence[NDArray[np.float64]] | None,
-    noise: _Noise,
-) -> ResidualLoad | None:
-    """The rigid load at the flange fitted to the residual of every piece judged
-    (:func:`~dynid.observer.residual_load.residual_load`, its serial correlation over the
-    pieces' cut-off at their rate); None without the accelerations."""
-    if ddq is None:
-        return None
-    robot = model.robot if isinstance(model, IdentifiedModel) else model
-    steps = np.concatenate([np.diff(v.log.t) for v in val.parts])
-    rate = 1.0 / float(np.median(steps)) if steps.size and np.median(steps) > 0 else None
-    return residual_load(
-        robot, [v.log.q for v in val.parts], [v.log.dq for v in val.parts], ddq,
-        [v.log.tau - v.tau_hat for v in val.parts], noise.total,
-        cutoff_hz=val.pieces.cutoff_hz, rate_hz=rate,
-    )  # fmt: skip
 
 
 def _payload_command(
@@ -746,18 +606,6 @@ def _payload_command(
     else:
         what = f"--robot {(label or model.name).removeprefix('robot ')}"
     return f"`dynid payload {what} --data {given} --out DIR`"
-
-
-@dataclass(frozen=True, slots=True)
-class _Noise:
-    """The noise per joint [N m] (n,) of the pieces judged: the torque sensors', that of
-    the states the model is evaluated at (None: not known) and both (root sum of
-    squares), and each joint's error over it as the verdict weighed it (None: not known)."""
-
-    sensor: NDArray[np.float64]
-    inputs: NDArray[np.float64] | None
-    total: NDArray[np.float64]
-    ratios: NDArray[np.float64] | None = None
 
 
 def _input_noise(
@@ -785,7 +633,7 @@ def _judged(
     errors: TorqueErrors,
     names: Sequence[str],
     inputs: list[tuple[int, NDArray[np.float64]]] | None = None,
-) -> tuple[Verdict, _Noise, float]:
+) -> tuple[Verdict, JudgedNoise, float]:
     """The verdict, the noise per joint and the noise floor [%] of the pieces ``sel`` (bool
     per piece), whose pooled errors are ``errors``
     (:func:`~dynid.identification.floor_verdict.judged_prediction`): the sensors' noise
@@ -804,11 +652,15 @@ def _judged(
         None if inputs is None else [inputs[k] for k in chosen],
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
     )
-    return verdict, _Noise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios), fl.percent
+    return (
+        verdict,
+        JudgedNoise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios),
+        fl.percent,
+    )
 
 
 def _error_spans(
-    verdict: Verdict, val: RecordingsValidation, logs: Sequence[TorqueLog], noise: _Noise
+    verdict: Verdict, val: RecordingsValidation, logs: Sequence[TorqueLog], noise: JudgedNoise
 ) -> ErrorSpans | None:
     """Above the noise floor, the recording whose error above the noise sits in a few short
     spans (:func:`~dynid.identification.error_spans.error_spans`, each recording's pieces
