@@ -40,7 +40,7 @@ from dynid.regressors.torque import torque_regressor  # noqa: E402
 TRUTH = np.array([1.0, 1.5, 1.0, 0.7, 1.0, 1.2, 1.0])
 
 
-def _log(samples: int, seed: int = 3):  # type: ignore[no-untyped-def]
+def _log(samples: int, seed: int = 3):
     """The model's columns (N, 7, 64), the logged torques (N, 7) [N m], their noise (7,)
     [N m], the gravity columns and the description's gravity torques (N, 7) [N m]."""
     robot = dynid.panda()
@@ -61,7 +61,7 @@ def _log(samples: int, seed: int = 3):  # type: ignore[no-untyped-def]
     return W, tau / TRUTH + rng.normal(size=tau.shape) * noise, noise, G, gravity_torques(robot, q)
 
 
-def _basis(X):  # type: ignore[no-untyped-def]
+def _basis(X):
     """The pivoted QR of ``X``'s rows with ``Q`` formed, cut at rank (relative 1e-10)."""
     Q, R, piv = tall_pivoted_qr(X)
     d = np.abs(np.diag(R))
@@ -69,14 +69,14 @@ def _basis(X):  # type: ignore[no-untyped-def]
     return Q[:, :r], R[:r, :r], piv[:r]
 
 
-def _gains(Ba, Q):  # type: ignore[no-untyped-def]
+def _gains(Ba, Q):
     """The smallest eigenvector of the efforts' normal matrix with ``Q`` projected out."""
     P = Ba - Q @ (Q.T @ Ba)
     V = scipy.linalg.eigh(P.T @ P)[1]
     return V[:, 0] * np.sign(V[:, 0].sum())
 
 
-def _scale(g, A, B, G, gd):  # type: ignore[no-untyped-def]
+def _scale(g, A, B, G, gd):
     """The description's scale of ``g``: the fitted gravity torques over the described."""
     x = np.linalg.lstsq(A, B @ g, rcond=None)[0]
     gm = G @ x
@@ -85,7 +85,7 @@ def _scale(g, A, B, G, gd):  # type: ignore[no-untyped-def]
     return float(d @ f / (d @ d))
 
 
-def explicit(W, tau, s, G, gd, labels):  # type: ignore[no-untyped-def]
+def explicit(W, tau, s, G, gd, labels):
     """The factors and the held-out gains and standard errors of ``drive_gains`` with every
     motor fitted (as on this log), each fit on the explicit rows."""
     N, n, p = W.shape
@@ -103,7 +103,7 @@ def explicit(W, tau, s, G, gd, labels):  # type: ignore[no-untyped-def]
         gf = _gains(B[tr], Q)
         unit = _scale(gf, A[tr], B[tr], G[labels != f], gd[labels != f])
 
-        def mean_square(h, Q=Q, R=R, cols=cols, tr=tr, te=te):  # type: ignore[no-untyped-def]
+        def mean_square(h, Q=Q, R=R, cols=cols, tr=tr, te=te):
             y = B @ h
             x = scipy.linalg.solve_triangular(R, Q.T @ y[tr])
             return float(np.mean((y[te] - (A[te] / norms)[:, cols] @ x) ** 2))
@@ -123,10 +123,10 @@ def main(argv: list[str] | None = None) -> dict:
         W, tau, s, G, gd = _log(samples)
         labels = block_labels(samples, DEFAULT_FOLDS)
 
-        def ours(W=W, tau=tau, s=s, G=G, gd=gd, labels=labels):  # type: ignore[no-untyped-def]
+        def ours(W=W, tau=tau, s=s, G=G, gd=gd, labels=labels):
             return drive_gains(W, tau, s, None, G, gd, labels)
 
-        def ref(W=W, tau=tau, s=s, G=G, gd=gd, labels=labels):  # type: ignore[no-untyped-def]
+        def ref(W=W, tau=tau, s=s, G=G, gd=gd, labels=labels):
             return explicit(W, tau, s, G, gd, labels)
 
         found, (factor, gain, se) = ours(), ref()
