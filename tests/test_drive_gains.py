@@ -311,3 +311,97 @@ def test_a_gain_the_error_ignores_is_said_and_its_scale_unknown(panda):
     assert said is not None and re.search(r"joint 7's 0\.8\d+ \(std 0\.0\d+, 0\.0\d+ over", said)
     assert "not named: holding it at 1 leaves the error as it is" in said, said
     assert ignored.as_dict()["unknown_scale"] == [6]
+
+
+def _rank_deficient(rng: np.random.Generator, rows: int, p: int, m: int):
+    """Model columns ``A`` (rows, p) spanning less than ``p``: column 1 a multiple of 0
+    plus column 2, column 3 zero (a joint that never moved); efforts ``B`` (rows, m)
+    partly in their span; column scales from 1e-3 to 1e2."""
+    A = rng.normal(size=(rows, p)) * np.logspace(-3, 2, p)
+    A[:, 1] = 3.0 * A[:, 0] + A[:, 2]
+    A[:, 3] = 0.0
+    B = A @ rng.normal(size=(p, m)) + rng.normal(size=(rows, m))
+    return A, B
+
+
+def test_fold_fits_from_stacked_factors_equal_the_explicit_least_squares():
+    """Each fold's fit from the factors of the other folds' rows stacked (the projected
+    efforts' normal matrix, their rank, the gains' eigenvector, the least-norm solution of
+    the common scale, the held-out mean square) equals ``lstsq`` and ``eigh`` on the
+    explicit training and test rows to round-off, with rank-deficient model columns, a
+    free effort column beside them, a fold of fewer rows than columns and one of several
+    row blocks."""
+    import scipy.linalg
+
+    from dynid.identification.drive_gains import _columns, _fold_rows, _Rows, _smallest
+
+    rng = np.random.default_rng(31)
+    p, m = 9, 4
+    A, B = _rank_deficient(rng, 5000, p, m)
+    labels = np.repeat([0, 1, 2, 3], [3000, 10, 1200, 790])  # 10 rows < 13 columns
+    parts = _fold_rows(A, B, labels)
+    D = np.concatenate([A, B], axis=1)
+    norms = np.linalg.norm(D, axis=0)
+    norms[norms == 0] = 1.0
+    active = np.array([True, False, True, True])  # effort 1 a free column
+    x, y = _columns(p, active)
+    C = np.diag(rng.uniform(0.5, 2.0, size=3))
+    for f in range(4):
+        tr, te = labels != f, labels == f
+        train = _Rows.stacked([q for j, q in enumerate(parts) if j != f])
+        fold = train.split(x, y, norms)
+        X, Y = D[tr][:, x], D[tr][:, y]
+        P = Y - X @ np.linalg.lstsq(X, Y, rcond=None)[0]
+        S = P.T @ P
+        assert fold.rank == np.linalg.matrix_rank(X / norms[x]) == p - 1  # p - 2, the free one
+        np.testing.assert_allclose(fold.S, S, rtol=1e-9, atol=1e-9 * np.abs(S).max())
+        lam, V = scipy.linalg.eigh(S, C)
+        g = V[:, 0] * np.sign(V[:, 0].sum())
+        np.testing.assert_allclose(_smallest(fold.S, C)[2], g, rtol=1e-8, atol=1e-10)
+        h = rng.normal(size=3)
+        x_ls = np.linalg.lstsq(X, Y @ h, rcond=None)[0]  # the least-norm solution
+        np.testing.assert_allclose(train.lstsq(x, y, h), x_ls, rtol=1e-8, atol=1e-12)
+        r = D[te][:, y] @ h - D[te][:, x] @ x_ls
+        got = parts[f].mean_square(fold.residual(h))
+        assert got == pytest.approx(float(np.mean(r**2)), rel=1e-9)
+
+
+def test_held_out_gains_equal_a_plain_computation_on_the_explicit_rows(panda):
+    """``heldout_gain``, ``heldout_se`` and ``ratio_fixed`` of a log with a duplicated
+    model column and one that is zero equal the plain computation on the explicit rows:
+    per fold, ``lstsq`` of the training rows, the smallest eigenvector of the projected
+    efforts' normal matrix (joint-side: ``C = I``), the test rows' mean square with every
+    gain fitted and with each held at 1 (the geometric mean of the fold's gains)."""
+    import scipy.linalg
+
+    rng = np.random.default_rng(13)
+    W, _, _, tau = _panda_columns(panda, 13, n=300)
+    W = np.concatenate([W, W[:, :, :1], np.zeros_like(W[:, :, :1])], axis=-1)
+    truth = np.array([1.0, 1.5, 1.0, 0.7, 1.0, 1.2, 1.0])
+    noise = 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    logged = tau / truth + rng.normal(size=tau.shape) * noise
+    labels = np.repeat(np.arange(4), 75)
+    found = drive_gains(W, logged, noise, folds=labels)
+    assert found is not None and found.heldout_gain is not None and found.determined.all()
+    N, n, p = W.shape
+    A = (W / noise[:, None]).reshape(N * n, p)
+    B = (effort_columns(logged) / noise[:, None]).reshape(N * n, n)
+    rows = np.repeat(labels, n)
+    P = B - A @ np.linalg.lstsq(A, B, rcond=None)[0]
+    dof = N * n - np.linalg.matrix_rank(A) - (n - 1)
+    assert found.ratio_fixed == pytest.approx(np.sqrt(np.sum(P.sum(axis=1) ** 2) / dof), 1e-9)
+    diffs = []
+    for f in range(4):
+        tr, te = rows != f, rows == f
+        fit = np.linalg.lstsq(A[tr], B[tr], rcond=None)[0]
+        Pt = B[tr] - A[tr] @ fit
+        V = scipy.linalg.eigh(Pt.T @ Pt)[1]
+        g = V[:, 0] * np.sign(V[:, 0].sum())
+        unit = np.exp(np.mean(np.log(g)))
+        Pe = B[te] - A[te] @ fit  # the test rows less the training fit, per effort
+        held = [np.where(np.arange(n) == k, unit, g) for k in range(n)]
+        diffs.append([np.mean((Pe @ h) ** 2) - np.mean((Pe @ g) ** 2) for h in held])
+    D = np.asarray(diffs)
+    np.testing.assert_allclose(found.heldout_gain, D.mean(axis=0), rtol=1e-8, atol=1e-12)
+    se = D.std(axis=0, ddof=1) / 2.0
+    np.testing.assert_allclose(found.heldout_se, se, rtol=1e-8, atol=1e-12)

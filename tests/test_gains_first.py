@@ -25,7 +25,7 @@ from dynid.dynamics.terms import gravity_torques
 from dynid.exceptions import DynidWarning
 from dynid.friction.laws import LAWS
 from dynid.friction.model import ClassicalFriction, LawFriction
-from dynid.identification.drive_gains import _column_space, _Factored, drive_gains
+from dynid.identification.drive_gains import drive_gains
 from dynid.identification.structure import Structure
 from dynid.io.feasible import load_feasible_json
 from dynid.io.feasible_bundle import save_feasible_bundle
@@ -279,20 +279,6 @@ def test_a_negative_rotor_inertia_is_warned_with_its_joint_and_cause(panda, tmp_
     said = [str(w.message) for w in caught if "rotor inertia Ia4 of joint 4" in str(w.message)]
     assert said and "is negative" in said[0] and "wrong scale on that joint" in said[0], said
     assert any("Ia4 of joint 4 is negative" in note for note in got.model.info.notes)
-
-
-def test_the_folds_fit_from_one_qr_is_the_pseudo_inverses():
-    """A fold's prediction from the pivoted QR of its training columns equals
-    ``X[te] pinv(X[tr]) y[tr]`` to round-off, and its ``Q`` spans the columns' space."""
-    rng = np.random.default_rng(21)
-    X = rng.normal(size=(300, 12)) * np.logspace(-3, 2, 12)
-    y = X @ rng.normal(size=12) + rng.normal(size=300)
-    tr, te = np.arange(300) < 240, np.arange(300) >= 240
-    fold = _Factored.of(X[tr])
-    r = y[te] - X[te] @ (np.linalg.pinv(X[tr], rcond=1e-10) @ y[tr])
-    assert fold.score(y, X, tr, te) == pytest.approx(float(np.mean(r**2)), rel=1e-9)
-    Q = _column_space(X[tr])
-    np.testing.assert_allclose(fold.Q @ (fold.Q.T @ y[tr]), Q @ (Q.T @ y[tr]), atol=1e-9)
 
 
 def test_a_factor_of_a_joint_that_barely_moves_is_not_determined(panda):

@@ -47,7 +47,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .solvers import tall_pivoted_qr
+from .solvers import tall_r
 
 __all__ = [
     "DETERMINED",
@@ -527,17 +527,22 @@ def drive_gains(
         return None
     A = (W / s[:, None]).reshape(N * n, p)
     B = (E / s[:, None]).reshape(N * n, m)
-    Q = _column_space(A)
+    labels = _fold_labels(N, folds)
+    parts = None if labels is None else _fold_rows(A, B, np.repeat(labels, n))
+    whole = _Rows.of(A, B) if parts is None else _Rows.stacked(parts)
+    norms = np.concatenate([np.linalg.norm(A, axis=0), np.linalg.norm(B, axis=0)])
+    norms[norms == 0] = 1.0  # the columns' pivoted QR scaled (a zero column as it is)
     ones = np.ones(m)
-    P = B - Q @ (Q.T @ B)  # the efforts with the model's columns projected out
-    dof = N * n - Q.shape[1] - (m - 1)
-    fixed = float(ones @ P.T @ P @ ones) / max(dof, 1)
+    # the efforts with the model's columns projected out
+    model = whole.split(*_columns(p, np.ones(m, dtype=bool)), norms)
+    dof = N * n - model.rank - (m - 1)
+    fixed = model.square(ones) / max(dof, 1)
     if not fixed > 0:
         return None
     C = _noise_covariance(s, transmission)
-    active = _linked(A, B, C, N)
+    active = _linked(whole, norms, C, N)
     while True:
-        fit = _Eigen.of(A, B, C, W, active, gravity_columns, gravity)
+        fit = _Eigen.of(whole, norms, B, C, active, gravity_columns, gravity)
         loose = active & ~fit.sure()
         if not loose.any() or active.sum() - loose.sum() < 2:
             break
@@ -545,14 +550,13 @@ def drive_gains(
     factor, cov, scaled, g = fit.factor, fit.cov, fit.scaled, fit.g
     if np.any(factor[active] <= 0):  # a motor of the opposite sign: the sign checks name it
         return None
-    Qa, dof, fitted = fit.Q, fit.dof, fit.fitted
-    held = _held_ratios(factor, g, active, B, Qa, dof)
-    labels = _fold_labels(N, folds)
+    held = _held_ratios(factor, g, active, fit.split, fit.dof)
     G = None if gravity_columns is None else np.asarray(gravity_columns, dtype=np.float64)
     gd = None if gravity is None else np.asarray(gravity, dtype=np.float64)
     gain = se = spread = None
-    if labels is not None:
-        gain, se, spread = _heldout(A, B, C, active, labels, G, gd, factor)
+    if labels is not None and parts is not None:
+        gain, se, spread = _heldout(parts, norms, C, active, labels, G, gd, factor)
+    fitted = fit.fitted
     found = DriveGains(
         factor, cov, scaled, float(np.sqrt(fixed)), float(np.sqrt(fitted)), held,
         heldout_gain=gain, heldout_se=se, heldout_std=spread,
@@ -584,33 +588,34 @@ class _Eigen:
     """The gains of the ``active`` motors fitted in-sample (:func:`drive_gains`), the
     others' efforts free columns beside the model's: ``g`` at the efforts' energy,
     ``factor`` and ``cov`` (m,) at the common scale (NaN on the motors left out),
-    ``scaled`` as :func:`_common_scale` says, the basis ``Q`` of the columns projected
-    out, the residual's degrees of freedom and its mean square per row with the gains
-    fitted (``fitted``)."""
+    ``scaled`` as :func:`_common_scale` says, the model's columns and the free efforts
+    fitted to the active efforts (``split``), the residual's degrees of freedom and its
+    mean square per row with the gains fitted (``fitted``)."""
 
     g: NDArray[np.float64]
     factor: NDArray[np.float64]
     cov: NDArray[np.float64]
     scaled: bool
-    Q: NDArray[np.float64]
+    split: _Split
     dof: int
     fitted: float
 
     @classmethod
     def of(
         cls,
-        A: NDArray[np.float64],
+        whole: _Rows,
+        norms: NDArray[np.float64],
         B: NDArray[np.float64],
         C: NDArray[np.float64],
-        W: NDArray[np.float64],
         active: NDArray[np.bool_],
         gravity_columns: ArrayLike | None,
         gravity: ArrayLike | None,
     ) -> _Eigen:
         m = B.shape[1]
-        Qa = _column_space(np.concatenate([A, B[:, ~active]], axis=1))
-        S, lam, V, g = _smallest(B[:, active], Qa, C[np.ix_(active, active)])
-        dof = B.shape[0] - Qa.shape[1] - (int(active.sum()) - 1)
+        p = whole.R.shape[1] - m
+        split = whole.split(*_columns(p, active), norms)
+        lam, V, g = _smallest(split.S, C[np.ix_(active, active)])
+        dof = whole.rows - split.rank - (int(active.sum()) - 1)
         var = max(float(lam[0]), 0.0) / max(dof, 1)  # per row, at g' C g = 1
         gap = np.maximum(lam[1:] - lam[0], 1e-300)
         cov_a = (V[:, 1:] / gap) @ V[:, 1:].T * var
@@ -618,15 +623,14 @@ class _Eigen:
         c = float(np.linalg.norm(B[:, active] @ np.ones(int(active.sum()))))
         c /= max(float(np.linalg.norm(B[:, active] @ g)), 1e-300)
         g = g * c
-        # a sum of squares: below zero only by round-off (a log exact to round-off)
-        fitted = max(float(g @ S @ g), 0.0) / max(dof, 1)
+        fitted = split.square(g) / max(dof, 1)
         full = np.full(m, np.nan)
         full[active] = g
-        factor, scaled = _common_scale(full, W, B, A, gravity_columns, gravity)
+        factor, scaled = _common_scale(full, whole, p, gravity_columns, gravity)
         c *= float(np.linalg.norm(factor[active]) / np.linalg.norm(g))
         cov = np.full((m, m), np.nan)
         cov[np.ix_(active, active)] = cov_a * c**2
-        return cls(g, factor, cov, scaled, Qa, dof, fitted)
+        return cls(g, factor, cov, scaled, split, dof, fitted)
 
     def sure(self) -> NDArray[np.bool_]:
         """The motors (m,) whose gain is fitted and determined in-sample (relative standard
@@ -654,8 +658,8 @@ def _fold_labels(samples: int, folds: ArrayLike | None) -> NDArray[np.intp] | No
 
 
 def _heldout(
-    A: NDArray[np.float64],
-    B: NDArray[np.float64],
+    parts: list[_Rows],
+    norms: NDArray[np.float64],
     C: NDArray[np.float64],
     active: NDArray[np.bool_],
     labels: NDArray[np.intp],
@@ -668,29 +672,26 @@ def _heldout(
     fitted on every row: the description's, else the same geometric mean over the active
     motors; jackknife ``(K - 1) / K sum (g_f - mean g)^2`` over the ``K`` folds): on
     each fold, the gains (of the ``active`` motors; the others' efforts free columns beside
-    the model's ``A``) and the parameters fitted on the other folds' rows, the fold's
-    weighted residual's mean square with every gain as fitted and with motor ``k``'s held
-    at 1 (the description's scale from ``G``, ``gd`` on the training rows, else the
-    geometric mean), the parameters fitted again on the training rows."""
-
-    n = B.shape[0] // labels.size
-    rows = np.repeat(labels, n)
+    the model's) and the parameters fitted on the other folds' rows (``parts``: each
+    fold's rows factored, in the order of ``np.unique(labels)``), the fold's weighted
+    residual's mean square with every gain as fitted and with motor ``k``'s held at 1 (the
+    description's scale from ``G``, ``gd`` on the training rows, else the geometric mean),
+    the parameters fitted again on the training rows."""
+    m = active.size
+    p = parts[0].R.shape[1] - m
+    x, y = _columns(p, active)
     motors = np.flatnonzero(active)
     diffs: list[NDArray[np.float64]] = []
     gains: list[NDArray[np.float64]] = []
-    X = np.concatenate([A, B[:, ~active]], axis=1)
-    scale = np.linalg.norm(X, axis=0)
-    X = X / np.where(scale > 0, scale, 1.0)
-    Ba = B[:, active]
-    for f in np.unique(labels):
-        tr, te = rows != f, rows == f
-        fold = _Factored.of(X[tr])
-        g = _smallest(Ba[tr], fold.Q, C[np.ix_(active, active)])[3]
-        full = np.full(B.shape[1], np.nan)
+    for i, f in enumerate(np.unique(labels)):
+        train = _Rows.stacked([q for j, q in enumerate(parts) if j != i])
+        fold = train.split(x, y, norms)
+        g = _smallest(fold.S, C[np.ix_(active, active)])[2]
+        full = np.full(m, np.nan)
         full[active] = g
         ts = labels != f
         factor, scaled = _common_scale(
-            full, A, B[tr], A[tr], None if G is None else G[ts], None if gd is None else gd[ts]
+            full, train, p, None if G is None else G[ts], None if gd is None else gd[ts]
         )
         if not np.all(factor[active] > 0):
             continue
@@ -698,14 +699,14 @@ def _heldout(
             factor = factor * np.exp(np.mean(np.log(whole[active] / factor[active])))
         gains.append(factor)
         unit = g / factor[active]  # a gain of 1 at the scale of g, per motor (all equal)
-        base = fold.score(Ba @ g, X, tr, te)
-        d = np.full(B.shape[1], np.nan)
-        for i, k in enumerate(motors):
+        test = parts[i]
+        base = test.mean_square(fold.residual(g))
+        d = np.full(m, np.nan)
+        for r, k in enumerate(motors):
             h = g.copy()
-            h[i] = unit[i]
-            d[k] = fold.score(Ba @ h, X, tr, te) - base
+            h[r] = unit[r]
+            d[k] = test.mean_square(fold.residual(h)) - base
         diffs.append(d)
-    m = B.shape[1]
     if len(diffs) < 2:
         return np.full(m, np.nan), np.full(m, np.nan), np.full(m, np.nan)
     D, F = np.asarray(diffs), np.asarray(gains)
@@ -715,66 +716,150 @@ def _heldout(
 
 
 def _smallest(
-    Ba: NDArray[np.float64], Q: NDArray[np.float64], C: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """The efforts' normal matrix ``S`` with the orthonormal columns ``Q`` projected out of
-    ``Ba``, the generalized eigenvalues and eigenvectors of ``(S, C)`` (``V' C V = I``),
+    S: NDArray[np.float64], C: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The generalized eigenvalues and eigenvectors of ``(S, C)`` (``V' C V = I``; ``S``
+    the efforts' normal matrix with the model's columns projected out, :attr:`_Split.S`)
     and the gains: the eigenvector of the smallest, its sign making them sum positive."""
     import scipy.linalg  # here: the command's start loads no scipy
 
-    P = Ba - Q @ (Q.T @ Ba)
-    S = P.T @ P
     lam, V = scipy.linalg.eigh(S, C)
-    return S, lam, V, V[:, 0] * np.sign(np.sum(V[:, 0]))
+    return lam, V, V[:, 0] * np.sign(np.sum(V[:, 0]))
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class _Factored:
-    """A fold's training columns ``X[tr]`` factored once by pivoted QR (rank from the
-    diagonal at relative tolerance :data:`_RANK_RTOL`; the columns scaled beforehand):
-    ``X[tr][:, cols] = Q R``, ``Q`` (rows, r) orthonormal, ``R`` (r, r) upper triangular.
-    ``Q`` is the projection of :func:`_smallest`, ``R`` the least-squares solve of
-    :meth:`score` (the pseudo-inverse's fit where ``X[tr]`` has full column rank)."""
+class _Rows:
+    """Rows of the model's columns and the efforts, ``D = [A | B]`` (rows, k), held as the
+    upper triangular factor ``R`` (k, k) of their QR ``D = Q R`` (``Q`` never formed):
+    ``Q`` keeps norms, so a least-squares fit of some of ``D``'s columns to others is the
+    same fit of those columns of ``R``, and the factor of several sets of rows is that of
+    their factors stacked (tall-skinny QR, :func:`~dynid.identification.solvers.tall_r`;
+    Demmel et al. 2012). One pass over each fold's rows serves every fit on them."""
 
-    Q: NDArray[np.float64]
     R: NDArray[np.float64]
-    cols: NDArray[np.intp]
+    rows: int
 
     @classmethod
-    def of(cls, X: NDArray[np.float64]) -> _Factored:
-        """The factors of ``X`` (rows, p)."""
-        Q, R, piv = tall_pivoted_qr(X)
-        d = np.abs(np.diag(R))
-        r = int(np.count_nonzero(d > _RANK_RTOL * max(float(d[0]) if d.size else 0.0, 1e-300)))
-        return cls(np.asarray(Q[:, :r]), np.asarray(R[:r, :r]), np.asarray(piv[:r]))
+    def of(cls, A: NDArray[np.float64], B: NDArray[np.float64]) -> _Rows:
+        """The factor of ``[A | B]`` (rows, k)."""
+        return cls(_square(tall_r(A, np.ones(A.shape[1]), B)), A.shape[0])
 
-    def score(
-        self,
-        y: NDArray[np.float64],
-        X: NDArray[np.float64],
-        tr: NDArray[np.bool_],
-        te: NDArray[np.bool_],
-    ) -> float:
-        """The mean square [-] over the rows ``te`` of the weighted torques ``y`` less the
-        columns ``X`` fitted to them on the rows ``tr`` (the rows factored)."""
+    @classmethod
+    def stacked(cls, parts: list[_Rows]) -> _Rows:
+        """The factor of the rows of ``parts`` together."""
+        if len(parts) == 1:
+            return parts[0]
+        R = np.vstack([q.R for q in parts])
+        k = R.shape[1]
+        R = _square(tall_r(R[:, : k - 1], np.ones(k - 1), R[:, k - 1]))
+        return cls(R, sum(q.rows for q in parts))
+
+    def split(self, x: NDArray[np.intp], y: NDArray[np.intp], norms: NDArray[np.float64]) -> _Split:
+        """The columns ``x`` of ``D`` (scaled by ``norms[x]``) fitted to the columns ``y``:
+        the pivoted QR of ``R[:, x] / norms[x]`` (the same factor and pivots as that of
+        the rows themselves, :func:`~dynid.identification.solvers.tall_pivoted_qr`), its
+        rank from the diagonal at relative tolerance :data:`_RANK_RTOL`."""
         import scipy.linalg
 
-        x = scipy.linalg.solve_triangular(self.R, self.Q.T @ y[tr])
-        r = y[te] - X[te][:, self.cols] @ x
-        return float(np.mean(r**2))
+        Q, R, piv = scipy.linalg.qr(self.R[:, x] / norms[x], pivoting=True)
+        d = np.abs(np.diag(R))
+        r = int(np.count_nonzero(d > _RANK_RTOL * max(float(d[0]) if d.size else 0.0, 1e-300)))
+        T = Q.T @ self.R[:, y]
+        cols = x[piv[:r]]
+        return _Split(R[:r, :r], cols, norms[cols], T[:r], T[r:], y, self.R.shape[1])
+
+    def lstsq(
+        self, x: NDArray[np.intp], y: NDArray[np.intp], h: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """The least-squares solution of least norm (SVD, ``np.linalg.lstsq``'s cut-off of
+        the rows themselves) of the columns ``x`` of ``D`` fitted to ``D[:, y] @ h``."""
+        rcond = np.finfo(np.float64).eps * max(self.rows, x.size)
+        x_ls = np.linalg.lstsq(self.R[:, x], self.R[:, y] @ h, rcond=rcond)[0]
+        return np.asarray(x_ls, dtype=np.float64)
+
+    def mean_square(self, v: NDArray[np.float64]) -> float:
+        """The mean square over the rows of ``D @ v``, ``v`` (k,)."""
+        return float(np.sum((self.R @ v) ** 2)) / self.rows
+
+
+def _square(R: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The factor ``R`` (r, k) of rows fewer than its columns (r < k) padded with zero rows
+    to (k, k)."""
+    k = R.shape[1]
+    if R.shape[0] >= k:
+        return R[:k]
+    return np.vstack([R, np.zeros((k - R.shape[0], k))])
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Split:
+    """Columns ``x`` of factored rows :class:`_Rows` fitted to columns ``y``: ``R`` (r, r)
+    the triangular factor of the ``r`` independent columns ``cols`` (pivot order, scaled
+    by ``norms``), ``T`` (r, q) the ``y`` columns in their orthonormal basis, ``rest``
+    (k - r, q) the ``y`` columns' part outside it (the efforts with the model's columns
+    projected out: ``rest' rest`` their normal matrix ``S``)."""
+
+    R: NDArray[np.float64]
+    cols: NDArray[np.intp]
+    norms: NDArray[np.float64]
+    T: NDArray[np.float64]
+    rest: NDArray[np.float64]
+    y: NDArray[np.intp]
+    k: int
+
+    @property
+    def rank(self) -> int:
+        """The rank of the ``x`` columns."""
+        return int(self.R.shape[0])
+
+    @property
+    def S(self) -> NDArray[np.float64]:
+        """The ``y`` columns' normal matrix (q, q) with the ``x`` columns projected out."""
+        return self.rest.T @ self.rest
+
+    def square(self, h: NDArray[np.float64]) -> float:
+        """``h' S h``: the sum of squares of ``D[:, y] @ h`` less the ``x`` columns fitted."""
+        return float(np.sum((self.rest @ h) ** 2))
+
+    def residual(self, h: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The coefficients (k,) of ``D``'s columns that give ``D[:, y] @ h`` less the
+        ``x`` columns fitted to it (the basic solution of the pivoted QR: the
+        pseudo-inverse's fit where the ``x`` columns have full rank)."""
+        import scipy.linalg
+
+        v = np.zeros(self.k)
+        v[self.y] = h
+        if self.rank:
+            v[self.cols] -= scipy.linalg.solve_triangular(self.R, self.T @ h) / self.norms
+        return v
+
+
+def _columns(p: int, active: NDArray[np.bool_]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The columns of ``D = [A | B]`` (``A``: ``p`` model columns) fitted, the model's and
+    the efforts of the motors not ``active``, and those they are fitted to, the active
+    motors' efforts."""
+    x = np.concatenate([np.arange(p), p + np.flatnonzero(~active)])
+    return x, p + np.flatnonzero(active)
+
+
+def _fold_rows(
+    A: NDArray[np.float64], B: NDArray[np.float64], rows: NDArray[np.intp]
+) -> list[_Rows]:
+    """Each fold's rows of ``[A | B]`` factored (the folds in increasing order; ``rows``
+    the fold of each row)."""
+    return [_Rows.of(A[rows == f], B[rows == f]) for f in np.unique(rows)]
 
 
 def _held_ratios(
     factor: NDArray[np.float64],
     g: NDArray[np.float64],
     active: NDArray[np.bool_],
-    B: NDArray[np.float64],
-    Q0: NDArray[np.float64],
+    split: _Split,
     dof: int,
 ) -> NDArray[np.float64]:
     """Per motor, the weighted residual's RMS over the noise with its gain held at 1
     (:attr:`DriveGains.ratio_held`): ``g`` the gains of the ``active`` motors at the
-    scale of the efforts ``B``, ``factor`` at the description's, ``Q0`` the columns fitted
+    scale of the efforts, ``factor`` at the description's, ``split`` the columns fitted
     again."""
     motors = np.flatnonzero(active)
     unit = float(g[0] / factor[motors[0]])  # a gain of 1 at the scale of g
@@ -782,38 +867,29 @@ def _held_ratios(
     for i, k in enumerate(motors):
         h = g.copy()
         h[i] = unit
-        r = B[:, active] @ h
-        held[k] = np.sqrt(float(np.sum((r - Q0 @ (Q0.T @ r)) ** 2)) / max(dof, 1))
+        held[k] = np.sqrt(split.square(h) / max(dof, 1))
     return held
 
 
 def _linked(
-    A: NDArray[np.float64], B: NDArray[np.float64], C: NDArray[np.float64], samples: int
+    whole: _Rows, norms: NDArray[np.float64], C: NDArray[np.float64], samples: int
 ) -> NDArray[np.bool_]:
     """The motors (m,) whose effort keeps a part above the noise once the model's columns
-    ``A`` and the other left-out efforts are projected out (energy per row at least
+    and the other left-out efforts are projected out (energy per row at least
     :data:`LINKED` of the noise's, ``C``'s diagonal): the others' gains their own columns
     take (left out one at a time, the weakest first)."""
-    m = B.shape[1]
+    m = C.shape[0]
+    p = whole.R.shape[1] - m
     active = np.ones(m, dtype=bool)
     while active.sum() > 2:
-        Q = _column_space(np.concatenate([A, B[:, ~active]], axis=1))
-        P = B[:, active] - Q @ (Q.T @ B[:, active])
-        rows = samples * (1.0 - Q.shape[1] / B.shape[0])  # the samples the projection leaves
-        above = np.sum(P**2, axis=0) / (rows * np.diag(C)[active]) - 1.0
+        split = whole.split(*_columns(p, active), norms)
+        rows = samples * (1.0 - split.rank / whole.rows)  # the samples the projection leaves
+        above = np.sum(split.rest**2, axis=0) / (rows * np.diag(C)[active]) - 1.0
         k = int(np.argmin(above))
         if above[k] >= LINKED:
             break
         active[np.flatnonzero(active)[k]] = False
     return active
-
-
-def _column_space(A: NDArray[np.float64]) -> NDArray[np.float64]:
-    """An orthonormal basis of ``A``'s columns, its rank from the pivoted QR of the
-    scaled columns (relative tolerance :data:`_RANK_RTOL` on the diagonal)."""
-    scale = np.linalg.norm(A, axis=0)
-    scale[scale == 0] = 1.0
-    return _Factored.of(A / scale).Q
 
 
 def _noise_covariance(
@@ -835,23 +911,22 @@ def _noise_covariance(
 
 def _common_scale(
     g: NDArray[np.float64],
-    W: NDArray[np.float64],
-    B: NDArray[np.float64],
-    A: NDArray[np.float64],
+    rows: _Rows,
+    p: int,
     gravity_columns: ArrayLike | None,
     gravity: ArrayLike | None,
 ) -> tuple[NDArray[np.float64], bool]:
     """The gains ``g`` at the description's scale (the fitted parameters' gravity torques
     over the description's, pooled over the loaded joints) and True; without a description's
     gravity, at geometric mean 1 over the positive gains, and False. ``g`` is NaN on the
-    motors left out, whose efforts are free columns beside ``A``."""
+    motors left out, whose efforts are free columns beside the ``p`` model columns of
+    ``rows``."""
     fitted = np.isfinite(g)
     if gravity_columns is not None and gravity is not None:
         G = np.asarray(gravity_columns, dtype=np.float64)
         gd = np.asarray(gravity, dtype=np.float64)
-        X = np.concatenate([A, B[:, ~fitted]], axis=1)
-        x, *_ = np.linalg.lstsq(X, B[:, fitted] @ g[fitted], rcond=None)
-        gm = G @ x[: A.shape[1]]
+        x = rows.lstsq(*_columns(p, fitted), g[fitted])
+        gm = G @ x[:p]
         loaded = np.any(gd != 0, axis=0)
         d, f = gd[:, loaded].ravel(), gm[:, loaded].ravel()
         if d @ d > 0 and d @ f > 0:
