@@ -86,7 +86,7 @@ from .dissipation import (
     warn_unphysical,
 )
 from .estimator_choice import choose_estimator
-from .estimators import WLS, Estimator, EstimatorName, estimator_named
+from .estimators import OLS, WLS, Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut, fold_errors_percent, shared_eigen
 from .input_noise import exact_note, exact_to_round_off
 from .judge import heldout_judge
@@ -1236,11 +1236,9 @@ def identify_recordings(
         The drive train the logs were recorded through (:mod:`dynid.model.drive`); default:
         link-side torques of a direct drive.
     estimator, std
-        Least squares (:mod:`dynid.identification.estimators`); ``"auto"`` (default):
-        ordinary or weighted, chosen for the structure on its held-out folds
-        (:mod:`dynid.identification.estimator_choice`; the structure chosen with ordinary
-        least squares). Standard deviations ``"hac"`` (default), ``"robust"`` or
-        ``"classical"`` (:func:`~.core.identify`).
+        Least squares (:mod:`.estimators`; ``"auto"``: ols or wls chosen on the structure's
+        folds, :mod:`.estimator_choice`); standard deviations ``"hac"`` (default),
+        ``"robust"`` or ``"classical"`` (:func:`~.core.identify`).
     max_std_percent : float, optional
         Remove coefficients with a larger relative standard deviation [%] and re-fit.
     rtol : float, optional
@@ -1285,23 +1283,22 @@ def identify_recordings(
     prep = {"torque_delay_s": torque_delay_s, "cutoff_hz": cutoff_hz, "trim_s": trim_s}
     prep |= {"max_gap_s": max_gap_s, "decimate": decimate}
     data, validation = _recordings(robot, logs, names, validate_on, drive, **prep)
-    auto = isinstance(estimator, str) and estimator == "auto"
-    est = estimator_named("ols" if auto else estimator)
+    est = None if estimator == "auto" else estimator_named(estimator)  # None: chosen
     selection: Selection | None = None
     gone: _Gone = {}
     fitted = data
     if structure == "auto":
         selection, structure, fitted, validation, gone = _choose(
             robot, logs, data, validation, validate_on, drive, friction, keep_outlying,
-            estimator=est, folds=folds, rtol=rtol, prep=prep,
+            estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
         )  # fmt: skip
         selection = selection and replace(selection, notes=(*exact, *selection.notes))
-    kw: dict[str, Any] = {"estimator": est, "std": std, "base": base, "rtol": rtol}
+    kw: dict[str, Any] = {"estimator": est or OLS(), "std": std, "base": base, "rtol": rtol}
     model, terms, fitted, odd, given = _fitted_given(
         robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
         judge=selection is None, max_std_percent=max_std_percent, **kw,
     )  # fmt: skip
-    if auto:
+    if est is None:  # ols or wls, chosen on the folds of the structure fitted
         model = _estimator_chosen(
             robot, fitted, structure, drive, folds, validation, model, std=std, base=base,
             max_std_percent=max_std_percent, rtol=rtol,
