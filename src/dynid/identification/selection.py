@@ -1236,9 +1236,8 @@ def identify_recordings(
         The drive train the logs were recorded through (:mod:`dynid.model.drive`); default:
         link-side torques of a direct drive.
     estimator, std
-        Least squares (:mod:`.estimators`; ``"auto"``: ols or wls chosen on the structure's
-        folds, :mod:`.estimator_choice`); standard deviations ``"hac"`` (default),
-        ``"robust"`` or ``"classical"`` (:func:`~.core.identify`).
+        Least squares (``"auto"``: ols or wls chosen, :mod:`.estimator_choice`); standard
+        deviations ``"hac"`` (default), ``"robust"`` or ``"classical"`` (:func:`~.core.identify`).
     max_std_percent : float, optional
         Remove coefficients with a larger relative standard deviation [%] and re-fit.
     rtol : float, optional
@@ -1293,16 +1292,11 @@ def identify_recordings(
             estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
         )  # fmt: skip
         selection = selection and replace(selection, notes=(*exact, *selection.notes))
-    kw: dict[str, Any] = {"estimator": est or OLS(), "std": std, "base": base, "rtol": rtol}
-    model, terms, fitted, odd, given = _fitted_given(
+    kw: dict[str, Any] = {"std": std, "base": base, "rtol": rtol}
+    model, terms, fitted, odd, given = _fitted_chosen(
         robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
-        judge=selection is None, max_std_percent=max_std_percent, **kw,
+        judge=selection is None, max_std_percent=max_std_percent, estimator=est, **kw,
     )  # fmt: skip
-    if est is None:  # ols or wls, chosen on the folds of the structure fitted
-        model = _estimator_chosen(
-            robot, fitted, structure, drive, folds, validation, model, std=std, base=base,
-            max_std_percent=max_std_percent, rtol=rtol,
-        )  # fmt: skip
     warn_unphysical(model, terms)
     if selection is not None and structure == selection.chosen:
         selection = _per_recording_of(model, selection, gone)
@@ -1311,6 +1305,33 @@ def identify_recordings(
     model = _recorded(model, exact, combined, heldout, structure, selection, given)
     gone |= odd  # left out (or cut) by the choice (auto) or under the structure given
     return _with_left_out(model, data, gone, fitted) if gone else model
+
+
+def _fitted_chosen(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    data: Recordings,
+    structure: Structure,
+    drive: Drive | None,
+    folds: int,
+    validation: Recordings | None,
+    keep: bool,
+    prep: dict[str, Any],
+    *,
+    estimator: Estimator | None,
+    judge: bool,
+    **kw: Any,
+) -> tuple[IdentifiedModel, tuple[ModelTerm, ...], Recordings, _Gone, dict[str, Any]]:
+    """:func:`_fitted_given` with ``estimator``; None: with ols, then ols or wls chosen on
+    the folds of the recordings it fitted (:func:`_estimator_chosen`, ``kw`` as
+    :func:`_fitted` takes them)."""
+    model, terms, fitted, odd, given = _fitted_given(
+        robot, logs, data, structure, drive, folds, validation, keep, prep, judge=judge,
+        estimator=estimator or OLS(), **kw,
+    )  # fmt: skip
+    if estimator is None:
+        model = _estimator_chosen(robot, fitted, structure, drive, folds, validation, model, **kw)
+    return model, terms, fitted, odd, given
 
 
 def _fitted_given(
