@@ -114,7 +114,9 @@ def test_another_arms_log_is_judged_poor_naming_its_wrist(tmp_path, capsys):
     """Regression: a UR10 log identified with the UR5 model was "usable, with reservations"
     (pooled 9 x the floor) while its wrist joints erred 146-316 % held out; judged by
     validate's per-joint rule it is poor, the wrist joints named, in heldout.json, on the
-    console and in the report."""
+    console and in the report. (The estimator chosen is wls, weighing the wrists' small
+    noise: its wrist 1 errs 211 %, named with the hint of another robot's log; ols's three
+    wrists err 146-316 %.)"""
     ur10 = robot_data_urdf("ur_description/urdf/ur10_robot.urdf")
     ur5 = robot_data_urdf("ur_description/urdf/ur5_robot.urdf")
     log = tmp_path / "ur10.csv"
@@ -130,7 +132,9 @@ def test_another_arms_log_is_judged_poor_naming_its_wrist(tmp_path, capsys):
     said = capsys.readouterr().out
     verdict = _heldout(out)["verdict"]
     assert verdict["level"] == "poor", verdict
-    for name in ("wrist_1_joint", "wrist_2_joint", "wrist_3_joint"):
-        assert name in verdict["reason"] and name in said, verdict["reason"]
+    wrists = [n for n in ("wrist_1_joint", "wrist_2_joint", "wrist_3_joint") if n in said]
+    assert "wrist_1_joint" in wrists, verdict["reason"]
+    assert all(name in verdict["reason"] for name in wrists), verdict["reason"]
+    assert "a log of another robot" in verdict["reason"], verdict["reason"]
     assert "held-out verdict on " in said and "every sample: poor" in said
     assert '<section class="verdict poor"' in (out / "report.html").read_text()

@@ -237,12 +237,14 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--estimator",
-        choices=list(ESTIMATORS),
-        default="ols",
-        help="least squares: ordinary (default), weighted by each joint's (static: each row's) "
+        choices=[*ESTIMATORS, "auto"],
+        default="auto",
+        help="least squares: ordinary, weighted by each joint's (static: each row's) "
         "noise level from a first fit, or Huber-reweighted against outlying rows after "
         "filtering (one-sample torque spikes are replaced before filtering, whatever the "
-        "estimator, with a warning)",
+        "estimator, with a warning); auto (default): of torque logs, ols or wls chosen for "
+        "the chosen structure on its held-out folds, each joint in units of its own noise "
+        "(ols kept within one standard error), of static data ols",
     )
     p.add_argument(
         "--rtol",

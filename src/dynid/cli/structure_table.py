@@ -8,7 +8,7 @@ from typing import Any
 
 from ..identification.determined import determined_sentence
 
-__all__ = ["per_recording_lines", "selection_lines", "text_width"]
+__all__ = ["estimator_lines", "per_recording_lines", "selection_lines", "text_width"]
 
 
 def text_width(header: str, cells: Any, least: int = 0) -> int:
@@ -97,6 +97,27 @@ def per_recording_lines(record: Any, indent: str = "", given: bool = False) -> l
             for r in per
         )
     ]
+
+
+def estimator_lines(choice: Any) -> list[str]:
+    """The estimators judged on the chosen structure's held-out folds
+    (``metadata.estimator_choice``), the one kept marked ``*``: one line each."""
+    if not choice:
+        return []
+    cands = choice["candidates"]
+    out = [f"estimator chosen on the same held-out data: {choice['chosen']} ({choice['rule']})"]
+    out.append(
+        f"    {'estimator':<9} {'train %':>9} {'held-out %':>11} {'whitened %':>11} "
+        f"{'se vs best':>10}"
+    )
+    for c in cands:
+        mark = "*" if c["estimator"] == choice["chosen"] else " "
+        out.append(
+            f"  {mark} {c['estimator']:<9} {c['train_error_percent']:>9.4g} "
+            f"{c['heldout_error_percent']:>11.4g} {_or_nan(c['heldout_whitened_percent']):>11.4g} "
+            f"{_se_vs_best(c):>10}"
+        )
+    return out
 
 
 def _or_nan(x: float | None) -> float:

@@ -38,7 +38,7 @@ from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
 from ..regressors.base import identifiability
 from ..regressors.terms import LinearFriction
-from .structure_table import per_recording_lines, selection_lines, text_width
+from .structure_table import estimator_lines, per_recording_lines, selection_lines, text_width
 
 __all__ = [
     "format_consistent",
@@ -125,6 +125,7 @@ def format_identification(
     gravity = info.extra.get("gravity_fitted")  # the gravity vector a tilted base reads
     head += [f"note: {gravity['note']}"] if isinstance(gravity, dict) and "note" in gravity else []
     head += selection_lines(info.selection)
+    head += estimator_lines(info.estimator_choice)
     lw = text_width("name", model.base.labels[: model.base.rank], 7)
     head.append(f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}  kept  expression")
     rows = []

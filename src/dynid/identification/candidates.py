@@ -44,6 +44,7 @@ __all__ = [
     "recording_oddness",
     "relative_stds",
     "std_inflation",
+    "within_best",
     "without_recordings",
 ]
 
@@ -195,6 +196,16 @@ def paired_se(c: Candidate, best: Candidate) -> float:
     if c.part_scores and len(c.part_scores) == len(best.part_scores):
         return paired_fold_se(c.part_scores, best.part_scores)
     return paired_fold_se(c.fold_scores, best.fold_scores)
+
+
+def within_best(c: Candidate, best: Candidate) -> bool:
+    """Whether ``c`` predicts as well as ``best``: its held-out error (:attr:`Candidate.score`)
+    above the lowest by at most one standard error of the difference, paired over the
+    folds (:func:`paired_se`), or by less than :data:`RELATIVE_TIE` of the lowest (or
+    :data:`~.structure.ERROR_FLOOR_PERCENT`)."""
+    low = best.score
+    tie = max(paired_se(c, best), RELATIVE_TIE * low, ERROR_FLOOR_PERCENT)
+    return c.score <= low + tie
 
 
 def paired_fold_se(a: Sequence[float], b: Sequence[float]) -> float:

@@ -178,6 +178,11 @@ class IdentificationInfo:
         The model structure chosen on held-out data
         (:mod:`dynid.identification.selection`): ``rule``, ``validation``, ``chosen`` and
         every ``candidates`` entry with its parameters, training and held-out errors.
+    estimator_choice : mapping, optional
+        The estimator chosen on held-out data
+        (:class:`~dynid.identification.estimator_choice.EstimatorChoice`): ``rule``,
+        ``chosen`` and every ``candidates`` entry (``estimator`` with its training and
+        held-out errors); None when the estimator was given or not chosen.
     recordings : tuple of mapping
         Torque logs: each recording read (``file``, ``pieces``, ``samples``, ``duration_s``).
     notes : tuple of str
@@ -211,6 +216,7 @@ class IdentificationInfo:
     notes: tuple[str, ...] = ()
     extra: Mapping[str, Any] = field(default_factory=dict)
     selection: Mapping[str, Any] | None = None
+    estimator_choice: Mapping[str, Any] | None = None
     recordings: tuple[Mapping[str, Any], ...] = ()
     combined: Mapping[str, str] = field(default_factory=dict)
 

@@ -67,7 +67,6 @@ from ..signals import lowpass_noise_gain
 from .bumps import bump_widths
 from .candidates import (
     OUTLIER_RATIO,
-    RELATIVE_TIE,
     Candidate,
     Selection,
     candidate_judged,
@@ -75,6 +74,7 @@ from .candidates import (
     heldout_of,
     paired_se,
     recording_oddness,
+    within_best,
     without_recordings,
 )
 from .core import identify, model_columns, shared_bases
@@ -85,7 +85,8 @@ from .dissipation import (
     reversed_sign_finding,
     warn_unphysical,
 )
-from .estimators import Estimator, EstimatorName, estimator_named
+from .estimator_choice import choose_estimator
+from .estimators import OLS, WLS, Estimator, EstimatorName, estimator_named
 from .holdout import DEFAULT_FOLDS, HeldOut, fold_errors_percent, shared_eigen
 from .input_noise import exact_note, exact_to_round_off
 from .judge import heldout_judge
@@ -109,7 +110,6 @@ from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
 from .structural import absorbed_by
 from .structure import (
-    ERROR_FLOOR_PERCENT,
     Structure,
     candidate_columns,
     candidate_structures,
@@ -209,10 +209,8 @@ def _within(c: Candidate, best: Candidate) -> bool:
     """Whether ``c`` predicts as well as ``best``: its held-out error above the lowest by
     at most one standard error of the difference, paired over the folds
     (:func:`~.candidates.paired_se`), or by less than :data:`~.candidates.RELATIVE_TIE` of
-    the lowest (or :data:`~.structure.ERROR_FLOOR_PERCENT`)."""
-    low = best.score
-    tie = max(paired_se(c, best), RELATIVE_TIE * low, ERROR_FLOOR_PERCENT)
-    return c.score <= low + tie
+    the lowest (or :data:`~.structure.ERROR_FLOOR_PERCENT`): :func:`~.candidates.within_best`."""
+    return within_best(c, best)
 
 
 def _chosen(candidates: Sequence[Candidate]) -> Structure:
@@ -1198,7 +1196,7 @@ def identify_recordings(
     max_gap_s: float | None = None,
     decimate: int | None = None,
     drive: Drive | None = None,
-    estimator: EstimatorName | Estimator = "ols",
+    estimator: EstimatorName | Estimator | Literal["auto"] = "auto",
     std: StdMethod = "hac",
     max_std_percent: float | None = None,
     rtol: float | None = None,
@@ -1238,8 +1236,8 @@ def identify_recordings(
         The drive train the logs were recorded through (:mod:`dynid.model.drive`); default:
         link-side torques of a direct drive.
     estimator, std
-        Least squares (:mod:`dynid.identification.estimators`); standard deviations
-        ``"hac"`` (default), ``"robust"`` or ``"classical"`` (:func:`~.core.identify`).
+        Least squares (``"auto"``: ols or wls chosen, :mod:`.estimator_choice`); standard
+        deviations ``"hac"`` (default), ``"robust"`` or ``"classical"`` (:func:`~.core.identify`).
     max_std_percent : float, optional
         Remove coefficients with a larger relative standard deviation [%] and re-fit.
     rtol : float, optional
@@ -1263,7 +1261,7 @@ def identify_recordings(
     -------
     IdentifiedModel
         With ``info.selection`` (the candidates and the choice) when the structure was
-        chosen, and ``info.recordings``.
+        chosen, ``info.estimator_choice`` when the estimator was, and ``info.recordings``.
 
     Raises
     ------
@@ -1284,20 +1282,20 @@ def identify_recordings(
     prep = {"torque_delay_s": torque_delay_s, "cutoff_hz": cutoff_hz, "trim_s": trim_s}
     prep |= {"max_gap_s": max_gap_s, "decimate": decimate}
     data, validation = _recordings(robot, logs, names, validate_on, drive, **prep)
-    est = estimator_named(estimator)
+    est = None if estimator == "auto" else estimator_named(estimator)  # None: chosen
     selection: Selection | None = None
     gone: _Gone = {}
     fitted = data
     if structure == "auto":
         selection, structure, fitted, validation, gone = _choose(
             robot, logs, data, validation, validate_on, drive, friction, keep_outlying,
-            estimator=est, folds=folds, rtol=rtol, prep=prep,
+            estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
         )  # fmt: skip
         selection = selection and replace(selection, notes=(*exact, *selection.notes))
-    kw: dict[str, Any] = {"estimator": est, "std": std, "base": base, "rtol": rtol}
-    model, terms, fitted, odd, given = _fitted_given(
+    kw: dict[str, Any] = {"std": std, "base": base, "rtol": rtol}
+    model, terms, fitted, odd, given = _fitted_chosen(
         robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
-        judge=selection is None, max_std_percent=max_std_percent, **kw,
+        judge=selection is None, max_std_percent=max_std_percent, estimator=est, **kw,
     )  # fmt: skip
     warn_unphysical(model, terms)
     if selection is not None and structure == selection.chosen:
@@ -1307,6 +1305,33 @@ def identify_recordings(
     model = _recorded(model, exact, combined, heldout, structure, selection, given)
     gone |= odd  # left out (or cut) by the choice (auto) or under the structure given
     return _with_left_out(model, data, gone, fitted) if gone else model
+
+
+def _fitted_chosen(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    data: Recordings,
+    structure: Structure,
+    drive: Drive | None,
+    folds: int,
+    validation: Recordings | None,
+    keep: bool,
+    prep: dict[str, Any],
+    *,
+    estimator: Estimator | None,
+    judge: bool,
+    **kw: Any,
+) -> tuple[IdentifiedModel, tuple[ModelTerm, ...], Recordings, _Gone, dict[str, Any]]:
+    """:func:`_fitted_given` with ``estimator``; None: with ols, then ols or wls chosen on
+    the folds of the recordings it fitted (:func:`_estimator_chosen`, ``kw`` as
+    :func:`_fitted` takes them)."""
+    model, terms, fitted, odd, given = _fitted_given(
+        robot, logs, data, structure, drive, folds, validation, keep, prep, judge=judge,
+        estimator=estimator or OLS(), **kw,
+    )  # fmt: skip
+    if estimator is None:
+        model = _estimator_chosen(robot, fitted, structure, drive, folds, validation, model, **kw)
+    return model, terms, fitted, odd, given
 
 
 def _fitted_given(
@@ -1577,6 +1602,37 @@ def _fitted(
     except RankDeficientError as exc:
         raise _without_hint(exc, structure) from exc
     return model, terms
+
+
+def _estimator_chosen(
+    robot: Robot,
+    data: Recordings,
+    structure: Structure,
+    drive: Drive | None,
+    folds: int,
+    validation: Recordings | None,
+    plain: IdentifiedModel,
+    *,
+    rtol: float | None,
+    **kw: Any,
+) -> IdentifiedModel:
+    """Of ``plain`` (``structure`` fitted by ordinary least squares) and the weighted fit
+    of the same structure on the same folds (:func:`_fitted` with ``kw``), the one
+    :func:`~.estimator_choice.choose_estimator` keeps, its choice in its record
+    (``info.estimator_choice``); ``plain`` alone without held-out folds or the joints'
+    noise (nothing to judge on)."""
+    if plain.holdout is None or not plain.holdout.whitened:
+        return plain
+    with stage("the estimator's choice, the weighted fit", rows=data.n_rows):
+        weighted, _ = _fitted(
+            robot, data, structure, drive, folds, validation, estimator=WLS(), rtol=rtol, **kw
+        )  # fmt: skip
+    fits = [("ols", plain), ("wls", weighted)]
+    choice = choose_estimator(structure, fits, 1e-10 if rtol is None else rtol)
+    if choice is None:
+        return plain
+    kept = weighted if choice.chosen == "wls" else plain
+    return replace(kept, info=replace(kept.info, estimator_choice=choice.as_dict()))
 
 
 def _with_left_out(

@@ -235,6 +235,8 @@ def info_to_dict(info: IdentificationInfo, drive: Drive | None = None) -> dict[s
         out["notes"] = list(info.notes)
     if info.selection is not None:
         out["selection"] = dict(info.selection)
+    if info.estimator_choice is not None:
+        out["estimator_choice"] = dict(info.estimator_choice)
     if info.recordings:
         out["recordings"] = [dict(r) for r in info.recordings]
     if info.combined:
@@ -281,6 +283,9 @@ def info_from_dict(
             column_map=None if m.get("column_map") is None else dict(m.pop("column_map")),
             notes=tuple(str(x) for x in m.pop("notes", ())),
             selection=None if m.get("selection") is None else dict(m.pop("selection")),
+            estimator_choice=(
+                None if m.get("estimator_choice") is None else dict(m.pop("estimator_choice"))
+            ),
             recordings=tuple(dict(r) for r in m.pop("recordings", ())),
             combined={str(k): str(v) for k, v in dict(m.pop("combined", {})).items()},
             extra={k: v for k, v in m.items() if k not in _DERIVED_KEYS + _FRICTION_KEYS},

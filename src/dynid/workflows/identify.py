@@ -251,8 +251,10 @@ class IdentifyOptions:
     std : {"classical", "robust", "hac"}, optional
         Standard deviations (default robust for static data, hac for a log; with
         ``consistent`` too, those of the unconstrained fit it returns).
-    estimator : {"ols", "wls", "irls"}
-        Least squares: ordinary, weighted by the noise level, or Huber-reweighted.
+    estimator : {"auto", "ols", "wls", "irls"}
+        Least squares: ordinary, weighted by the noise level, or Huber-reweighted;
+        ``"auto"`` (default): of a torque log, ordinary or weighted chosen on held-out data
+        (:mod:`dynid.identification.estimator_choice`), of static data ordinary.
     drive : Drive, optional
         The drive train the data were recorded through.
     cutoff_hz : float or "none", optional
@@ -309,7 +311,7 @@ class IdentifyOptions:
     max_std_percent: float | None = None
     rtol: float | None = None
     std: StdMethod | None = None
-    estimator: EstimatorName = "ols"
+    estimator: EstimatorName | Literal["auto"] = "auto"
     drive: Drive | None = None
     cutoff_hz: Cutoff = None
     max_gap_s: float | None = None
@@ -327,6 +329,12 @@ class IdentifyOptions:
     margin: float | None = None
     total_mass: tuple[float, float] | None = None
 
+    @property
+    def static_estimator(self) -> EstimatorName:
+        """The estimator of static data: ``"auto"`` is ordinary least squares there (the
+        choice on held-out folds is made of torque logs)."""
+        return "ols" if self.estimator == "auto" else self.estimator
+
     def __post_init__(self) -> None:
         for name in ("max_std_percent", "max_gap_s"):
             check_number(self, name)
@@ -336,7 +344,7 @@ class IdentifyOptions:
         check_number(self, "prior_weight", low_open=False)
         check_number(self, "margin", low_open=False, high=0.25, high_open=True)
         check_count(self, "folds", low=2)
-        check_choice(self, "estimator", ESTIMATORS, optional=False)
+        check_choice(self, "estimator", (*ESTIMATORS, "auto"), optional=False)
         check_choice(self, "std", STD_METHODS)
         check_choice(self, "objective", ("logdet", "euclidean"))
         check_band(self, "total_mass")
@@ -732,7 +740,7 @@ def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> Identi
             rtol=opt.rtol,
             std=opt.std or "robust",
             drive=opt.drive,
-            estimator=opt.estimator,
+            estimator=opt.static_estimator,
         ),
     )
     misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
@@ -917,7 +925,7 @@ def _consistent_static(
             data,
             rtol=opt.rtol,
             drive=opt.drive,
-            estimator=opt.estimator,
+            estimator=opt.static_estimator,
             std=opt.std,
             prior=prior,
             total_mass=opt.total_mass,
