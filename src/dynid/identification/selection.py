@@ -103,8 +103,10 @@ from .outlying_spans import (
     cut_text,
     outlying_spans,
     spans_text,
+    widened_intervals,
     without_intervals,
 )
+from .own_bursts import own_bursts
 from .recordings import Recordings, prepare_recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
@@ -514,17 +516,27 @@ def _cut_out(
     those whose intervals the preparation would bridge (``data.max_gap_s``)."""
     out = {}
     for k, spans in found.items():
-        mine = [p for p, r in zip(data.pieces, data.recording, strict=True) if r == k]
-        if not mine or not spans:
+        edge = _cut_edges(data, k)
+        if edge is None or not spans:
             continue
-        t = np.concatenate([np.asarray(p.log.t, dtype=np.float64) for p in mine])
-        step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
-        margin = max(p.trim_s for p in mine) + step
-        raw = 1.0 / mine[0].sample_rate_hz
-        bridged = default_max_gap(raw) if data.max_gap_s is None else float(data.max_gap_s)
-        if cut := cut_intervals(spans, ratios.get(k, math.inf), t, margin, bridged):
+        if cut := cut_intervals(spans, ratios.get(k, math.inf), *edge):
             out[k] = cut
     return out
+
+
+def _cut_edges(data: Recordings, k: int) -> tuple[NDArray[np.float64], float, float] | None:
+    """Recording ``k``'s sample times [s] in ``data``, the widening [s] of a span cut out
+    of it (the filter's edge trimmed at a piece's ends and one decimated step) and the
+    longest gap [s] its preparation bridges (``data.max_gap_s``); None without pieces."""
+    mine = [p for p, r in zip(data.pieces, data.recording, strict=True) if r == k]
+    if not mine:
+        return None
+    t = np.concatenate([np.asarray(p.log.t, dtype=np.float64) for p in mine])
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    margin = max(p.trim_s for p in mine) + step
+    raw = 1.0 / mine[0].sample_rate_hz
+    bridged = default_max_gap(raw) if data.max_gap_s is None else float(data.max_gap_s)
+    return t, margin, bridged
 
 
 def cut_log(log: TorqueLog, cut: _Cut) -> TorqueLog:
@@ -1297,6 +1309,18 @@ def identify_recordings(
         robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
         judge=selection is None, max_std_percent=max_std_percent, estimator=est, **kw,
     )  # fmt: skip
+    if not gone and not keep_outlying and len(data.names) < 3:  # the outlying check: 3 or more
+        bursts = _burst_cuts(robot, model, terms, data)
+        if bursts:
+            selection, structure, fitted, validation, given = _chosen_with_cuts(
+                robot, logs, data, bursts, selection, structure, validate_on, drive,
+                friction, given, estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
+            )  # fmt: skip
+            model, terms, fitted, _, _ = _fitted_chosen(
+                robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
+                judge=False, max_std_percent=max_std_percent, estimator=est, **kw,
+            )  # fmt: skip
+            gone = bursts
     warn_unphysical(model, terms)
     if selection is not None and structure == selection.chosen:
         selection = _per_recording_of(model, selection, gone)
@@ -1305,6 +1329,79 @@ def identify_recordings(
     model = _recorded(model, exact, combined, heldout, structure, selection, given)
     gone |= odd  # left out (or cut) by the choice (auto) or under the structure given
     return _with_left_out(model, data, gone, fitted) if gone else model
+
+
+def _burst_cuts(
+    robot: Robot, model: IdentifiedModel, terms: Sequence[ModelTerm], data: Recordings
+) -> _Gone:
+    """The intervals [s] cut out of each recording of ``data`` whose residual under
+    ``model`` (fitted with ``terms`` on every recording, of one or two, where no recording
+    can be judged against the others) sits in a few short spans
+    (:func:`~.own_bursts.own_bursts`), widened as an outlying recording's are
+    (:func:`_cut_edges`, :func:`~.outlying_spans.widened_intervals`), said in one warning
+    (:func:`_warn_bursts`); empty where none is so.
+
+    Regression: a 6-DoF arm's one recording with a 20 N m burst on joint 2 for 0.1 s,
+    fitted whole: training error 10.97 % for a 1.12 % floor, a clean recording predicted
+    at 5.15 % (its floor 1.13 %), the burst named nowhere."""
+    found = own_bursts(robot, model, terms, data)
+    cuts: _Gone = {}
+    for k, spans in found.items():
+        edge = _cut_edges(data, k)
+        if edge is not None and (cut := widened_intervals(spans.spans, *edge)):
+            cuts[k] = cut
+    if cuts:
+        said = [
+            f"{found[k].sentence(robot.joint_names)}; {_cut_said(c, data.names[k])}"
+            for k, c in cuts.items()
+        ]
+        warnings.warn(
+            f"{', '.join(data.names[k] for k in cuts)}: the fit's own residual (in units of "
+            f"each joint's noise): {'; '.join(said)}; the structure is chosen and fitted "
+            "again on the rest",
+            DynidWarning,
+            stacklevel=3,
+        )
+    return cuts
+
+
+def _chosen_with_cuts(
+    robot: Robot,
+    logs: Sequence[TorqueLog],
+    data: Recordings,
+    cuts: _Gone,
+    selection: Selection | None,
+    structure: Structure,
+    validate_on: TorqueLog | None,
+    drive: Drive | None,
+    friction: tuple[str, ...] | None,
+    given: dict[str, Any],
+    *,
+    estimator: Estimator,
+    folds: int,
+    rtol: float | None,
+    prep: dict[str, Any],
+) -> tuple[Selection | None, Structure, Recordings, Recordings | None, dict[str, Any]]:
+    """The recordings of ``logs`` with the intervals ``cuts`` cut out of them prepared on
+    their own, the structure chosen again on them where it was chosen (``selection``,
+    :func:`_chosen_without`, its record holding the cuts as an outlying recording's)
+    or ``structure`` as given (its record ``given`` holding them); returns the selection,
+    the structure, the recordings, the separate validation prepared as they are and the
+    record of a structure given."""
+    cut = tuple((data.names[k], c) for k, c in cuts.items())
+    if selection is not None:
+        fitted, validation, chosen, structure = _chosen_without(
+            robot, logs, data, cuts, replace(selection, cut=cut), validate_on, drive,
+            friction, estimator=estimator, folds=folds, rtol=rtol, **prep,
+        )  # fmt: skip
+        return chosen, structure, fitted, validation, given
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # said when all were prepared
+        fitted, validation = _recordings(
+            robot, [cut_log(log, cuts.get(i, ())) for i, log in enumerate(logs)],
+            data.names, validate_on, drive, **prep,
+        )  # fmt: skip
+    return None, structure, fitted, validation, {**given, "cut_out_spans": cut_record(cut)}
 
 
 def _fitted_chosen(

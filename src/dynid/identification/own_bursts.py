@@ -1,0 +1,100 @@
+"""Short bursts in a fit's own residual: a contact or a logging fault in one or two recordings.
+
+Of three recordings or more, one holding torques no candidate models (a contact, a burst on
+one joint for a fraction of a second) is found by leaving each out in turn
+(:mod:`~dynid.identification.selection`); of one or two, that check cannot run. What is
+left is the fit's own residual: :func:`own_bursts` computes it for every recording (the
+torques as measured less the fitted model's, at the fit's samples), in units of each
+joint's own noise (the raw torque noise of each piece, through the low-pass where the
+residual is judged on filtered torques), and judges each by the rule of a validation
+(:func:`~dynid.identification.error_spans.error_spans`: at most
+:data:`~dynid.identification.error_spans.SHORT_SHARE` of its samples holding at least
+:data:`~dynid.identification.error_spans.MOST_SHARE` of its squared error above the
+noise). A clean recording stays near the noise; an effect the model lacks (a spring, a
+tilted base, unmodelled friction) spreads over the motion: neither is judged so. Times [s]
+as the logs hold them, torques [N m].
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.robot import Robot
+from ..regressors.terms import ModelTerm
+from ..signals import lowpass_noise_gain
+from .core import model_columns
+from .error_spans import ErrorSpans, error_spans
+from .model import IdentifiedModel
+from .recordings import Recordings
+
+__all__ = ["fit_residuals", "own_bursts"]
+
+
+def fit_residuals(
+    robot: Robot, model: IdentifiedModel, terms: Sequence[ModelTerm], data: Recordings
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]] | None:
+    """Each recording's sample times [s] (N,), the residual of ``model`` (fitted with
+    ``terms`` on ``data``) on its torques as measured [N m] (N, n), and each sample's
+    joints' noise [N m] (N, n): the raw torque noise of its piece, times the low-pass's
+    noise gain where the torques judged are filtered. None where a piece's noise is not
+    known or the rows do not match the samples."""
+    pieces = data.pieces
+    if any(p.torque_noise_std is None for p in pieces):
+        return None
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    x = np.asarray(fit.beta, dtype=np.float64)
+    columns = model_columns(robot, data, drive=model.drive, terms=tuple(terms), base=model.base)
+    rows = [blk.y - blk.W @ x for blk in data.measured_blocks(robot, columns)]
+    e = np.concatenate(rows) if rows else np.zeros(0)
+    n = data.n
+    if e.size != sum(p.log.n_samples for p in pieces) * n:
+        return None
+    out = []
+    o = 0
+    by_recording: dict[int, list[tuple[NDArray[np.float64], ...]]] = {}
+    for p, r in zip(pieces, data.recording, strict=True):
+        m = p.log.n_samples
+        gain = 1.0 if data.measured else lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz)
+        noise = np.broadcast_to(gain * np.asarray(p.torque_noise_std, dtype=np.float64), (m, n))
+        t = np.asarray(p.log.t, dtype=np.float64)
+        by_recording.setdefault(int(r), []).append((t, e[o : o + m * n].reshape(m, n), noise))
+        o += m * n
+    for k in range(len(data.names)):
+        mine = by_recording.get(k, [])
+        if not mine:
+            out.append((np.zeros(0), np.zeros((0, n)), np.zeros((0, n))))
+            continue
+        out.append(tuple(np.concatenate([part[i] for part in mine]) for i in range(3)))  # type: ignore[arg-type]
+    return out
+
+
+def own_bursts(
+    robot: Robot, model: IdentifiedModel, terms: Sequence[ModelTerm], data: Recordings
+) -> dict[int, ErrorSpans]:
+    """The recordings (indices into ``data.names``) whose residual under ``model`` (its own
+    fit, :func:`fit_residuals`) sits in a few short spans
+    (:func:`~dynid.identification.error_spans.error_spans` on the residual in units of each
+    joint's noise), each with those spans, their peaks [N m] as measured; empty where the
+    noise is not known or none is so."""
+    found = fit_residuals(robot, model, terms, data)
+    if found is None:
+        return {}
+    out = {}
+    starts = data.starts
+    for k, (t, e, noise) in enumerate(found):
+        if t.size == 0 or not np.all(noise > 0):
+            continue
+        t0 = starts[k] if k < len(starts) else None
+        spans = error_spans(t, e / noise, np.ones(e.shape[1]), data.names[k], t0)
+        if spans is None:
+            continue
+        peaks = []
+        for s in spans.spans:
+            inside = (t >= s.t0) & (t <= s.t1)
+            peaks.append(replace(s, peak=float(np.abs(e[inside][:, list(s.joints)]).max())))
+        out[k] = replace(spans, spans=tuple(peaks))
+    return out
