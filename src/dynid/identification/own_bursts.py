@@ -10,8 +10,10 @@ residual is judged on filtered torques), and judges each by the rule of a valida
 (:func:`~dynid.identification.error_spans.error_spans`: at most
 :data:`~dynid.identification.error_spans.SHORT_SHARE` of its samples holding at least
 :data:`~dynid.identification.error_spans.MOST_SHARE` of its squared error above the
-noise). A clean recording stays near the noise; an effect the model lacks (a spring, a
-tilted base, unmodelled friction) spreads over the motion: neither is judged so. Times [s]
+noise), no more than :data:`~dynid.identification.outlying_spans.SPANS_SHOWN` spans
+standing off (more recur with the motion: friction at each start of a point-to-point
+log's moves). A clean recording stays near the noise; an effect the model lacks (a
+spring, a tilted base) spreads over the motion: neither is judged so. Times [s]
 as the logs hold them, torques [N m].
 """
 
@@ -29,6 +31,7 @@ from ..signals import lowpass_noise_gain
 from .core import model_columns
 from .error_spans import ErrorSpans, error_spans
 from .model import IdentifiedModel
+from .outlying_spans import MIN_SHARE, SPANS_SHOWN, outlying_spans
 from .recordings import Recordings
 
 __all__ = ["fit_residuals", "own_bursts"]
@@ -89,7 +92,10 @@ def own_bursts(
         if t.size == 0 or not np.all(noise > 0):
             continue
         t0 = starts[k] if k < len(starts) else None
-        spans = error_spans(t, e / noise, np.ones(e.shape[1]), data.names[k], t0)
+        z = e / noise
+        if _recurring(t, z):
+            continue
+        spans = error_spans(t, z, np.ones(e.shape[1]), data.names[k], t0)
         if spans is None:
             continue
         peaks = []
@@ -98,3 +104,13 @@ def own_bursts(
             peaks.append(replace(s, peak=float(np.abs(e[inside][:, list(s.joints)]).max())))
         out[k] = replace(spans, spans=tuple(peaks))
     return out
+
+
+def _recurring(t: NDArray[np.float64], z: NDArray[np.float64]) -> bool:
+    """Whether more than :data:`~dynid.identification.outlying_spans.SPANS_SHOWN` spans of
+    the residual ``z`` (N, n) [noise units] at times ``t`` [s] stand off, each holding at
+    least :data:`~dynid.identification.outlying_spans.MIN_SHARE` of it: an effect that
+    recurs with the motion (friction at every start of a point-to-point log's moves), not
+    a burst."""
+    big = [s for s in outlying_spans(t, z) if s.share >= MIN_SHARE]
+    return len(big) > SPANS_SHOWN
