@@ -37,14 +37,22 @@ from .recordings import Recordings
 __all__ = ["fit_residuals", "own_bursts"]
 
 
+#: A recording's times [s] (N,), residual [N m] (N, n), noise [N m] (N, n) and joint
+#: velocities [rad/s] (N, n) at the fit's samples.
+_Residual = tuple[
+    NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]
+]
+
+
 def fit_residuals(
     robot: Robot, model: IdentifiedModel, terms: Sequence[ModelTerm], data: Recordings
-) -> list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]] | None:
+) -> list[_Residual] | None:
     """Each recording's sample times [s] (N,), the residual of ``model`` (fitted with
-    ``terms`` on ``data``) on its torques as measured [N m] (N, n), and each sample's
-    joints' noise [N m] (N, n): the raw torque noise of its piece, times the low-pass's
-    noise gain where the torques judged are filtered. None where a piece's noise is not
-    known or the rows do not match the samples."""
+    ``terms`` on ``data``) on its torques as measured [N m] (N, n), each sample's joints'
+    noise [N m] (N, n): the raw torque noise of its piece, times the low-pass's noise gain
+    where the torques judged are filtered, and the prepared joint velocities [rad/s]
+    (N, n). None where a piece's noise is not known or the rows do not match the
+    samples."""
     pieces = data.pieces
     if any(p.torque_noise_std is None for p in pieces):
         return None
@@ -64,37 +72,45 @@ def fit_residuals(
         gain = 1.0 if data.measured else lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz)
         noise = np.broadcast_to(gain * np.asarray(p.torque_noise_std, dtype=np.float64), (m, n))
         t = np.asarray(p.log.t, dtype=np.float64)
-        by_recording.setdefault(int(r), []).append((t, e[o : o + m * n].reshape(m, n), noise))
+        dq = np.asarray(p.log.dq, dtype=np.float64)
+        by_recording.setdefault(int(r), []).append((t, e[o : o + m * n].reshape(m, n), noise, dq))
         o += m * n
     for k in range(len(data.names)):
         mine = by_recording.get(k, [])
         if not mine:
-            out.append((np.zeros(0), np.zeros((0, n)), np.zeros((0, n))))
+            out.append((np.zeros(0), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n))))
             continue
-        out.append(tuple(np.concatenate([part[i] for part in mine]) for i in range(3)))  # type: ignore[arg-type]
+        out.append(tuple(np.concatenate([part[i] for part in mine]) for i in range(4)))  # type: ignore[arg-type]
     return out
 
 
 def own_bursts(
-    robot: Robot, model: IdentifiedModel, terms: Sequence[ModelTerm], data: Recordings
+    robot: Robot,
+    model: IdentifiedModel,
+    terms: Sequence[ModelTerm],
+    data: Recordings,
+    exact: bool = False,
 ) -> dict[int, ErrorSpans]:
     """The recordings (indices into ``data.names``) whose residual under ``model`` (its own
     fit, :func:`fit_residuals`) sits in a few short spans
     (:func:`~dynid.identification.error_spans.error_spans` on the residual in units of each
-    joint's noise), each with those spans, their peaks [N m] as measured; empty where the
-    noise is not known or none is so."""
-    found = fit_residuals(robot, model, terms, data)
+    joint's noise, the spans at a reversal of their joints left out: :func:`_at_reversals`),
+    each with those spans, their peaks [N m] as measured; empty where the noise is not
+    known, the logs are ``exact`` to round-off (no noise to judge against) or none is so."""
+    found = None if exact else fit_residuals(robot, model, terms, data)
     if found is None:
         return {}
     out = {}
     starts = data.starts
-    for k, (t, e, noise) in enumerate(found):
+    for k, (t, e, noise, dq) in enumerate(found):
         if t.size == 0 or not np.all(noise > 0):
             continue
-        t0 = starts[k] if k < len(starts) else None
         z = e / noise
-        if _recurring(t, z):
+        keep = ~_at_reversals(t, z, dq)
+        t, z, e = t[keep], z[keep], e[keep]
+        if t.size == 0 or _recurring(t, z):
             continue
+        t0 = starts[k] if k < len(starts) else None
         spans = error_spans(t, z, np.ones(e.shape[1]), data.names[k], t0)
         if spans is None:
             continue
@@ -103,6 +119,26 @@ def own_bursts(
             inside = (t >= s.t0) & (t <= s.t1)
             peaks.append(replace(s, peak=float(np.abs(e[inside][:, list(s.joints)]).max())))
         out[k] = replace(spans, spans=tuple(peaks))
+    return out
+
+
+def _at_reversals(
+    t: NDArray[np.float64], z: NDArray[np.float64], dq: NDArray[np.float64]
+) -> NDArray[np.bool_]:
+    """The samples (N,) of the spans where the residual ``z`` (N, n) [noise units] at times
+    ``t`` [s] stands off (:func:`~.outlying_spans.outlying_spans`) while each of its joints
+    reverses (its velocity ``dq`` (N, n) [rad/s] at zero or changing sign within the span
+    and one sample either side): friction's step at a reversal, which the fit on filtered
+    torques and the model's sharp step place differently (a Panda's 3 N m Coulomb: single
+    samples 27 times the noise), not a burst."""
+    out = np.zeros(t.size, dtype=bool)
+    for s in outlying_spans(t, z):
+        i0, i1 = int(np.searchsorted(t, s.t0)), int(np.searchsorted(t, s.t1, side="right"))
+        near = np.sign(dq[max(i0 - 1, 0) : min(i1 + 1, t.size)][:, list(s.joints)])
+        if near.shape[0] and np.all(
+            (near == 0).any(axis=0) | (np.diff(near, axis=0) != 0).any(axis=0)
+        ):
+            out[i0:i1] = True
     return out
 
 

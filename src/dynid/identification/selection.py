@@ -1302,7 +1302,7 @@ def identify_recordings(
         robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
         judge=selection is None, estimator=est, **kw,
     )  # fmt: skip
-    if bursts := {} if gone or keep_outlying else _burst_cuts(robot, model, terms, data):
+    if bursts := {} if gone or keep_outlying else _burst_cuts(robot, model, terms, data, logs):
         gone, (selection, structure, fitted, validation, given, model, terms) = bursts, _cut_refit(
             robot, logs, data, bursts, selection, structure, validate_on, drive, friction,
             given, estimator=est, folds=folds, prep=prep, **kw,
@@ -1329,21 +1329,26 @@ def _check_given(
 
 
 def _burst_cuts(
-    robot: Robot, model: IdentifiedModel, terms: Sequence[ModelTerm], data: Recordings
+    robot: Robot,
+    model: IdentifiedModel,
+    terms: Sequence[ModelTerm],
+    data: Recordings,
+    logs: Sequence[TorqueLog],
 ) -> _Gone:
     """The intervals [s] cut out of each recording of ``data`` whose residual under
     ``model`` (fitted with ``terms`` on every recording, of one or two, where no recording
     can be judged against the others; none of three or more) sits in a few short spans
     (:func:`~.own_bursts.own_bursts`), widened as an outlying recording's are
     (:func:`_cut_edges`, :func:`~.outlying_spans.widened_intervals`), said in one warning
-    (:func:`_warn_bursts`); empty where none is so.
+    (with the recording, the spans, their joints and peaks); empty where none is so or the
+    ``logs`` (those ``data`` holds, as read) are exact to round-off.
 
     Regression: a 6-DoF arm's one recording with a 20 N m burst on joint 2 for 0.1 s,
     fitted whole: training error 10.97 % for a 1.12 % floor, a clean recording predicted
     at 5.15 % (its floor 1.13 %), the burst named nowhere."""
     if len(data.names) >= 3:
         return {}
-    found = own_bursts(robot, model, terms, data)
+    found = own_bursts(robot, model, terms, data, exact_to_round_off(logs))
     cuts: _Gone = {}
     for k, spans in found.items():
         edge = _cut_edges(data, k)
