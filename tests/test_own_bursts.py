@@ -153,6 +153,19 @@ def test_a_recording_without_a_burst_is_not_cut(arm, kind):
     np.testing.assert_allclose(model.fit.beta, kept.fit.beta, rtol=1e-12, atol=1e-12)
 
 
+def test_a_pandas_coulomb_steps_at_reversals_are_not_cut():
+    """Two 4 s Panda recordings with Coulomb friction of 3 to 1 N m, the structure given:
+    the fit on filtered torques and the model's sharp step leave single samples 27 times
+    the noise at the joints' reversals, friction's, not a burst: not cut."""
+    pan = dynid.panda()
+    fr = ClassicalFriction(np.linspace(0.6, 0.2, 7), np.linspace(3.0, 1.0, 7), np.zeros(7))
+    logs = recordings(pan, (61, 62), friction=fr, duration=4.0, noise=SensorNoise())
+    given = Structure(friction=("viscous", "coulomb"))
+    model, said = said_warnings(identify_recordings, pan, logs, structure=given, estimator="ols")
+    assert not [m for m in said if SAID in m]
+    assert not any("cut_out" in r for r in model.info.recordings)
+
+
 def test_a_tilted_panda_is_not_cut_and_its_burst_is():
     """The Panda, 8 s at 200 Hz: its gravity tilted by 0.05 rad (the level model's residual
     spread over the motion) is not cut; the level arm with a 0.1 s burst on joint 2 at
