@@ -33,6 +33,7 @@ __all__ = [
     "cut_text",
     "outlying_spans",
     "spans_text",
+    "widened_intervals",
     "without_intervals",
 ]
 
@@ -187,8 +188,25 @@ def cut_intervals(
     share = sum(s.share for s in big)
     if not big or ratio * math.sqrt(max(0.0, 1.0 - share)) > CUT_REST_RATIO:
         return ()
+    return widened_intervals(tuple(big), t, margin_s, bridged_s)
+
+
+def widened_intervals(
+    spans: tuple[Span, ...],
+    t: NDArray[np.float64],
+    margin_s: float,
+    bridged_s: float,
+) -> tuple[tuple[float, float], ...]:
+    """The time intervals [s] that cut ``spans`` out of a recording of sample times ``t``
+    [s]: each widened by ``margin_s`` [s] on both sides, joined where they overlap,
+    ascending; none where they hold more than :data:`CUT_MAX_TIME_SHARE` of its
+    duration or where one is no longer than ``bridged_s`` [s] (the preparation would
+    bridge it, not cut it). The one widening of :func:`cut_intervals` and of the spans a
+    fit's own residual holds (:mod:`~dynid.identification.own_bursts`)."""
+    if not spans:
+        return ()
     out: list[list[float]] = []
-    for a, b in sorted((s.t0 - margin_s, s.t1 + margin_s) for s in big):
+    for a, b in sorted((s.t0 - margin_s, s.t1 + margin_s) for s in spans):
         if out and a <= out[-1][1]:
             out[-1][1] = max(out[-1][1], b)
         else:
