@@ -28,13 +28,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import stage
 from ..regressors.terms import ModelTerm
-from .candidates import (
-    OUTLIER_RATIO,
-    Selection,
-    cut_record,
-    heldout_of,
-    recording_oddness,
-)
+from .candidates import OUTLIER_RATIO, Selection, cut_record, heldout_of, recording_oddness
 from .core import model_columns
 from .holdout import fold_errors_percent
 from .input_noise import exact_to_round_off
@@ -51,9 +45,7 @@ from .outlying_spans import (
 )
 from .own_bursts import own_bursts
 from .recordings import Recordings
-from .structure import (
-    Structure,
-)
+from .structure import Structure
 from .structure_fit import _fitted, _recordings
 
 #: The intervals [s] cut out of a recording (closed, ascending); none: left out whole.

@@ -110,9 +110,7 @@ from .outlying_recordings import (
     _warn_outlying,
     cut_log,
 )
-from .outlying_spans import (
-    Span,
-)
+from .outlying_spans import Span
 from .recordings import Recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape

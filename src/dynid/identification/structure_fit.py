@@ -27,10 +27,7 @@ from .largest import recording_bands
 from .log import TorqueLog
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
-from .structure import (
-    Structure,
-    structure_terms,
-)
+from .structure import Structure, structure_terms
 
 
 def _terms_of(
