@@ -7,12 +7,14 @@ never does."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
 from dynid.exceptions import ShapeError
 from dynid.observer.residual import first_order_lag
-from dynid.observer.sign import TorqueSign, opposite_finding
+from dynid.observer.sign import TorqueSign, opposite_finding, unexplained_finding
 
 
 @pytest.mark.parametrize("block", [1, 7, 1000])
@@ -57,6 +59,31 @@ def test_a_residual_of_twice_the_torque_names_the_joint_a_model_without_torques_
     assert not none.opposite().any() and opposite_finding(none, names) is None
     with pytest.raises(ShapeError):
         opposite_finding(none, ("a",))
+
+
+def test_the_velocities_noise_through_the_gain_is_not_called_the_models_error():
+    """A model exact to the torques, its residual white noise of 0.8 N m RMS (the
+    velocities' noise through ``K_O M(q)``, known) on a joint whose torque spreads 1 N m:
+    the residual's spread is 0.8 of the torques', but none of it is the model's, so nothing
+    is said once that noise is taken out; a model error of 0.9 times the torque on top is
+    still named alone, its share 0.9 to 0.01."""
+    t = np.arange(0.0, 20.0, 1e-3)
+    rng = np.random.default_rng(4)
+    tau = np.sqrt(2.0) * np.stack([np.sin(2 * np.pi * t), np.cos(3 * t)], axis=1)
+    noise = 0.8 * rng.standard_normal(tau.shape)
+    names = ("a", "b")
+    exact = TorqueSign(2)
+    exact.add(tau, noise)
+    assert unexplained_finding(exact, names) is not None  # 0.8 > 0.5 without the noise
+    assert unexplained_finding(exact, names, [0.8, 0.8]) is None
+    wrong = TorqueSign(2)
+    wrong.add(tau, noise + tau * [0.9, 0.0])
+    said = unexplained_finding(wrong, names, [0.8, 0.8])
+    found = re.search(r"taken out: (.*?)\)", said or "")
+    assert found is not None and found.group(1).startswith("a "), said
+    assert abs(float(found.group(1)[2:]) - 0.9) < 0.01, said
+    with pytest.raises(ShapeError):
+        unexplained_finding(wrong, names, [0.8])
 
 
 def test_a_model_that_explains_little_of_the_log_is_said_at_calibration(tmp_path, capsys):

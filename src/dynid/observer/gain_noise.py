@@ -109,6 +109,12 @@ class GainNoiseTally:
         self._res += np.sum(R**2, axis=0)
         self._count += N
 
+    def merge(self, other: GainNoiseTally) -> None:
+        """Add the sums of ``other`` (another log's, of the same gain and joints)."""
+        self._pred += other._pred
+        self._res += other._res
+        self._count += other._count
+
     def result(self) -> GainNoise | None:
         """The RMS of both over every block added (None before any)."""
         if not np.any(self._count):

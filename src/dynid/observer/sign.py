@@ -104,6 +104,11 @@ class TorqueSign:
             c = self._m2[2] / np.sqrt(self._m2[0] * self._m2[1])
         return np.where(np.isfinite(c), c, 0.0)
 
+    @property
+    def count(self) -> int:
+        """The samples observed so far."""
+        return self._count
+
     def torque_spread(self) -> NDArray[np.float64]:
         """Per joint (n,): the measured torques' spread, ``sqrt(sum (tau - mean)^2)``
         [N m]."""
@@ -175,27 +180,41 @@ def opposite_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
 UNEXPLAINED_SHARE = 0.5
 
 
-def unexplained_finding(sign: TorqueSign, names: Sequence[str]) -> str | None:
+def unexplained_finding(
+    sign: TorqueSign, names: Sequence[str], gain_noise: ArrayLike | None = None
+) -> str | None:
     """The one-line finding of the joints whose residual spreads over more than
     :data:`UNEXPLAINED_SHARE` of their measured torques' spread (the model, its drive or
     its friction do not fit the log: thresholds calibrated on it detect nothing smaller),
     among the joints whose torques vary (a tenth of the largest spread), or None.
 
+    ``gain_noise`` (n,) [N m], the RMS of the velocities' noise through the observer's gain
+    in the residual (:class:`~dynid.observer.gain_noise.GainNoise`), is taken out of the
+    residual's spread first: that part is the gain's, not the model's error (a Baxter arm at
+    the noise floor of its torques, 0.3 rad/s of velocity noise: 100 % of the residual of
+    its shoulder), and the calibration's summary names it on its own.
+
     Raises
     ------
     ShapeError
-        ``names`` not one per joint.
+        ``names`` or ``gain_noise`` not one per joint.
     """
     spread = sign.torque_spread()
     u = sign.unexplained()
+    if gain_noise is not None:
+        s = _checks.as_exact("gain_noise", gain_noise, (sign.n,))
+        count = max(sign.count, 1)
+        mine = np.maximum(u**2 - count * s**2 / np.maximum(spread**2, 1e-300), 0.0)
+        u = np.where(spread > 0, np.sqrt(mine), u)
     varies = spread > 0.1 * float(spread.max(initial=0.0))
     bad = _flagged(sign, (u > UNEXPLAINED_SHARE) & varies, names)
     if not bad:
         return None
     said = ", ".join(f"{names[k]} {u[k]:.3g}" for k in bad)
+    noise = "" if gain_noise is None else ", the velocities' noise through the gain taken out"
     return (
         f"the model leaves most of the measured torques unexplained (the residual's spread "
-        f"over the torques': {said}): thresholds calibrated on it detect only contacts "
+        f"over the torques'{noise}: {said}): thresholds calibrated on it detect only contacts "
         "larger than the model's error; hint: check the model, its drive and friction on "
         "this log with dynid validate"
     )

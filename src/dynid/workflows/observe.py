@@ -797,6 +797,7 @@ def _calibrated(
             keep = Series.new(prep, model.n, wants_std, wants_margin) if opts.keep_series else None
             peak = np.zeros(model.n)
             sign = TorqueSign(model.n)
+            mine = GainNoiseTally(model, tally.gain)
             q, dq = prep.log.q, prep.dq
             seen = model.friction
             if unmodelled is not None:
@@ -810,7 +811,7 @@ def _calibrated(
                     keep.put(blk)
                 rows = slice(blk.a, blk.a + blk.r.shape[0])
                 sign.add(prep.log.tau[rows], blk.r)
-                tally.add(q[rows], dq[rows], blk.r)
+                mine.add(q[rows], dq[rows], blk.r)
                 if np.isfinite(blk.r).any():
                     np.fmax(r_max, np.nanmax(np.abs(blk.r), axis=0), out=r_max)
                 if sigma_max is not None and blk.std is not None and np.isfinite(blk.std).any():
@@ -820,7 +821,10 @@ def _calibrated(
                 yield blk
             if (opposite := opposite_finding(sign, names)) is not None:
                 raise DataError(opposite, file=Path(path).name)
-            if (unexplained := unexplained_finding(sign, names)) is not None:
+            tally.merge(mine)
+            found = mine.result()
+            gain_noise = None if found is None else found.predicted
+            if (unexplained := unexplained_finding(sign, names, gain_noise)) is not None:
                 warnings.warn(f"{Path(path).name}: {unexplained}", DynidWarning, stacklevel=2)
             logs.append(_observation(prep, model, mapped, opts, keep, peak, seen))
 
