@@ -12,7 +12,10 @@ residual is judged on filtered torques), and judges each by the rule of a valida
 :data:`~dynid.identification.error_spans.MOST_SHARE` of its squared error above the
 noise), no more than :data:`~dynid.identification.outlying_spans.SPANS_SHOWN` spans
 standing off (more recur with the motion: friction at each start of a point-to-point
-log's moves). A clean recording stays near the noise; an effect the model lacks (a
+log's moves). A span at a reversal of its joints that stands off by no more than the
+model's friction steps there (:data:`STEP_MARGIN`) is friction's step, placed
+differently by the fit and the model, and left out; a burst there stands off beyond it.
+A clean recording stays near the noise; an effect the model lacks (a
 spring, a tilted base) spreads over the motion: neither is judged so. Times [s]
 as the logs hold them, torques [N m].
 """
