@@ -32,6 +32,7 @@ __all__ = [
     "cut_intervals",
     "cut_text",
     "outlying_spans",
+    "robust_levels",
     "spans_text",
     "widened_intervals",
     "without_intervals",
@@ -105,8 +106,7 @@ def outlying_spans(
     """
     e = np.asarray(e, dtype=np.float64)
     t = np.asarray(t, dtype=np.float64)
-    dev = e - np.median(e, axis=0)
-    level = _MAD_TO_STD * np.median(np.abs(dev), axis=0)
+    dev, level = robust_levels(e)
     off = np.abs(dev) > sigmas * np.where(level > 0, level, np.inf)
     rows = np.flatnonzero(off.any(axis=1))
     if rows.size == 0:
@@ -122,6 +122,15 @@ def outlying_spans(
             Span(float(t[a]), float(t[b]), joints, peak, float(np.sum(e[a : b + 1] ** 2)) / total)
         )
     return tuple(sorted(out, key=lambda s: -s.share))
+
+
+def robust_levels(e: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The residual ``e`` (N, n) less each joint's median (N, n), and each joint's robust
+    level (n,): the median absolute deviation, scaled to a Gaussian standard deviation;
+    in ``e``'s units. A sample stands off its joint's median by more than
+    :data:`OFF_SIGMAS` levels (:func:`outlying_spans`)."""
+    dev = e - np.median(e, axis=0)
+    return dev, _MAD_TO_STD * np.median(np.abs(dev), axis=0)
 
 
 def spans_text(

@@ -12,7 +12,10 @@ residual is judged on filtered torques), and judges each by the rule of a valida
 :data:`~dynid.identification.error_spans.MOST_SHARE` of its squared error above the
 noise), no more than :data:`~dynid.identification.outlying_spans.SPANS_SHOWN` spans
 standing off (more recur with the motion: friction at each start of a point-to-point
-log's moves). A clean recording stays near the noise; an effect the model lacks (a
+log's moves). A span at a reversal of its joints that stands off by no more than the
+model's friction steps there (:data:`STEP_MARGIN`) is friction's step, placed
+differently by the fit and the model, and left out; a burst there stands off beyond it.
+A clean recording stays near the noise; an effect the model lacks (a
 spring, a tilted base) spreads over the motion: neither is judged so. Times [s]
 as the logs hold them, torques [N m].
 """
@@ -30,18 +33,30 @@ from ..regressors.terms import ModelTerm
 from ..signals import lowpass_noise_gain
 from .core import model_columns
 from .error_spans import ErrorSpans, error_spans
-from .model import IdentifiedModel
-from .outlying_spans import MIN_SHARE, SPANS_SHOWN, outlying_spans
+from .model import IdentifiedModel, IdentifiedTerm
+from .outlying_spans import MIN_SHARE, OFF_SIGMAS, SPANS_SHOWN, outlying_spans, robust_levels
 from .recordings import Recordings
 
-__all__ = ["fit_residuals", "own_bursts"]
+__all__ = ["STEP_MARGIN", "fit_residuals", "own_bursts"]
 
 
-#: A recording's times [s] (N,), residual [N m] (N, n), noise [N m] (N, n) and joint
-#: velocities [rad/s] (N, n) at the fit's samples.
+#: A recording's times [s] (N,), residual [N m] (N, n), noise [N m] (N, n), joint
+#: velocities [rad/s] (N, n) and the model's friction torques [N m] (N, n) at the fit's
+#: samples.
 _Residual = tuple[
-    NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
 ]
+
+#: A span at a reversal is friction's step, placed differently by the fit and the model,
+#: when its residual would not stand off with this many times the step the model's
+#: friction makes across it taken off each of its joints [1] (a misplaced step misfits
+#: by at most its height; the margin: the fit's step against the truth's, a filter's
+#: overshoot). A burst there larger than that is judged as any other span.
+STEP_MARGIN = 1.5
 
 
 def fit_residuals(
@@ -67,20 +82,40 @@ def fit_residuals(
     out = []
     o = 0
     by_recording: dict[int, list[tuple[NDArray[np.float64], ...]]] = {}
+    frictions = [tm for tm in model.appended if tm.friction is not None]
     for p, r in zip(pieces, data.recording, strict=True):
         m = p.log.n_samples
         gain = 1.0 if data.measured else lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz)
         noise = np.broadcast_to(gain * np.asarray(p.torque_noise_std, dtype=np.float64), (m, n))
         t = np.asarray(p.log.t, dtype=np.float64)
         dq = np.asarray(p.log.dq, dtype=np.float64)
-        by_recording.setdefault(int(r), []).append((t, e[o : o + m * n].reshape(m, n), noise, dq))
+        f = _friction_torques(frictions, p.log.q, dq, p.log.ddq)
+        by_recording.setdefault(int(r), []).append(
+            (t, e[o : o + m * n].reshape(m, n), noise, dq, f)
+        )
         o += m * n
     for k in range(len(data.names)):
         mine = by_recording.get(k, [])
         if not mine:
-            out.append((np.zeros(0), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n))))
+            out.append((np.zeros(0), *(np.zeros((0, n)),) * 4))
             continue
-        out.append(tuple(np.concatenate([part[i] for part in mine]) for i in range(4)))  # type: ignore[arg-type]
+        out.append(tuple(np.concatenate([part[i] for part in mine]) for i in range(5)))  # type: ignore[arg-type]
+    return out
+
+
+def _friction_torques(
+    frictions: Sequence[IdentifiedTerm],
+    q: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    ddq: NDArray[np.float64] | None,
+) -> NDArray[np.float64]:
+    """The joint torques [N m] (N, n) of the friction terms ``frictions`` at the joint
+    states ``q`` [rad], ``dq`` [rad/s], ``ddq`` [rad/s^2] (N, n) (None: zero; friction does
+    not depend on it)."""
+    out = np.zeros(np.shape(dq))
+    a = np.zeros(out.shape) if ddq is None else ddq
+    for tm in frictions:
+        out += tm.torques(q, dq, a)
     return out
 
 
@@ -94,7 +129,8 @@ def own_bursts(
     """The recordings (indices into ``data.names``) whose residual under ``model`` (its own
     fit, :func:`fit_residuals`) sits in a few short spans
     (:func:`~dynid.identification.error_spans.error_spans` on the residual in units of each
-    joint's noise, the spans at a reversal of their joints left out: :func:`_at_reversals`),
+    joint's noise, the spans of friction's step at a reversal of their joints left out:
+    :func:`_friction_steps`),
     each with those spans, their peaks [N m] as measured; empty where the noise is not
     known, the logs are ``exact`` to round-off (no noise to judge against) or none is so."""
     found = None if exact else fit_residuals(robot, model, terms, data)
@@ -102,11 +138,11 @@ def own_bursts(
         return {}
     out = {}
     starts = data.starts
-    for k, (t, e, noise, dq) in enumerate(found):
+    for k, (t, e, noise, dq, f) in enumerate(found):
         if t.size == 0 or not np.all(noise > 0):
             continue
         z = e / noise
-        keep = ~_at_reversals(t, z, dq)
+        keep = ~_friction_steps(t, z, dq, f / noise)
         t, z, e = t[keep], z[keep], e[keep]
         if t.size == 0 or _recurring(t, z):
             continue
@@ -122,24 +158,47 @@ def own_bursts(
     return out
 
 
-def _at_reversals(
-    t: NDArray[np.float64], z: NDArray[np.float64], dq: NDArray[np.float64]
+def _friction_steps(
+    t: NDArray[np.float64],
+    z: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    f: NDArray[np.float64],
 ) -> NDArray[np.bool_]:
     """The samples (N,) of the spans where the residual ``z`` (N, n) [noise units] at times
-    ``t`` [s] stands off (:func:`~.outlying_spans.outlying_spans`) while each of its joints
-    reverses (its velocity ``dq`` (N, n) [rad/s] at zero or changing sign within the span
-    and one sample either side): friction's step at a reversal, which the fit on filtered
-    torques and the model's sharp step place differently (a Panda's 3 N m Coulomb: single
-    samples 27 times the noise), not a burst."""
+    ``t`` [s] stands off (:func:`~.outlying_spans.outlying_spans`) as friction's step at a
+    reversal does: each of its joints reverses (its velocity ``dq`` (N, n) [rad/s] at zero
+    or changing sign within the span and one sample either side) and no more than the
+    model's friction ``f`` (N, n) [noise units] steps there (:func:`_within_step`). The
+    fit on filtered torques and the model's sharp step place that step differently (a
+    Panda's 3 N m Coulomb: single samples 27 times the noise); a burst at a reversal stands
+    off beyond the step and is not left out."""
     out = np.zeros(t.size, dtype=bool)
+    dev, level = robust_levels(z)
     for s in outlying_spans(t, z):
         i0, i1 = int(np.searchsorted(t, s.t0)), int(np.searchsorted(t, s.t1, side="right"))
-        near = np.sign(dq[max(i0 - 1, 0) : min(i1 + 1, t.size)][:, list(s.joints)])
-        if near.shape[0] and np.all(
-            (near == 0).any(axis=0) | (np.diff(near, axis=0) != 0).any(axis=0)
-        ):
+        near = slice(max(i0 - 1, 0), min(i1 + 1, t.size))
+        joints = list(s.joints)
+        sign = np.sign(dq[near][:, joints])
+        reverses = (sign == 0).any(axis=0) | (np.diff(sign, axis=0) != 0).any(axis=0)
+        if sign.shape[0] and np.all(reverses) and _within_step(dev[i0:i1], level, f[near], joints):
             out[i0:i1] = True
     return out
+
+
+def _within_step(
+    dev: NDArray[np.float64],
+    level: NDArray[np.float64],
+    f: NDArray[np.float64],
+    joints: list[int],
+) -> bool:
+    """Whether a span's residual ``dev`` (M, n) [noise units, less each joint's median]
+    would not stand off (:data:`~.outlying_spans.OFF_SIGMAS` robust levels ``level`` (n,))
+    with :data:`STEP_MARGIN` times the step of the model's friction ``f`` (K, n) [noise
+    units] across it (its range over the span and one sample either side) taken off, on
+    each of ``joints``."""
+    step = np.ptp(f[:, joints], axis=0) if f.shape[0] else np.zeros(len(joints))
+    peak = np.abs(dev[:, joints]).max(axis=0) if dev.shape[0] else np.zeros(len(joints))
+    return bool(np.all(peak <= OFF_SIGMAS * level[joints] + STEP_MARGIN * step))
 
 
 def _recurring(t: NDArray[np.float64], z: NDArray[np.float64]) -> bool:
