@@ -47,6 +47,7 @@ from ..io.feasible import (
 )
 from ..model.drive import Drive
 from ..model.robot import Robot
+from .as_identified import read_as_identified
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .export import ExportRobotOptions, RobotExport, export_robot
 from .identify import data_files, parsed_terms
@@ -154,14 +155,17 @@ def identify_payload_files(
         ``--columns`` and ``--units`` of files of another tool (default: an identified
         model's recorded ones, or those a ``feasible`` file records).
     drop_invalid : bool
-        Drop invalid rows (counted) instead of failing.
+        Drop invalid rows (counted) instead of failing; False: torque logs as an
+        identified ``arm``'s identification did
+        (:func:`~dynid.workflows.as_identified.read_as_identified`, with a note).
     cutoff_hz : float or "none", optional
         Torque logs: zero-phase low-pass cut-off [Hz]; default: the identification's
         recorded one (with its decimation; none if it was identified without), else the one
         read from the motion; ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): none.
         Refused with static data, which are not filtered.
     max_gap_s : float, optional
-        Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces.
+        Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces; default:
+        an identified ``arm``'s recorded one (a note names it), else the default rule.
     drive : Drive, optional
         The drive the data were recorded through, for an arm without one (a robot's known
         rotor inertias come from it).
@@ -212,6 +216,7 @@ def identify_payload_files(
         return _static(arm, kin, paths, base, cmap, drop_invalid, gravity_only, common)
     if gravity_only:
         raise DataError("--gravity-only applies to static data (q, g), not to a torque log")
+    drop_invalid, max_gap_s = read_as_identified(recorded, drop_invalid, max_gap_s)
     read_as: dict[str, Any] = dict(
         recorded=_recorded_columns(arm, feasible),
         columns=columns,

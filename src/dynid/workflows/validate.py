@@ -3,7 +3,8 @@ with every policy the command applies, so that the Python API behaves as the com
 
 * The recordings (one or more files, or a folder) are read strictly with the model's
   joint count, through the column map the model's data were read with when none is given
-  (:mod:`dynid.workflows.recordings`).
+  (:mod:`dynid.workflows.recordings`); their invalid rows dropped and their gaps bridged as
+  the identification's were, unless given (:mod:`dynid.workflows.as_identified`).
 * The friction added to the model: its own (an identified model's classical friction, a
   robot's published sigmoid, the friction stored in a ``feasible.json``), none, a
   friction file, or a friction model (:class:`ValidateOptions` ``friction``).
@@ -85,6 +86,7 @@ from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..observer.residual_load import ResidualLoad
 from ..progress import NOTE
+from .as_identified import read_as_identified
 from .data_files import ColumnSpec, in_file
 from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
 from .recordings import (
@@ -118,14 +120,17 @@ class ValidateOptions:
     columns : (str or None, str or None), optional
         Column names and units of another tool's files; default: the model's recorded ones.
     drop_invalid : bool
-        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
+        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing;
+        False: as the identification did (:func:`~dynid.workflows.as_identified.
+        read_as_identified`, with a note), else refused.
     cutoff_hz : float or "none", optional
         Low-pass cut-off of the states [Hz]; default: the identification's recorded one
         (no filter if it was identified without), else the one read from the recordings'
         motion; ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a recording into
-        pieces.
+        pieces; default: the identification's recorded one (a note names it), else the
+        default rule.
     torque_delay_s : float, optional
         How far the torques lag the positions [s] (positive: the torques late): each
         piece's torques read that much later before filtering
@@ -396,6 +401,10 @@ def validate_files(
     opt = options or ValidateOptions()
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     own = _own_record(model, feasible, source)  # whose record reads and prepares the data
+    drop, gap = read_as_identified(
+        None if own is None else own.info.log, opt.drop_invalid, opt.max_gap_s
+    )
+    opt = dataclasses.replace(opt, drop_invalid=drop, max_gap_s=gap)  # as identify read them
     drive, placed = _drives(model, opt.drive, feasible)
     rec = recorded or read_recordings(
         data, robot, recorded=None if own is None else own.info.column_map, columns=opt.columns,
