@@ -469,7 +469,6 @@ def identify_payload(
     else:
         opt = dict(structure=structure, drive=d, friction=friction, cutoff_hz=cutoff_hz)
         opt |= dict(decimate=decimate, max_gap_s=max_gap_s, rtol=rtol, terms=terms)
-        opt["torque_delay_s"] = _recorded_delay(inner)
         logs = cast(list[TorqueLog], list(items))
         without = None if base is None else cast(list[TorqueLog], list(base))
         W, yv, route, kept, record, differenced, scale, judging = _log_route(
@@ -850,7 +849,7 @@ def _log_route(
     ``opt``: the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
-    d = opt["drive"]
+    d, opt = opt["drive"], {**opt, "torque_delay_s": _recorded_delay(inner)}
     cut, dec, source = log_preparation(inner, logs, opt["cutoff_hz"], opt["decimate"])
     gap, lag = opt["max_gap_s"], opt["torque_delay_s"]
     rec = prepare_recordings(

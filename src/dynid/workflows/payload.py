@@ -218,13 +218,9 @@ def identify_payload_files(
         raise DataError("--gravity-only applies to static data (q, g), not to a torque log")
     drop_invalid, max_gap_s = read_as_identified(recorded, drop_invalid, max_gap_s)
     read_as: dict[str, Any] = dict(
-        recorded=_recorded_columns(arm, feasible),
-        columns=columns,
-        drop_invalid=drop_invalid,
-        cutoff_hz=known,
-        drive=read_drive,
-        sign_map=True,
-    )
+        recorded=_recorded_columns(arm, feasible), columns=columns, drop_invalid=drop_invalid,
+        cutoff_hz=known, drive=read_drive, sign_map=True,
+    )  # fmt: skip
     rec = read_recordings(
         paths, kin, owner=f"robot {kin.name!r}", q_start=q_start, max_gap_s=max_gap_s, **read_as
     )

@@ -398,13 +398,9 @@ def validate_files(
     ShapeError
         A friction model of another joint count.
     """
-    opt = options or ValidateOptions()
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     own = _own_record(model, feasible, source)  # whose record reads and prepares the data
-    drop, gap = read_as_identified(
-        None if own is None else own.info.log, opt.drop_invalid, opt.max_gap_s
-    )
-    opt = dataclasses.replace(opt, drop_invalid=drop, max_gap_s=gap)  # as identify read them
+    opt = _as_identified(options or ValidateOptions(), own)  # as identify read its logs
     drive, placed = _drives(model, opt.drive, feasible)
     rec = recorded or read_recordings(
         data, robot, recorded=None if own is None else own.info.column_map, columns=opt.columns,
@@ -474,6 +470,15 @@ def validate_files(
         springs=hints.springs, gains=gains, torque_delay=delay, applied_delay=applied,
         gravity_tilt=hints.tilt, flange_load=hints.load, error_spans=burst,
     )  # fmt: skip
+
+
+def _as_identified(opt: ValidateOptions, own: IdentifiedModel | None) -> ValidateOptions:
+    """``opt`` with ``drop_invalid`` and ``max_gap_s`` as given, else as ``own``'s
+    identification read its logs (:func:`~dynid.workflows.as_identified.read_as_identified`,
+    with a note)."""
+    record = None if own is None else own.info.log
+    drop, gap = read_as_identified(record, opt.drop_invalid, opt.max_gap_s)
+    return dataclasses.replace(opt, drop_invalid=drop, max_gap_s=gap)
 
 
 def _drives(
