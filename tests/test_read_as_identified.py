@@ -19,6 +19,7 @@ import pytest
 from dynid.exceptions import DataError
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.info import LogInfo
+from dynid.io.feasible import load_feasible_json, save_feasible_json
 from dynid.io.model_json import load_model_json, save_model_json
 from dynid.io.torque_log import save_torque_log
 from dynid.model.robot import Robot
@@ -96,6 +97,7 @@ def identified(tmp_path_factory):
         warnings.simplefilter("ignore")
         model = identify_files(_arm(), fitted, opt).model
     path = save_model_json(d / "identification.json", model)
+    save_feasible_json(d / "feasible.json", _arm())  # as --consistent writes it beside
     return path, other, n_rows
 
 
@@ -157,3 +159,17 @@ def test_observe_and_payload_read_the_log_as_identify_did(identified, caplog):
     assert prep["max_gap_s"] == MAX_GAP_S and prep["torque_delay_s"] == DELAY_S
     assert [r["pieces"] for r in est.recordings] == [1]
     assert est.estimate.mass == pytest.approx(0.6, abs=0.2)
+
+
+def test_params_of_a_feasible_file_reads_as_the_identification_beside_it(identified):
+    """observe and payload of the feasible.json beside the identification.json read the
+    second log as --model does: its NaN rows dropped, its gap bridged (one piece), and
+    observe with the identification's torque delay."""
+    path, other, _ = identified
+    feasible = path.with_name("feasible.json")
+    got = _quiet(observe_files, ObserveOptions(data=(other,), params=feasible, calibrate=True))
+    assert got.model.torque_delay_s == DELAY_S
+    robot = load_feasible_json(feasible)
+    est = _quiet(identify_payload_files, robot, other, feasible=feasible, terms="viscous")
+    assert est.estimate.preprocessing["max_gap_s"] == MAX_GAP_S
+    assert [r["pieces"] for r in est.recordings] == [1]

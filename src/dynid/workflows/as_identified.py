@@ -5,17 +5,23 @@ repeated timestamp dropped (``--drop-invalid``) and the longest gap bridged
 
 The identification's record is its :class:`~dynid.identification.info.LogInfo`
 (``identification.json``'s metadata ``drop_invalid`` and ``max_gap_s``); a model of
-static data, or a robot, has none.
+static data, or a robot, has none; a ``feasible.json`` has that of the
+``identification.json`` beside it (:func:`identification_beside`).
 """
 
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 
+from ..exceptions import DataError
 from ..identification.info import LogInfo
+from ..identification.model import IdentifiedModel
+from ..io.model_json import load_model_json
+from ..model.robot import Robot
 from ..progress import NOTE
 
-__all__ = ["read_as_identified"]
+__all__ = ["identification_beside", "read_as_identified"]
 
 _log = logging.getLogger(__name__)
 
@@ -68,3 +74,18 @@ def read_as_identified(
             ", ".join(said),
         )
     return drop_invalid, max_gap_s
+
+
+def identification_beside(feasible: str | Path, robot: Robot) -> IdentifiedModel | None:
+    """The model of the ``identification.json`` in the folder of ``feasible`` (``identify
+    --consistent`` writes both) whose robot has ``robot``'s joints, or None (none there,
+    not readable, another arm): the record of how the data the consistent parameters were
+    fitted to were read and prepared."""
+    path = Path(feasible).with_name("identification.json")
+    if path == Path(feasible) or not path.is_file():
+        return None
+    try:
+        mine = load_model_json(path)
+    except DataError:
+        return None
+    return mine if mine.robot.joint_names == robot.joint_names else None

@@ -110,7 +110,7 @@ from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import wrench_kind, wrench_rank
 from ..progress import NOTE
-from .as_identified import read_as_identified
+from .as_identified import identification_beside, read_as_identified
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -369,7 +369,30 @@ def load_observer_model(
         fr = placed_friction(loaded, own)
     if fr in ("model", "robot") and (said := own_at_motors_note(robot, own)) is not None:
         _log.log(NOTE, said)
-    return from_robot(robot, friction="robot" if fr == "model" else fr, drive=own), None
+    obs = from_robot(robot, friction="robot" if fr == "model" else fr, drive=own)
+    return _read_as_beside(obs, spec)
+
+
+def _read_as_beside(
+    obs: ObserverModel, params: str
+) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
+    """``obs`` of a ``params`` ``feasible.json`` that reads its logs as the
+    ``identification.json`` beside it records (its torque delay, invalid rows and gap rule:
+    :func:`~dynid.workflows.as_identified.identification_beside`, with a note), with its
+    column map; ``obs`` as it is, and None, without one."""
+    own = identification_beside(params, obs.robot) if params.lower().endswith(".json") else None
+    if own is None or own.info.log is None:
+        return obs, None
+    _log.log(
+        NOTE,
+        "%s: the logs read as identification.json beside it records (its --columns/--units, "
+        "torque delay, --drop-invalid and gap rule), as --model reads them; each given "
+        "replaces its part",
+        Path(params).name,
+    )
+    log = own.info.log
+    obs = dataclasses.replace(obs, torque_delay_s=float(log.torque_delay_s), logs_read=log)
+    return obs, own.info.column_map
 
 
 def default_tip_hint(params: str, robot: Robot, tip: str | None) -> str | None:

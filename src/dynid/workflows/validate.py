@@ -80,13 +80,12 @@ from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_del
 from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
-from ..io.model_json import load_model_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..observer.residual_load import ResidualLoad
 from ..progress import NOTE
-from .as_identified import read_as_identified
+from .as_identified import identification_beside, read_as_identified
 from .data_files import ColumnSpec, in_file
 from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
 from .recordings import (
@@ -501,21 +500,6 @@ def _recorded_delay(model: IdentifiedModel | Robot | None) -> float:
     """The delay [s] an identified model was identified with (0: a robot, static data)."""
     own = model.info.log if isinstance(model, IdentifiedModel) else None
     return 0.0 if own is None else float(own.torque_delay_s)
-
-
-def identification_beside(feasible: str | Path, robot: Robot) -> IdentifiedModel | None:
-    """The model of the ``identification.json`` in the folder of ``feasible`` (``identify
-    --consistent`` writes both) whose robot has ``robot``'s joints, or None (none there,
-    not readable, another arm): the record of how the data the consistent parameters were
-    fitted to were read and prepared."""
-    path = Path(feasible).with_name("identification.json")
-    if path == Path(feasible) or not path.is_file():
-        return None
-    try:
-        mine = load_model_json(path)
-    except DataError:
-        return None
-    return mine if mine.robot.joint_names == robot.joint_names else None
 
 
 def _own_record(
