@@ -223,17 +223,20 @@ def add_log_options(
     *,
     drop_invalid: bool = True,
     torque_delay: Literal["given", "recorded"] | None = None,
+    recorded: bool = True,
 ) -> None:
     """``--max-gap SECONDS`` and ``--drop-invalid`` for commands that read a torque log;
     with ``torque_delay``, ``--torque-delay MS`` (:func:`add_torque_delay`: ``"recorded"``
-    for a command whose default is the identification's)."""
+    for a command whose default is the identification's); ``recorded``: the gap rule's
+    default is a ``--model``'s identification's."""
     p.add_argument(
         "--max-gap",
         type=positive_type,
         default=None,
         metavar="SECONDS",
-        help="longest gap in the log bridged by interpolation [s] (default: 2.5 median "
-        "steps, at least 0.02 s; a log at any rate from 10 Hz up passes)",
+        help="longest gap in the log bridged by interpolation [s] (default: "
+        + ("a --model's identification's, else " if recorded else "")
+        + "2.5 median steps, at least 0.02 s; a log at any rate from 10 Hz up passes)",
     )
     if drop_invalid:
         add_drop_invalid(p)
@@ -292,7 +295,8 @@ def add_drop_invalid(p: argparse.ArgumentParser) -> None:
         "--drop-invalid",
         action="store_true",
         help="drop rows with NaN, inf, empty cells or a repeated timestamp (reported: "
-        "how many and where) instead of failing",
+        "how many and where) instead of failing (default: so where --model was identified "
+        "with --drop-invalid, said in a note)",
     )
 
 

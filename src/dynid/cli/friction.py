@@ -40,8 +40,9 @@ OUT/friction.png (residual against velocity with the fitted curve, per joint, or
 motor against the motor velocity where the law was fitted at the motors; skipped, with a
 note, without matplotlib). The model's own friction is the table's row "own (classical)"
 (its law named, as the figure's title and validate name it). The log is read strictly:
-rows with NaN/inf or a repeated timestamp are an error unless --drop-invalid; gaps up to
---max-gap are bridged, longer ones cut the log into pieces.
+rows with NaN/inf or a repeated timestamp are an error unless --drop-invalid (or the
+model's identification dropped them: a note says so); gaps up to --max-gap (the
+identification's by default) are bridged, longer ones cut the log into pieces.
 
 Example:
   dynid friction --model out/identification.json --data traj.csv --out out/friction

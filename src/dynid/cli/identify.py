@@ -225,7 +225,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "NaN/inf or a repeated timestamp (torque logs), instead of failing; says how many "
         "and where",
     )
-    add_log_options(p, drop_invalid=False, torque_delay="given")
+    add_log_options(p, drop_invalid=False, torque_delay="given", recorded=False)
     p.add_argument(
         "--std",
         choices=STD_METHODS,

@@ -261,8 +261,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         metavar="SECONDS",
         help="longest step the observer integrates over [s], rows dropped by "
         "--drop-invalid included (bridged as identify bridges them); the log is cut at "
-        "longer ones and the observer starts again (default: 2.5 median steps, at least "
-        "0.02 s)",
+        "longer ones and the observer starts again (default: the --model's identification's, "
+        "else 2.5 median steps, at least 0.02 s)",
     )
     add_torque_delay(p, recorded=True)
     p.add_argument(

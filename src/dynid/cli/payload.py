@@ -252,6 +252,11 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
             f"preprocessing: cut-off {'none' if cut is None else f'{cut:.4g} Hz'} "
             f"({source.get(prep['cutoff_source'], prep['cutoff_source'])}), "
             f"decimation {prep['decimate']}"
+            + (
+                f", torque delay {1e3 * lag:g} ms (the model's)"
+                if (lag := prep.get("torque_delay_s"))
+                else ""
+            )
         )
     for note in est.notes:
         console.print(f"note: {note}")

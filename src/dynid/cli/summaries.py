@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -74,7 +74,7 @@ def format_identification(
     if info.static is not None:
         data = f"{info.static.n_configurations} configurations"
     elif info.log is not None:
-        data = samples_text(info.log, _decimations(info.recordings))
+        data = samples_text(info.log, _decimations(info.recordings), info.recordings)
     else:
         data = "? samples"
     head = [
@@ -388,16 +388,18 @@ def recordings_lines(recordings: Any) -> list[str]:
 
 
 def _cut_out(rec: Any) -> str:
-    """``; t = 4.672 to 5.428 s cut out (outlying; ...)``: the intervals cut out of an
-    outlying recording's fit (``cut_out``), empty for none."""
+    """``; t = 4.672 to 5.428 s cut out as a burst (...)``: the intervals cut out of a
+    recording's fit (``cut_out``: spans of an outlying recording's residual, or of the
+    fit's own), empty for none; the gaps they leave are not said as gaps."""
     cut = rec.get("cut_out") or ()
     if not cut:
         return ""
     n = rec.get("cut_samples")
     return (
-        f"; {cut_text(tuple((float(a), float(b)) for a, b in cut))} cut out"
-        + (f" ({n} more recorded)" if n else "")
-        + ": outlying there (with the filter's edge beside it; --keep-outlying fits it whole)"
+        f"; {cut_text(tuple((float(a), float(b)) for a, b in cut))} cut out as a burst the "
+        "model does not hold ("
+        + (f"{n} recorded samples, " if n else "")
+        + "with the filter's edge beside it; --keep-outlying fits it whole)"
     )
 
 
@@ -447,10 +449,14 @@ def _lost(rec: Any) -> str:
     return f" of {rec['recorded']} recorded" + (": " + ", ".join(parts) if parts else "")
 
 
-def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
+def samples_text(
+    log: LogInfo, decimations: Sequence[int] = (), recordings: Sequence[Any] = ()
+) -> str:
     """The samples of a torque log: used and recorded, the filter and decimation that chose
-    them (``decimations``: the recordings', when they differ, e.g. at other rates), and the
-    resampling when the timestamps were not uniform."""
+    them (``decimations``: the recordings', when they differ, e.g. at other rates), the
+    resampling when the timestamps were not uniform, and the gaps the logs were cut at
+    apart from the bursts cut out of them (``recordings``' ``cut_out``, their ``gaps``
+    the recordings' own)."""
     cut = log.cutoff_hz
     how = "no low-pass" if cut is None else f"{cut:.3g} Hz low-pass"
     if log.cutoff_source == "motion" and log.motion_frequency_hz:
@@ -480,8 +486,13 @@ def samples_text(log: LogInfo, decimations: Sequence[int] = ()) -> str:
             )
         elif jitter is not None and not log.n_dropped and not log.n_cuts:
             text += ", no sample dropped"
-    if log.n_cuts:
-        text += f", cut into pieces at {log.n_cuts} longer gap(s)"
+    fitted = [r for r in recordings if isinstance(r, Mapping) and not r.get("left_out")]
+    bursts = sum(len(r.get("cut_out") or ()) for r in fitted)
+    gaps = sum(len(r.get("gaps") or ()) for r in fitted) if bursts else log.n_cuts
+    if gaps:
+        text += f", cut into pieces at {gaps} longer gap(s)"
+    if bursts:
+        text += f", {bursts} burst(s) cut out"
     return text + ")"
 
 

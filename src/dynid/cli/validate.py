@@ -77,7 +77,9 @@ Writes OUT/validation.json {"rms": [...], "mse": [...], "relative_error_percent"
 "recordings", the noise floor and the verdict) and the figures
 OUT/validation_torques.png and OUT/validation_rms.png (skipped, with a note, without
 matplotlib). The log is read strictly: rows with NaN/inf or a repeated timestamp are an
-error unless --drop-invalid; gaps up to --max-gap are bridged, longer ones cut the log.
+error unless --drop-invalid (or the model's identification dropped them: a note says
+so); gaps up to --max-gap (the identification's by default) are bridged, longer ones cut
+the log.
 
 Example:
   dynid validate --robot panda --data traj.csv --out out/validation

@@ -849,13 +849,16 @@ def _log_route(
     ``opt``: the options of :func:`identify_payload`."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
     kin = inner.robot if isinstance(inner, IdentifiedModel) else inner
-    d = opt["drive"]
+    d, opt = opt["drive"], {**opt, "torque_delay_s": _recorded_delay(inner)}
     cut, dec, source = log_preparation(inner, logs, opt["cutoff_hz"], opt["decimate"])
-    gap = opt["max_gap_s"]
-    rec = prepare_recordings(kin, logs, names, cutoff_hz=cut, max_gap_s=gap, decimate=dec, drive=d)
+    gap, lag = opt["max_gap_s"], opt["torque_delay_s"]
+    rec = prepare_recordings(
+        kin, logs, names, cutoff_hz=cut, max_gap_s=gap, decimate=dec, drive=d, torque_delay_s=lag
+    )
     used = max(p.decimate for p in rec.pieces)
     prep = {"cutoff_hz": rec.cutoff_hz, "cutoff_source": source, "decimate": used}
     prep |= {"max_gap_s": gap, "sample_rate_hz": rec.pieces[0].sample_rate_hz}
+    prep |= {"torque_delay_s": lag} if lag else {}
     if base is None:
         if isinstance(inner, IdentifiedModel) and (why := holds_the_load(inner, rec.summary())):
             raise DataError(why)
@@ -875,6 +878,7 @@ def _log_route(
             max_gap_s=gap,
             drive=d,
             rtol=opt["rtol"],
+            torque_delay_s=lag,
         )
         differenced = _difference_said(inner, the_arm, note, notes)
     still = still_joints(logs, d)
@@ -950,6 +954,14 @@ def _friction_rows(
     return chosen, other
 
 
+def _recorded_delay(arm: Any) -> float:
+    """The torques' lag behind the positions [s] an identified ``arm`` was identified with
+    (:attr:`~dynid.identification.info.LogInfo.torque_delay_s`): the loaded recordings are
+    prepared with it too; 0 for a robot or a model of static data."""
+    log = arm.info.log if isinstance(arm, IdentifiedModel) else None
+    return 0.0 if log is None else float(log.torque_delay_s)
+
+
 def _prepared_base(
     kin: Robot,
     base: Sequence[TorqueLog],
@@ -970,6 +982,7 @@ def _prepared_base(
             max_gap_s=opt["max_gap_s"],
             decimate=decimate,
             drive=opt["drive"],
+            torque_delay_s=opt["torque_delay_s"],
         )
 
 

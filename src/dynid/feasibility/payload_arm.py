@@ -248,6 +248,7 @@ def unloaded_arm(
     max_gap_s: float | None = None,
     drive: Drive | None = None,
     rtol: float | None = None,
+    torque_delay_s: float = 0.0,
 ) -> tuple[ArmModel, str]:
     """The arm identified from data recorded without the load, and a note saying how.
 
@@ -268,6 +269,8 @@ def unloaded_arm(
         The drive the data were recorded through.
     rtol : float, optional
         Relative rank tolerance (default: identification's).
+    torque_delay_s : float
+        Recordings: how far the torques lag the positions [s] (the loaded data's).
     """
     if isinstance(unloaded, StaticDataset):
         model = identify_static(robot, unloaded, rtol=rtol, drive=drive)
@@ -283,6 +286,7 @@ def unloaded_arm(
             max_gap_s=max_gap_s,
             drive=drive,
             rtol=rtol,
+            torque_delay_s=torque_delay_s,
         )
         chosen = model_structure(model)
         how = "chosen on held-out data" if structure == "auto" else "given"

@@ -96,6 +96,10 @@ class LogInfo:
         the joints): the motion the model was identified on, which ``validate`` compares
         a recording's with (:mod:`~dynid.identification.motion_range`); None in older
         records.
+    drop_invalid : bool
+        Rows with NaN/inf or a repeated timestamp were dropped from the logs
+        (``--drop-invalid``) instead of refused: ``validate``, ``friction``, ``observe``
+        and ``payload`` read their recordings so too (False in older records).
     """
 
     cutoff_hz: float | None
@@ -117,6 +121,7 @@ class LogInfo:
     n_dropped: int = 0
     stamp_jitter_s: float = 0.0
     torque_delay_s: float = 0.0
+    drop_invalid: bool = False
 
     @property
     def preprocessing(self) -> Preprocessing:

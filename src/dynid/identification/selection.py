@@ -1364,12 +1364,22 @@ def _cut_record(fitted: dict[str, Any], whole: dict[str, Any], cut: _Cut) -> dic
     """A recording's record as fitted, and with the intervals ``cut`` out of it: those
     (``cut_out``, ``[t0, t1]`` [s] each) and the samples they held (``cut_samples``, of
     ``whole``'s ``recorded``; ``recorded`` is what was left), the ``sha256`` of the
-    recording as read (``whole``'s: ``payload --model`` knows the file by it)."""
+    recording as read (``whole``'s: ``payload --model`` knows the file by it). The
+    ``gaps`` the cuts leave in the stamps are not the recording's (a burst cut out, not a
+    gap: :func:`_gaps_not_cut`)."""
     if not cut:
         return fitted
     gone = int(whole.get("recorded", 0)) - int(fitted.get("recorded", 0))
     out = {**fitted, "cut_out": [list(c) for c in cut], "cut_samples": gone}
+    out.pop("gaps", None)
+    out |= {"gaps": gaps} if (gaps := _gaps_not_cut(fitted.get("gaps") or (), cut)) else {}
     return out | ({"sha256": whole["sha256"]} if "sha256" in whole else {})
+
+
+def _gaps_not_cut(gaps: Any, cut: _Cut) -> list[list[float]]:
+    """Of a recording's ``gaps`` (``[t_before, length]`` [s] each), those no interval of
+    ``cut`` ([s], ``(t0, t1)`` each) lies in: the recording's own."""
+    return [[float(t), float(n)] for t, n in gaps if not any(t <= b and a <= t + n for a, b in cut)]
 
 
 def _recorded(

@@ -58,11 +58,12 @@ its noise floor (``noise_rms`` and the states' noise; the factor then takes torq
 arm's model lacks: neither a doubt nor a load to trust).
 ``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
 ``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
-bridged [s], null for the default rule); null for static data. ``friction_terms`` names
-the friction estimated beside the load from torque logs as ``dynid identify`` names a
-structure (the classical ``viscous + coulomb + offset``, or the one chosen on held-out
-data or given by ``--terms``: :mod:`dynid.feasibility.payload_friction`); null for static
-data. Floats use Python's
+bridged [s], null for the default rule; ``torque_delay_s``, the torques' lag behind the
+positions [s] of an identified arm's identification, when not 0); null for static data.
+``friction_terms`` names the friction estimated beside the load from torque logs as
+``dynid identify`` names a structure (the classical ``viscous + coulomb + offset``, or the
+one chosen on held-out data or given by ``--terms``:
+:mod:`dynid.feasibility.payload_friction`); null for static data. Floats use Python's
 shortest round-trip representation.
 """
 

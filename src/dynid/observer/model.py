@@ -24,6 +24,7 @@ from .. import _checks
 from ..exceptions import ShapeError
 from ..friction.model import FrictionModel, FrictionSum
 from ..friction.validation import own_friction
+from ..identification.info import LogInfo
 from ..identification.model import IdentifiedModel, IdentifiedTerm
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -76,6 +77,9 @@ class ObserverModel:
         How far the torques lag the positions [s] as the model was identified
         (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`): the logs it
         observes are prepared with it by default; 0 for a robot's own.
+    logs_read : LogInfo, optional
+        How the identification read its logs (``drop_invalid``, ``max_gap_s``): the logs
+        it observes are read so by default; None for a robot's own.
     """
 
     robot: Robot
@@ -90,6 +94,7 @@ class ObserverModel:
     position_terms: tuple[tuple[ModelTerm, NDArray[np.float64]], ...] = ()
     position_covariance: NDArray[np.float64] | None = None
     torque_delay_s: float = 0.0
+    logs_read: LogInfo | None = None
 
     def __post_init__(self) -> None:
         n = self.robot.n
@@ -191,6 +196,7 @@ def from_identified(
         position_terms=tuple((t.term, np.asarray(t.values, dtype=np.float64)) for t in held),
         position_covariance=None if not held else np.diag(_variances(held)),
         torque_delay_s=0.0 if model.info.log is None else float(model.info.log.torque_delay_s),
+        logs_read=model.info.log,
     )
 
 

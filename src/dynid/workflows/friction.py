@@ -4,7 +4,8 @@ as the command does.
 
 * The logs (one or more files, or a folder) are read strictly with the model's joint
   count, through the column map the model's data were read with when none is given
-  (:mod:`dynid.workflows.recordings`).
+  (:mod:`dynid.workflows.recordings`); their invalid rows dropped and their gaps bridged as
+  the identification's were, unless given (:mod:`dynid.workflows.as_identified`).
 * Each recording, and each piece of one cut at a gap longer than ``max_gap_s``, is
   filtered and differentiated on its own (:func:`~dynid.friction.recordings.prepare_pieces`);
   the laws are fitted on the residual of every piece together.
@@ -22,6 +23,7 @@ as the command does.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -49,6 +51,7 @@ from ..identification.model import IdentifiedModel
 from ..identification.spikes import SPIKES_BEFORE_FIT
 from ..model.drive import Drive
 from ..model.robot import Robot
+from .as_identified import read_as_identified
 from .data_files import ColumnSpec, in_file
 from .options import (
     Cutoff,
@@ -77,7 +80,9 @@ class FrictionOptions:
         Column names and units of another tool's files; default: those the model's data
         were read with.
     drop_invalid : bool
-        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
+        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing;
+        False: as the identification did (:func:`~dynid.workflows.as_identified.
+        read_as_identified`, with a note), else refused.
     drive : Drive, optional
         The drive the log was recorded through, for a model without one.
     cutoff_hz : float or "none", optional
@@ -87,7 +92,9 @@ class FrictionOptions:
         (:func:`~dynid.friction.validation.recorded_cutoff`); ``"none"``
         (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
     max_gap_s : float, optional
-        Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces.
+        Longest gap bridged by interpolation [s]; a longer one cuts a log into pieces;
+        default: the identification's recorded one (a note names it), else the default
+        rule.
     torque_delay_s : float, optional
         How far the torques lag the positions [s]: each piece's states read that much
         earlier before filtering
@@ -201,6 +208,12 @@ def fit_friction_files(
         (the message starts with the file's name).
     """
     opt = options or FrictionOptions()
+    drop, gap = read_as_identified(
+        model.info.log if isinstance(model, IdentifiedModel) else None,
+        opt.drop_invalid,
+        opt.max_gap_s,
+    )
+    opt = dataclasses.replace(opt, drop_invalid=drop, max_gap_s=gap)  # as identify read them
     law, columns, drop_invalid = opt.law, opt.columns, opt.drop_invalid
     drive, cutoff_hz, max_gap_s = opt.drive, opt.cutoff_hz, opt.max_gap_s
     path = data

@@ -185,12 +185,15 @@ def _heldout(
     return kw
 
 
-def _record(model: IdentifiedModel, spec: ColumnSpec | None) -> IdentifiedModel:
-    """The model with the column map its data were read with (``info.column_map``)."""
-    if spec is None or spec == (None, None):
-        return model
-    info = dataclasses.replace(model.info, column_map={"columns": spec[0], "units": spec[1]})
-    return dataclasses.replace(model, info=info)
+def _record(model: IdentifiedModel, opt: IdentifyOptions) -> IdentifiedModel:
+    """The model with the column map its data were read with (``info.column_map``) and,
+    of torque logs, whether their invalid rows were dropped (``info.log.drop_invalid``)."""
+    info, spec = model.info, opt.columns
+    if opt.drop_invalid and info.log is not None:
+        info = dataclasses.replace(info, log=dataclasses.replace(info.log, drop_invalid=True))
+    if spec is not None and spec != (None, None):
+        info = dataclasses.replace(info, column_map={"columns": spec[0], "units": spec[1]})
+    return model if info is model.info else dataclasses.replace(model, info=info)
 
 
 def parsed_terms(terms: str | Structure | None) -> Structure | Literal["auto"]:
@@ -479,8 +482,8 @@ def identify_files(
     got = in_file(path, fit) if len(paths) == 1 else fit()
     result = got.consistent
     if result is not None and result.identified is not None:
-        result = dataclasses.replace(result, identified=_record(result.identified, opt.columns))
-    model = _record(got.model, opt.columns)
+        result = dataclasses.replace(result, identified=_record(result.identified, opt))
+    model = _record(got.model, opt)
     return IdentifyResult(model, result, tuple(paths), got.heldout, got.torque_delay, got.gravity)
 
 
@@ -746,7 +749,7 @@ def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> Identi
     misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
     if misfit is not None:
         warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
-    return _record(model, opt.columns)
+    return _record(model, opt)
 
 
 def _searched(
@@ -934,5 +937,5 @@ def _consistent_static(
     )
     if result.identified is None:  # pragma: no cover - identify_consistent always sets it
         raise DataError("the one-step identification returned no unconstrained fit")
-    model = _record(result.identified, opt.columns)
+    model = _record(result.identified, opt)
     return dataclasses.replace(result, identified=model), model

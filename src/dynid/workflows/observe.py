@@ -12,10 +12,12 @@ the command applies, so that the Python API behaves as the command does.
 * Logs are read strictly with the model's joint count (extra columns ignored, with a
   warning), through the column map the model's data were read with when none is given, and
   brought to the joint side through the model's drive. A log is cut at its gaps (steps
-  longer than ``max_gap``, default :func:`~dynid.identification.log.default_max_gap`, as
-  ``identify`` cuts): the observer starts again on each piece and no event spans a cut
-  (one warning names the file and the times). Rows dropped for NaN or inf
-  (``drop_invalid``; refused otherwise, the row named) are bridged as ``identify``
+  longer than ``max_gap``, default the model's identification's, else
+  :func:`~dynid.identification.log.default_max_gap`, as ``identify`` cuts): the observer
+  starts again on each piece and no event spans a cut (one warning names the file and the
+  times). Rows dropped for NaN or inf (``drop_invalid``, or the model's identification
+  dropped them: :mod:`dynid.workflows.as_identified`; refused otherwise, the row named)
+  are bridged as ``identify``
   bridges them: the observer carries on across the step they leave when it is within
   that rule (its update takes any step), and a longer one is a gap. A position that
   jumps more than its velocity explains over a regular time step (samples lost without a
@@ -108,6 +110,7 @@ from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import wrench_kind, wrench_rank
 from ..progress import NOTE
+from .as_identified import identification_beside, read_as_identified
 from .data_files import (
     ColumnSpec,
     column_map,
@@ -221,10 +224,13 @@ class ObserveOptions:
     drop_invalid : bool
         Drop rows with NaN/inf or a repeated timestamp instead of failing (the observer
         carries on across the step they leave, or starts again after it when it is longer
-        than ``max_gap``).
+        than ``max_gap``); False: as the model's identification did
+        (:func:`~dynid.workflows.as_identified.read_as_identified`, with a note), else
+        refused.
     max_gap : float, optional
         Longest step [s] the observer integrates over (rows dropped with
-        ``drop_invalid`` included); the log is cut at longer ones.
+        ``drop_invalid`` included); the log is cut at longer ones; default: the model's
+        identification's (a note names it), else the default rule.
     base, tip : str, optional
         The chain of a ``params`` URDF with several leaves (its root and only leaf by
         default).
@@ -363,7 +369,30 @@ def load_observer_model(
         fr = placed_friction(loaded, own)
     if fr in ("model", "robot") and (said := own_at_motors_note(robot, own)) is not None:
         _log.log(NOTE, said)
-    return from_robot(robot, friction="robot" if fr == "model" else fr, drive=own), None
+    obs = from_robot(robot, friction="robot" if fr == "model" else fr, drive=own)
+    return _read_as_beside(obs, spec)
+
+
+def _read_as_beside(
+    obs: ObserverModel, params: str
+) -> tuple[ObserverModel, Mapping[str, str | None] | None]:
+    """``obs`` of a ``params`` ``feasible.json`` that reads its logs as the
+    ``identification.json`` beside it records (its torque delay, invalid rows and gap rule:
+    :func:`~dynid.workflows.as_identified.identification_beside`, with a note), with its
+    column map; ``obs`` as it is, and None, without one."""
+    own = identification_beside(params, obs.robot) if params.lower().endswith(".json") else None
+    if own is None or own.info.log is None:
+        return obs, None
+    _log.log(
+        NOTE,
+        "%s: the logs read as identification.json beside it records (its --columns/--units, "
+        "torque delay, --drop-invalid and gap rule), as --model reads them; each given "
+        "replaces its part",
+        Path(params).name,
+    )
+    log = own.info.log
+    obs = dataclasses.replace(obs, torque_delay_s=float(log.torque_delay_s), logs_read=log)
+    return obs, own.info.column_map
 
 
 def default_tip_hint(params: str, robot: Robot, tip: str | None) -> str | None:
@@ -506,6 +535,8 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         drive=opts.drive,
         snap_angles=opts.snap_angles,
     )
+    drop, gap = read_as_identified(model.logs_read, opts.drop_invalid, opts.max_gap)
+    opts = dataclasses.replace(opts, drop_invalid=drop, max_gap=gap)  # as identify read them
     fingerprint = model_fingerprint(opts)
     given = _given_thresholds(opts, model, fingerprint)
     own = friction_source(opts) if model.friction is not None else None

@@ -47,6 +47,7 @@ from ..io.feasible import (
 )
 from ..model.drive import Drive
 from ..model.robot import Robot
+from .as_identified import identification_beside, read_as_identified
 from .data_files import ColumnSpec, column_map, data_kind, in_file, read_static_file
 from .export import ExportRobotOptions, RobotExport, export_robot
 from .identify import data_files, parsed_terms
@@ -154,14 +155,17 @@ def identify_payload_files(
         ``--columns`` and ``--units`` of files of another tool (default: an identified
         model's recorded ones, or those a ``feasible`` file records).
     drop_invalid : bool
-        Drop invalid rows (counted) instead of failing.
+        Drop invalid rows (counted) instead of failing; False: torque logs as an
+        identified ``arm``'s identification did
+        (:func:`~dynid.workflows.as_identified.read_as_identified`, with a note).
     cutoff_hz : float or "none", optional
         Torque logs: zero-phase low-pass cut-off [Hz]; default: the identification's
         recorded one (with its decimation; none if it was identified without), else the one
         read from the motion; ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): none.
         Refused with static data, which are not filtered.
     max_gap_s : float, optional
-        Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces.
+        Torque logs: longest gap bridged [s]; a longer one cuts a log into pieces; default:
+        an identified ``arm``'s recorded one (a note names it), else the default rule.
     drive : Drive, optional
         The drive the data were recorded through, for an arm without one (a robot's known
         rotor inertias come from it).
@@ -212,14 +216,11 @@ def identify_payload_files(
         return _static(arm, kin, paths, base, cmap, drop_invalid, gravity_only, common)
     if gravity_only:
         raise DataError("--gravity-only applies to static data (q, g), not to a torque log")
+    drop_invalid, max_gap_s = read_as_identified(_logs_read(arm, feasible), drop_invalid, max_gap_s)
     read_as: dict[str, Any] = dict(
-        recorded=_recorded_columns(arm, feasible),
-        columns=columns,
-        drop_invalid=drop_invalid,
-        cutoff_hz=known,
-        drive=read_drive,
-        sign_map=True,
-    )
+        recorded=_recorded_columns(arm, feasible), columns=columns, drop_invalid=drop_invalid,
+        cutoff_hz=known, drive=read_drive, sign_map=True,
+    )  # fmt: skip
     rec = read_recordings(
         paths, kin, owner=f"robot {kin.name!r}", q_start=q_start, max_gap_s=max_gap_s, **read_as
     )
@@ -241,6 +242,19 @@ def identify_payload_files(
     )
     est = in_file(paths[0], fit) if len(paths) == 1 else fit()
     return PayloadFileResult(est, "torque_log")
+
+
+def _logs_read(arm: Robot | IdentifiedModel, feasible: str | Path | None) -> Any:
+    """How the arm's own logs were read (:class:`~dynid.identification.info.LogInfo`): an
+    identified model's record, else that of the ``identification.json`` beside a
+    ``feasible`` file (:func:`~dynid.workflows.as_identified.identification_beside`), else
+    None."""
+    if isinstance(arm, IdentifiedModel):
+        return arm.info.log
+    if feasible is None or Path(feasible).suffix.lower() != ".json":
+        return None
+    own = identification_beside(feasible, arm)
+    return None if own is None else own.info.log
 
 
 def _logs_only(**given: Any) -> None:

@@ -3,7 +3,8 @@ with every policy the command applies, so that the Python API behaves as the com
 
 * The recordings (one or more files, or a folder) are read strictly with the model's
   joint count, through the column map the model's data were read with when none is given
-  (:mod:`dynid.workflows.recordings`).
+  (:mod:`dynid.workflows.recordings`); their invalid rows dropped and their gaps bridged as
+  the identification's were, unless given (:mod:`dynid.workflows.as_identified`).
 * The friction added to the model: its own (an identified model's classical friction, a
   robot's published sigmoid, the friction stored in a ``feasible.json``), none, a
   friction file, or a friction model (:class:`ValidateOptions` ``friction``).
@@ -79,12 +80,12 @@ from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_del
 from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
-from ..io.model_json import load_model_json
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..observer.residual_load import ResidualLoad
 from ..progress import NOTE
+from .as_identified import identification_beside, read_as_identified
 from .data_files import ColumnSpec, in_file
 from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
 from .recordings import (
@@ -118,14 +119,17 @@ class ValidateOptions:
     columns : (str or None, str or None), optional
         Column names and units of another tool's files; default: the model's recorded ones.
     drop_invalid : bool
-        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing.
+        Drop rows with NaN/inf or a repeated timestamp (counted) instead of failing;
+        False: as the identification did (:func:`~dynid.workflows.as_identified.
+        read_as_identified`, with a note), else refused.
     cutoff_hz : float or "none", optional
         Low-pass cut-off of the states [Hz]; default: the identification's recorded one
         (no filter if it was identified without), else the one read from the recordings'
         motion; ``"none"`` (:data:`~dynid.workflows.options.NO_FILTER`): no low-pass.
     max_gap_s : float, optional
         Longest gap bridged by interpolation [s]; a longer one cuts a recording into
-        pieces.
+        pieces; default: the identification's recorded one (a note names it), else the
+        default rule.
     torque_delay_s : float, optional
         How far the torques lag the positions [s] (positive: the torques late): each
         piece's torques read that much later before filtering
@@ -393,9 +397,9 @@ def validate_files(
     ShapeError
         A friction model of another joint count.
     """
-    opt = options or ValidateOptions()
     robot = model.robot if isinstance(model, IdentifiedModel) else model
     own = _own_record(model, feasible, source)  # whose record reads and prepares the data
+    opt = _as_identified(options or ValidateOptions(), own)  # as identify read its logs
     drive, placed = _drives(model, opt.drive, feasible)
     rec = recorded or read_recordings(
         data, robot, recorded=None if own is None else own.info.column_map, columns=opt.columns,
@@ -467,6 +471,15 @@ def validate_files(
     )  # fmt: skip
 
 
+def _as_identified(opt: ValidateOptions, own: IdentifiedModel | None) -> ValidateOptions:
+    """``opt`` with ``drop_invalid`` and ``max_gap_s`` as given, else as ``own``'s
+    identification read its logs (:func:`~dynid.workflows.as_identified.read_as_identified`,
+    with a note)."""
+    record = None if own is None else own.info.log
+    drop, gap = read_as_identified(record, opt.drop_invalid, opt.max_gap_s)
+    return dataclasses.replace(opt, drop_invalid=drop, max_gap_s=gap)
+
+
 def _drives(
     model: IdentifiedModel | Robot, given: Drive | None, feasible: str | Path | None
 ) -> tuple[Drive | None, Drive | None]:
@@ -487,21 +500,6 @@ def _recorded_delay(model: IdentifiedModel | Robot | None) -> float:
     """The delay [s] an identified model was identified with (0: a robot, static data)."""
     own = model.info.log if isinstance(model, IdentifiedModel) else None
     return 0.0 if own is None else float(own.torque_delay_s)
-
-
-def identification_beside(feasible: str | Path, robot: Robot) -> IdentifiedModel | None:
-    """The model of the ``identification.json`` in the folder of ``feasible`` (``identify
-    --consistent`` writes both) whose robot has ``robot``'s joints, or None (none there,
-    not readable, another arm): the record of how the data the consistent parameters were
-    fitted to were read and prepared."""
-    path = Path(feasible).with_name("identification.json")
-    if path == Path(feasible) or not path.is_file():
-        return None
-    try:
-        mine = load_model_json(path)
-    except DataError:
-        return None
-    return mine if mine.robot.joint_names == robot.joint_names else None
 
 
 def _own_record(
