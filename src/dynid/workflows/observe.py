@@ -785,6 +785,24 @@ def _read_logs(
     return read
 
 
+def _judge_sign(name: str, sign: TorqueSign, noise: GainNoiseTally, names: Sequence[str]) -> None:
+    """A calibration log's torques read against the model's through its residual
+    (:mod:`dynid.observer.sign`): refused where their sign is opposite, a warning where the
+    model leaves most of them unexplained beside the velocities' noise through the gain
+    (``noise``, that log's).
+
+    Raises
+    ------
+    DataError
+        Torques of the opposite sign to the model's on some joint or every joint."""
+    if (opposite := opposite_finding(sign, names)) is not None:
+        raise DataError(opposite, file=name)
+    found = noise.result()
+    gain_noise = None if found is None else found.predicted
+    if (unexplained := unexplained_finding(sign, names, gain_noise)) is not None:
+        warnings.warn(f"{name}: {unexplained}", DynidWarning, stacklevel=3)
+
+
 def _calibrated(
     read: Recorded,
     model: ObserverModel,
@@ -850,13 +868,8 @@ def _calibrated(
                 if unmodelled is not None:  # the friction the model misses, at speed
                     unmodelled.add(prep.log.t[rows], dq[rows], blk.r)
                 yield blk
-            if (opposite := opposite_finding(sign, names)) is not None:
-                raise DataError(opposite, file=Path(path).name)
+            _judge_sign(Path(path).name, sign, mine, names)
             tally.merge(mine)
-            found = mine.result()
-            gain_noise = None if found is None else found.predicted
-            if (unexplained := unexplained_finding(sign, names, gain_noise)) is not None:
-                warnings.warn(f"{Path(path).name}: {unexplained}", DynidWarning, stacklevel=2)
             logs.append(_observation(prep, model, mapped, opts, keep, peak, seen))
 
     # calibrate reads a block's residual, then its margin and std: these two come from the
