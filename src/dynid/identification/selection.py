@@ -55,7 +55,7 @@ from typing import Any, Literal, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, OptionError
+from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import stage
@@ -75,7 +75,7 @@ from .candidates import (
     within_best,
     without_recordings,
 )
-from .core import model_columns, shared_bases
+from .core import model_advice, model_columns, shared_bases
 from .dissipation import (
     Violation,
     friction_columns,
@@ -1094,6 +1094,7 @@ def identify_recordings(
         exact, estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
     )  # fmt: skip
     kw: dict[str, Any] = dict(std=std, base=base, rtol=rtol, max_std_percent=max_std_percent)
+    kw["advise"] = False  # the final fit's advice alone (_warned), not the fits before it
     model, terms, fitted, odd, given = _fitted_chosen(
         robot, logs, fitted, structure, drive, folds, validation, keep_outlying, prep,
         judge=selection is None, estimator=est, **kw,
@@ -1103,7 +1104,7 @@ def identify_recordings(
             robot, logs, data, bursts, selection, structure, validate_on, drive, friction,
             given, estimator=est, folds=folds, prep=prep, **kw,
         )  # fmt: skip
-    warn_unphysical(model, terms)
+    _warned(model, terms)
     if selection is not None and structure == selection.chosen:
         selection = _per_recording_of(model, selection, gone)
     heldout = _heldout_record(model, fitted if validation is None else validation)
@@ -1111,6 +1112,17 @@ def identify_recordings(
     model = _recorded(model, exact, combined, heldout, structure, selection, given)
     gone |= odd  # left out (or cut) by the choice (auto) or under the structure given
     return _with_left_out(model, data, gone, fitted) if gone else model
+
+
+def _warned(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
+    """The final fit's warnings: its friction where not dissipative (:func:`~.dissipation.
+    warn_unphysical`) and its conditioning advice (:func:`~.core.model_advice`). The fits
+    before it (the other estimator's, those with recordings left out or spans cut) say
+    none: a UR5's ols fit named ``beta19 (1.08e+03 %)`` above a table whose wls fit has
+    ``beta19`` at 50.5 %."""
+    warn_unphysical(model, terms)
+    for msg in model_advice(model):
+        warnings.warn(msg, DynidWarning, stacklevel=2)
 
 
 def _check_given(
