@@ -39,6 +39,7 @@ __all__ = [
     "candidate_judged",
     "cut_record",
     "heldout_of",
+    "loose_pushing",
     "paired_fold_se",
     "paired_se",
     "recording_oddness",
@@ -63,7 +64,8 @@ DETERMINED_STD_PERCENT = 20.0
 #: How the structure is chosen (:func:`paired_se`, :data:`DETERMINED_STD_PERCENT`).
 RULE = (
     "simplest within one standard error of the lowest held-out error (each joint in units "
-    "of its own noise), paired over the folds; a coefficient determined to 20 % kept"
+    "of its own noise), paired over the folds; a coefficient determined to 20 % kept; "
+    "friction below zero not determined to 20 % left out"
 )
 #: Held-out errors closer than this fraction of the lowest one count as equal: a model
 #: that predicts 1 % better (relative) is not worth a term.
@@ -118,6 +120,10 @@ class Candidate:
         Each coefficient it holds that a per-joint structure may leave out (``Ia5``,
         ``fv3``) and its relative standard deviation [%] in its fit on all data (as the
         identified model's: HAC, :func:`std_inflation`; ``inf`` at a coefficient of 0).
+    loose_pushing : tuple of (str, float, float)
+        Its friction coefficients that push the arm by themselves and that the data do
+        not determine (:func:`loose_pushing`): each one's label, value in its fit on all
+        data and relative standard deviation [%]; the choice leaves them out.
     """
 
     structure: Structure
@@ -134,6 +140,7 @@ class Candidate:
     relative_std: tuple[tuple[str, float], ...] = ()
     negative_bump: tuple[str, ...] = ()
     part_scores: tuple[float, ...] = ()
+    loose_pushing: tuple[tuple[str, float, float], ...] = ()
 
     @property
     def skipped(self) -> bool:
@@ -329,6 +336,7 @@ def candidate_judged(
     unphysical: tuple[Violation, ...] = ()
     relative: tuple[tuple[str, float], ...] = ()
     negative: tuple[str, ...] = ()
+    loose: tuple[tuple[str, float, float], ...] = ()
     if check is not None:
         assert whole_std is not None  # asked for with the check
         x, sd = np.zeros(use.size), np.zeros(use.size)
@@ -336,6 +344,7 @@ def candidate_judged(
         unphysical = check(x, sd)
         relative = relative_stds(x, sd, use, labels)
         negative = negative_bumps(x, use, labels)
+        loose = loose_pushing(x, sd, use, labels)
     return Candidate(
         structure=structure,
         n_params=int(use.sum()),
@@ -349,6 +358,7 @@ def candidate_judged(
         relative_std=relative,
         negative_bump=negative,
         part_scores=tuple(parts),
+        loose_pushing=loose,
     )
 
 
@@ -363,6 +373,33 @@ def negative_bumps(
     ``use`` whose value in ``x`` is below zero (static friction below Coulomb)."""
     found = (lab for lab, v, u in zip(labels, x, use, strict=False) if u and v < 0)
     return tuple(dict.fromkeys(lab for lab in found if _BUMP.fullmatch(lab)))
+
+
+#: A friction coefficient that dissipates by itself only when positive, of one joint
+#: (motor): viscous, Coulomb (sharp or smooth) or quadratic, ``fv3``, ``fc3``, ``fq3``,
+#: ``jfv7`` at a joint beside the motors.
+_DISSIPATING = re.compile(r"j?f[vcq][0-9]+")
+
+
+def loose_pushing(
+    x: NDArray[np.float64], sd: NDArray[np.float64], use: NDArray[np.bool_], labels: Sequence[str]
+) -> tuple[tuple[str, float, float], ...]:
+    """The friction coefficients among the columns ``use`` (``labels``: one per column)
+    that push the arm by themselves and that the data do not determine: viscous, Coulomb
+    or quadratic (``fv3``, ``fc3``, ``fq3``) below zero in ``x`` on every column of theirs
+    in use, none of them determined (relative standard deviation ``sd / |x|`` above
+    :data:`DETERMINED_STD_PERCENT`). Each one's label, value (of its first column in use)
+    and smallest relative standard deviation [%], in column order."""
+    seen: dict[str, list[tuple[float, float]]] = {}
+    for lab, on, xi, si in zip(labels, use, x, sd, strict=bool(labels)):
+        if lab and on and _DISSIPATING.fullmatch(lab):
+            r = 100.0 * float(si) / abs(float(xi)) if xi else math.inf
+            seen.setdefault(lab, []).append((float(xi), r))
+    return tuple(
+        (lab, got[0][0], min(r for _, r in got))
+        for lab, got in seen.items()
+        if all(v < 0 for v, _ in got) and min(r for _, r in got) > DETERMINED_STD_PERCENT
+    )
 
 
 def relative_stds(

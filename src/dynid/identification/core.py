@@ -74,6 +74,7 @@ __all__ = [
     "fit_stack",
     "identify",
     "informative_blocks",
+    "model_advice",
     "model_columns",
     "shared_bases",
     "stack_dataset",
@@ -254,6 +255,7 @@ def identify(
     rtol: float | None = None,
     judge: Judge | None = None,
     fold_labels: NDArray[np.intp] | None = None,
+    advise: bool = True,
 ) -> IdentifiedModel:
     """Identify the base parameters (and the appended terms: friction) from a data set.
 
@@ -295,6 +297,10 @@ def identify(
         with an estimator that does not weigh, the fit's pass gathers their normal
         equations (``StreamedRows.normals``, handed to the judge) so that the judgement
         needs no pass of its own.
+    advise : bool
+        Warn the fit's conditioning advice (default); False: a caller that fits several
+        models and keeps one warns the advice of the one it keeps (:func:`model_advice`),
+        so that no warning names the coefficients of a fit it did not keep.
 
     Returns
     -------
@@ -317,8 +323,9 @@ def identify(
     Warns
     -----
     DynidWarning
-        Dropped blocks holding data, an ill-conditioned regressor or coefficients above
-        1000 % std (:func:`~dynid.identification.least_squares.conditioning_advice`).
+        Dropped blocks holding data; with ``advise``, an ill-conditioned regressor or
+        coefficients above 1000 % std (:func:`~dynid.identification.least_squares.
+        conditioning_advice`).
     """
     data.check_robot(robot)
     check_options(std=std, max_std_percent=max_std_percent)
@@ -341,7 +348,7 @@ def identify(
             structural = structural_rank(robot, columns, ~frozen)
         raise _rank_error(exc, data, columns, stack, fit_rtol, structural) from exc
     held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
-    for msg in conditioning_advice(fit, labels, what=_what(data)):
+    for msg in conditioning_advice(fit, labels, what=_what(data)) if advise else ():
         warnings.warn(msg, DynidWarning, stacklevel=2)
     info = _record(data, columns, fit, stack, est.name, std, max_std_percent, rtol)
     if held is not None:
@@ -356,6 +363,16 @@ def check_options(*, std: str, max_std_percent: float | None) -> None:
     if max_std_percent is not None and not max_std_percent > 0:
         raise OptionError(f"max_std_percent must be positive or None; got {max_std_percent}")
     checked_std(std)
+
+
+def model_advice(model: IdentifiedModel, what: str = "the trajectory") -> list[str]:
+    """The conditioning advice of ``model``'s fit over every column
+    (:func:`~dynid.identification.least_squares.conditioning_advice`, the base parameters'
+    labels then the appended terms'), as :func:`identify` warns it; ``what`` names the
+    data ("the trajectory", "the configurations")."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    labels = model.base.labels + tuple(lab for t in model.appended for lab in t.labels)
+    return conditioning_advice(fit, labels, what=what)
 
 
 def _what(data: Dataset) -> str:
