@@ -49,9 +49,7 @@ def _pinocchio_panda_log(path, n_samples=2000, rate=500.0):
     ddq = -amp * w**2 * np.sin(np.outer(t, w))
     tau = np.stack([pin.rnea(model, data, *x) for x in zip(q, dq, ddq, strict=True)])
     tau += model.damping * dq  # the URDF's <dynamics damping>, as Pinocchio reads it
-    head = ",".join(
-        ["t", *(f"{c}{i}" for c in ("q", "dq", "tau", "ddq") for i in range(1, 8))]
-    )
+    head = ",".join(["t", *(f"{c}{i}" for c in ("q", "dq", "tau", "ddq") for i in range(1, 8))])
     rows = np.column_stack([t, q, dq, tau, ddq])
     with open(path, "w") as f:
         f.write("# units: t [s], q [rad], dq [rad/s], tau [N m], ddq [rad/s^2]\n")
