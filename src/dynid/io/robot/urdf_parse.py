@@ -292,9 +292,9 @@ def chain_with_branches(
     robot : Robot
         The chain, read as :func:`robot_from_urdf_string` reads it.
     off : OffChain
-        The branches left out (links hanging off a moving body through moving joints:
-        fingers) and the fixed links merged
-        (:func:`~dynid.io.robot.urdf_branches.off_chain`).
+        The branches (links hanging off a moving body through moving joints: those past
+        the tip, fingers, lumped into the last body; the others left out) and the fixed
+        links merged (:func:`~dynid.io.robot.urdf_branches.off_chain`).
 
     Raises
     ------

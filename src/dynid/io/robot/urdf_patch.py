@@ -271,7 +271,8 @@ def _bodies(
     source: str,
 ) -> tuple[dict[str, NDArray[np.float64] | None], NDArray[np.float64]]:
     """The inertials to write (link -> phi (10,), None: remove) and the ``phi`` (n, 10) the
-    patched template's chain must read back as (its branches left out, as a reader does).
+    patched template's chain must read back as (as a reader reads it: the branches past the
+    tip lumped at rest, the others left out).
 
     ``subtract`` and ``move`` take the identified body ``k`` to hold everything that moved
     with it on the arm: the fixed links merged into it and, for the last body, the
