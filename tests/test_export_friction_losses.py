@@ -199,7 +199,8 @@ def test_urdf_export_names_an_armature_without_gears_only_when_not_negligible(tm
 def test_template_dynamics_are_replaced_by_the_identified_friction(tmp_path):
     """A vendor template with damping/friction 1-2 on every joint: patched, the chain's
     <dynamics> hold the identified fv and fc (read back to 1e-12, Pinocchio reads the
-    same), the gripper's stay, and every other byte is the template's."""
+    same), the gripper's stay, and every other byte is the template's but dynid's comment
+    at the top."""
     pin = pytest.importorskip("pinocchio")
     path, chain = _z1()
     text = open(path).read()
@@ -209,7 +210,9 @@ def test_template_dynamics_are_replaced_by_the_identified_friction(tmp_path):
     options = ExportOptions(template=path, tip="link06", merged="keep", friction=fr)
     out, lines = _warnings(export_urdf, tmp_path / "z1.urdf", chain, options)
     assert lines == []
-    patched = out.read_text()
+    head, header, rest = out.read_text().split("\n", 2)
+    assert "the joints' friction as <dynamics damping friction> (identified)" in header
+    patched = f"{head}\n{rest}"  # without dynid's comment at the top
     inertial = re.compile(r"<inertial\b.*?</inertial>", re.S)
     assert _DYN.sub("", inertial.sub("", patched)) == _DYN.sub("", inertial.sub("", text))
     assert len(_DYN.findall(patched)) == len(_DYN.findall(text))

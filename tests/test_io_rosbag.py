@@ -385,6 +385,25 @@ def test_a_bag_folder_given_to_data_names_the_import_that_converts_it(
     np.testing.assert_allclose(back.t, log.t, atol=1e-9)
 
 
+def test_a_ros1_bag_given_to_data_names_the_import_that_converts_it(tmp_path, capsys, monkeypatch):
+    """Regression (a Baxter trial's identify --data train1.bag said only "a data file must
+    be .csv or .npz"): it names the dynid import that converts the bag, as the bag-folder
+    case does, and that command, run as given, writes the log the bag holds."""
+    robot = dynid.panda()
+    log = _small(robot, N=60, seed=9)
+    write_bag(tmp_path / "train1.bag", "ros1", _shuffled(log, robot, 10))
+    monkeypatch.chdir(tmp_path)
+    assert main(["identify", "--robot", "panda", "--data", "train1.bag", "--out", "o"]) == 2
+    err = capsys.readouterr().err
+    assert "train1.bag: a data file must be .csv or .npz; it is a ROS 1 bag" in err, err
+    command = err.split("'dynid ")[1].split("'")[0].replace("ROBOT", "panda")
+    assert command == "import train1.bag --robot panda --out train1.csv", err
+    assert main(command.split()) == 0
+    back = load_torque_log(tmp_path / "train1.csv")
+    np.testing.assert_array_equal(back.tau, log.tau)
+    np.testing.assert_allclose(back.t, log.t, atol=1e-9)
+
+
 def test_import_labels_the_effort_with_the_drives_unit(tmp_path, capsys):
     """Regression: dynid import wrote 'tau [N m]' on the units line of motor currents; with
     a --drive whose effort is current it writes 'tau [A]' (which identify refuses to read

@@ -54,7 +54,7 @@ REFUSED = [
     ),
     (
         "validate --model {d}/m.json --data {d}/l.csv --base x",
-        "--base applies to a URDF --robot only",
+        "--base applies to a URDF --robot or --params only",
     ),
     (
         "simulate --trajectory sinusoid --harmonics 3 --base-freq 0.3",

@@ -62,6 +62,26 @@ def test_random_drops_are_counted_exactly_under_heavy_jitter():
     assert 0.9 * true_gaps <= np.count_nonzero(steps > 1) <= true_gaps
 
 
+@pytest.mark.parametrize("past", [0.55, -0.55])
+def test_a_stamp_jittered_past_half_a_period_drops_no_sample(past):
+    """Regression (a Baxter trial's train1: 1.5 ms of Gaussian jitter at 100 Hz, one stamp
+    0.53 periods late in 3000; import said "std 5.2 ms ... 1 sample(s) dropped", the two
+    other recordings made the same way 1.5 ms and none): 1.45 ms of unclipped jitter (0.145
+    periods, placed on the grid stamp by stamp) with stamp 1500 0.55 periods late or early:
+    no step holds a dropped sample, the jitter is the drawn one (to 5 %), and with
+    samples 1000-1003 removed the one gap of 4 is found."""
+    rng = np.random.default_rng(11)
+    e = rng.normal(0.0, 1.45e-3, 3000)
+    e[1499:1502] = [0.0, past * H, 0.0]
+    t = np.arange(3000) * H + e
+    steps, _, jitter = grid_steps(t)
+    assert np.all(steps == 1) and jitter == pytest.approx(float(np.std(e)), rel=0.05)
+    c = _log(t, seed=5).cleaning
+    assert c.n_dropped == 0 and c.stamp_jitter_s == pytest.approx(float(np.std(e)), rel=0.05)
+    steps, _, _ = grid_steps(_gap(t))
+    assert np.flatnonzero(steps != 1).tolist() == [999] and steps[999] == 5
+
+
 def _log(t: np.ndarray, seed: int) -> TorqueLog:
     """A Panda torque log at stamps ``t`` (a slow sinusoid, noise-free torques)."""
     panda = dynid.panda()

@@ -61,29 +61,19 @@ def panda_urdf() -> str:
 
 @pytest.mark.parametrize("tip", ["panda_link8", "panda_hand"])
 def test_panda_urdf_matches_pinocchio_on_random_states(panda_urdf, tip):
-    """URDF Panda (fingers locked) equals Pinocchio on the same file: FK, J, RNEA, M, g, c."""
+    """URDF Panda equals Pinocchio on the same file with the fingers locked at neutral:
+    FK, J, RNEA, M, g, c (the fingers past the tip lumped into link 7 at their zero
+    position, as Pinocchio's reduced model does; before, they were left out and a test
+    had to add them as tools)."""
     robot = load_urdf(panda_urdf, "panda_link0", tip)
     full = pin.buildModelFromUrdf(panda_urdf)
     fingers = [full.getJointId(k) for k in ("panda_finger_joint1", "panda_finger_joint2")]
-    # Pinocchio merges the locked fingers into link 7; the fingers are off our chain, so add
-    # them as tools at their q = 0 placement, read from Pinocchio's model.
-    for jid in fingers:
-        Y = full.inertias[jid]
-        robot = robot.with_tool(
-            full.jointPlacements[jid].homogeneous,
-            Y.mass,
-            Y.lever,
-            Y.inertia,
-            parent="panda_link7",
-            name=f"locked_{full.names[jid]}",
-        )
     model, data = pin_model(pin.buildReducedModel(full, fingers, pin.neutral(full)), robot)
     assert robot.n == model.nv == 7
     assert robot.frames["flange"].link == 7
     np.testing.assert_allclose(
         dynid.fk(robot, np.zeros(7), "flange"), dynid.fk(robot, np.zeros(7), tip), atol=0
     )
-    robot = robot.replace(frames={k: f for k, f in robot.frames.items() if "locked" not in k})
     assert_matches_pinocchio(robot, model, data, n_states=100, seed=11)
 
 
@@ -125,15 +115,20 @@ def test_panda_urdf_structure_names_limits_and_frames(panda_urdf):
     np.testing.assert_array_equal(robot.frames["flange"].T_link_frame, T7_hand)
 
 
-def test_panda_urdf_loads_without_warnings(panda_urdf):
-    """The Panda URDF's inertials are consistent, so loading it warns about nothing but
-    the two fingers (prismatic joints off the hand) left out of the chain, 0.015 kg each
-    as the file writes."""
-    with warnings.catch_warnings(record=True) as caught:
+def test_panda_urdf_loads_without_warnings(panda_urdf, caplog):
+    """The Panda URDF's inertials are consistent and its two fingers (prismatic joints off
+    the hand, past the tip) are lumped into link 7: loading it warns about nothing, and a
+    note names the fingers with their 0.015 kg each as the file writes (before: a warning
+    that they were left out)."""
+    from dynid.progress import NOTE
+
+    with warnings.catch_warnings(record=True) as caught, caplog.at_level(NOTE, logger="dynid"):
         warnings.simplefilter("always")
         load_urdf(panda_urdf, tip_link="panda_hand")
-    (said,) = [str(w.message) for w in caught]
-    assert "panda_leftfinger (0.015 kg, through prismatic joint 'panda_finger_joint1'" in said
+    assert [str(w.message) for w in caught] == []
+    (said,) = [r.getMessage() for r in caplog.records if "lumped" in r.getMessage()]
+    assert "panda_leftfinger (0.015 kg, inertia up to" in said
+    assert "through prismatic joint 'panda_finger_joint1' on panda_hand" in said
     assert "panda_rightfinger (0.015 kg" in said
 
 
@@ -162,13 +157,17 @@ def test_panda_urdf_equals_builtin_mdh_panda(panda_urdf):
 
 
 def test_panda_hand_inertia_folds_into_link7(panda_urdf):
-    """Link 7 carries link 7 plus the hand (0.73 kg at (-0.01, 0, 0.03) in the hand frame)."""
+    """Link 7 carries link 7 plus the hand (0.73 kg at (-0.01, 0, 0.03) in the hand frame)
+    plus the two fingers at rest (0.015 kg each, 0.0584 m past the hand along its z)."""
     robot = load_urdf(panda_urdf, "panda_link0", "panda_link8")
     m7, c7 = 0.735522, np.array([1.0517e-02, -4.252e-03, 6.1597e-02])
     T7_hand = robot.frames["panda_hand"].T_link_frame
     c_hand = T7_hand[:3, :3] @ [-0.01, 0.0, 0.03] + T7_hand[:3, 3]
-    np.testing.assert_allclose(robot.mass[6], m7 + 0.73, rtol=1e-15)
-    np.testing.assert_allclose(robot.phi[6, 1:4], m7 * c7 + 0.73 * c_hand, atol=1e-15)
+    c_fingers = T7_hand[:3, :3] @ [0.0, 0.0, 0.0584] + T7_hand[:3, 3]
+    np.testing.assert_allclose(robot.mass[6], m7 + 0.73 + 0.03, rtol=1e-15)
+    np.testing.assert_allclose(
+        robot.phi[6, 1:4], m7 * c7 + 0.73 * c_hand + 0.03 * c_fingers, atol=1e-15
+    )
 
 
 # ---------------------------------------------------------------------------- UR5
@@ -362,23 +361,27 @@ def _gripper_arm(jaw: str) -> str:
     )
 
 
-def test_a_moving_branch_off_the_chain_is_named_with_its_mass_and_fixed_links_merged(caplog):
-    """Regression (a gripper's moving jaw, 12 g, dropped from the model with nothing said,
-    even with -v): the jaw and the pad fixed to it are named once with their 0.015 kg, the
-    fixed TCP is logged as merged into the arm, and noted with its 0.1 kg as it lies
-    beyond the tip; the model's mass is the file's arm and TCP, 1.1 kg; with a fixed jaw
-    joint nothing is left out and the mass is 1.115 kg."""
+def test_a_moving_branch_past_the_tip_is_lumped_at_zero_and_fixed_links_merged(caplog):
+    """Regression (a gripper's moving jaw, 12 g, dropped from the model; then named in a
+    warning with its mass only, its inertia in no link): the jaw and the pad fixed to it
+    are lumped into the last body at the jaw joint's zero, as a fixed jaw joint merges
+    them (the same phi, 1.115 kg), and a note names them with their 0.015 kg and inertia
+    (2 x 1e-4 kg m^2 plus 0.012 kg at 0.02 m and 0.003 kg at 0.08 m from their CoM);
+    the fixed TCP is logged as merged into the arm, and noted with its 0.1 kg as it lies
+    beyond the tip; nothing is warned."""
     import logging
 
-    with caplog.at_level(logging.INFO, logger="dynid"):
-        with pytest.warns(dynid.DynidWarning, match="left out of the chain") as caught:
-            robot = robot_from_urdf_string(_gripper_arm("revolute"), "base", "tip")
-    said = [str(w.message) for w in caught if "left out" in str(w.message)]
-    assert said == [
-        "URDF text: left out of the chain, as they move on joints of their own: jaw and 1 "
-        "link(s) below it (0.015 kg, through revolute joint 'jaw_joint' on arm); their mass "
-        "is in no link of the model (a fixed joint in place of the moving one merges a link "
-        "into the one it hangs from)"
+    with caplog.at_level(logging.INFO, logger="dynid"), warnings.catch_warnings():
+        warnings.simplefilter("error")
+        robot = robot_from_urdf_string(_gripper_arm("revolute"), "base", "tip")
+    lumped = [r.getMessage() for r in caplog.records if "lumped" in r.getMessage()]
+    assert lumped == [
+        "URDF text: links moving on joints of their own past the tip lumped into the last "
+        "body at their joints' zero position (0.015 kg in all): jaw and 1 link(s) below it "
+        "(0.015 kg, inertia up to 0.000224 kg m^2 about its CoM, through revolute joint "
+        "'jaw_joint' on arm); they ride on the arm at whatever opening they have, and at "
+        "rest is the best description of them there is (for an arm run without them, leave "
+        "them out of the URDF)"
     ]
     merged = [r.getMessage() for r in caplog.records if "merged" in r.getMessage()]
     assert merged == [
@@ -388,11 +391,36 @@ def test_a_moving_branch_off_the_chain_is_named_with_its_mass_and_fixed_links_me
         "URDF text: links fixed to the chain merged (their inertials added): tip into arm "
         "(0 kg), tcp into arm (0.1 kg)",
     ]
-    assert robot.phi[:, 0].sum() == pytest.approx(1.1, rel=1e-15)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        fixed = robot_from_urdf_string(_gripper_arm("fixed"), "base", "tip")
+    fixed = robot_from_urdf_string(_gripper_arm("fixed"), "base", "tip")
     assert fixed.phi[:, 0].sum() == pytest.approx(1.115, rel=1e-15)
+    np.testing.assert_allclose(robot.phi, fixed.phi, rtol=0, atol=1e-17)
+    assert "jaw" not in robot.frames and "pad" not in robot.frames
+
+
+def test_a_moving_branch_off_an_earlier_body_is_named_with_its_mass_and_inertia():
+    """A slider on the first of two bodies moves on its own while the chain is recorded:
+    it is left out, and the warning names its mass and its inertia about its CoM (the
+    largest principal moment of 0.1 kg m^2 about z; before: its mass only)."""
+    text = """<robot name="r"><link name="base"/>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"/>
+  </inertial></link>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"/>
+  </inertial></link>
+  <link name="slide"><inertial><mass value="0.2"/><inertia ixx="0.02" iyy="0.08" izz="0.1"/>
+  </inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/>
+    <origin xyz="0 0 0.5"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="s" type="prismatic"><parent link="a"/><child link="slide"/>
+    <axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>"""
+    with pytest.warns(dynid.DynidWarning, match="left out of the chain") as caught:
+        robot = robot_from_urdf_string(text, "base", "b")
+    (said,) = [str(w.message) for w in caught]
+    assert "slide (0.2 kg, inertia up to 0.1 kg m^2 about its CoM, through prismatic " in said
+    assert "their mass and inertia are in no link of the model" in said
+    assert robot.phi[:, 0].sum() == pytest.approx(2.0, rel=1e-15)
 
 
 # ---------------------------------------------------------------------------- errors
@@ -707,11 +735,14 @@ def test_a_hand_merged_beyond_the_tip_is_noted_with_its_mass(caplog):
         return robot, [r.getMessage() for r in caplog.records if r.levelno == NOTE]
 
     robot, lines = notes(lambda: load_urdf(urdf, tip_link="panda_link8"))
-    assert len(lines) == 1 and said in lines[0] and "0.73 kg in all" in lines[0]
+    hanging = [x for x in lines if "merged" in x]
+    assert len(hanging) == 1 and said in hanging[0] and "0.73 kg in all" in hanging[0]
     full = pin.buildModelFromUrdf(urdf)
-    mass7 = full.inertias[full.getJointId("panda_joint7")].mass
+    fingers = [full.getJointId(k) for k in ("panda_finger_joint1", "panda_finger_joint2")]
+    reduced = pin.buildReducedModel(full, fingers, pin.neutral(full))  # fingers at rest
+    mass7 = reduced.inertias[reduced.getJointId("panda_joint7")].mass
     assert robot.mass[6] == pytest.approx(mass7, rel=1e-12)
     _, lines = notes(lambda: load_prior(urdf, robot, tip="panda_link8"))
-    assert len(lines) == 1 and said in lines[0]
+    assert len([x for x in lines if said in x]) == 1
     _, lines = notes(lambda: load_urdf(urdf, tip_link="panda_hand"))
-    assert lines == []
+    assert [x for x in lines if "merged" in x] == []

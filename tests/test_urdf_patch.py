@@ -54,13 +54,17 @@ def _pin_M_g(path, q, lock=()):
 
 
 def test_patched_template_keeps_every_link_joint_and_mesh(tmp_path):
-    """Only the chain's <inertial> elements change and the fingers' go (the identified link 7
-    holds them); links, joints, meshes, dynamics and the hand's inertial stay."""
+    """Only the chain's <inertial> elements change; links, joints, meshes, dynamics and the
+    hand's and fingers' inertials stay (before, the fingers' went: a simulator drops a
+    moving link without one)."""
     path, chain = _template_chain()
     text = open(path).read()
     new = _identified(chain, seed=1)
     out = save_urdf(tmp_path / "p.urdf", new, template=path, base="panda_link0", tip="panda_hand")
     patched = out.read_text()
+    head, header, rest = patched.split("\n", 2)
+    assert header.startswith("<!-- written by dynid") and head == text.split("\n", 1)[0]
+    patched = f"{head}\n{rest}"  # without the header comment (its own test)
     inertial = re.compile(r"\s*<inertial\b.*?</inertial>", re.S)
     assert inertial.sub("", patched) == inertial.sub("", text)
     for pattern in (r'<link name="([^"]+)"', r'<joint name="([^"]+)"', r'filename="([^"]+)"'):
@@ -68,9 +72,46 @@ def test_patched_template_keeps_every_link_joint_and_mesh(tmp_path):
     assert patched.count("<dynamics") == text.count("<dynamics") > 0
     holding = re.compile(r'<link name="([^"]+)">(?:(?!</link>).)*<inertial', re.S)
     had, has = holding.findall(text), holding.findall(patched)
-    assert sorted(set(had) - set(has)) == ["panda_leftfinger", "panda_rightfinger"]
+    assert had == has and {"panda_leftfinger", "panda_rightfinger"} <= set(has)
+    for finger in ("panda_leftfinger", "panda_rightfinger"):
+        assert _link_inertial(patched, finger) == _link_inertial(text, finger)
     changed = [name for name in has if _link_inertial(patched, name) != _link_inertial(text, name)]
     assert changed == [f"panda_link{k}" for k in range(1, 8)]  # hand and link8 untouched
+
+
+def test_template_export_opens_with_what_dynid_wrote(tmp_path):
+    """A template export opens with dynid's comment after the XML declaration, as the chain
+    export does (before: none, though the README says exported URDFs open with one): the
+    template's name, the chain's links whose inertials were written, the joints' friction
+    kept or written, what URDF leaves out; Pinocchio reads the file (a valid comment)."""
+    pin = pytest.importorskip("pinocchio")
+    path, chain = _template_chain()
+    new = _identified(chain, seed=1)
+    out = save_urdf(tmp_path / "p.urdf", new, template=path, base="panda_link0", tip="panda_hand")
+    decl, header = out.read_text().split("\n")[:2]
+    assert decl.startswith("<?xml")
+    assert header.startswith("<!-- written by dynid ") and header.endswith(" -->")
+    for said in (
+        "into the template panda.urdf",
+        "the <inertial> of the chain's 7 moving links (panda_link1 to panda_link7)",
+        "the joints' <dynamics> as the template has them",
+        "rotor inertia and friction offsets are not part of URDF",
+    ):
+        assert said in header, header
+    fr = (np.full(7, 0.5), np.full(7, 0.25))
+    out = save_urdf(
+        tmp_path / "f.urdf",
+        new,
+        template=path,
+        base="panda_link0",
+        tip="panda_hand",
+        dynamics=fr,
+        template_dynamics=True,
+    )
+    header = out.read_text().split("\n")[1]
+    assert "the joints' friction as <dynamics damping friction> (identified)" in header
+    model = pin.buildModelFromUrdf(str(out))
+    np.testing.assert_allclose(model.damping[:7], 0.5, rtol=0, atol=0)
 
 
 def _link_inertial(text, name):
@@ -117,7 +158,8 @@ def test_patched_template_without_other_branches_equals_chain_export(tmp_path):
 
 
 def test_merged_move_puts_the_body_on_the_moving_link():
-    """merged='move': the hand loses its inertial, link7 carries the whole body, phi reads back."""
+    """merged='move': the hand loses its inertial, link7 carries the whole body but the
+    fingers (which keep their 0.015 kg each), phi reads back."""
     path, chain = _template_chain()
     new = _identified(chain, seed=6)
     text = patch_urdf_inertials(
@@ -130,7 +172,7 @@ def test_merged_move_puts_the_body_on_the_moving_link():
         back = robot_from_urdf_string(text, "panda_link0", "panda_hand")
     np.testing.assert_allclose(back.phi, new.phi, rtol=1e-12, atol=1e-15)
     m7 = re.search(r'<link name="panda_link7">.*?<mass value="([^"]+)"', text, re.S).group(1)
-    np.testing.assert_allclose(float(m7), new.phi[6, 0], rtol=1e-15)
+    np.testing.assert_allclose(float(m7), new.phi[6, 0] - 0.03, rtol=1e-14)  # fingers kept
 
 
 def test_subtract_refuses_a_rest_that_is_not_a_body(tmp_path, capsys):
@@ -152,7 +194,7 @@ def test_subtract_refuses_a_rest_that_is_not_a_body(tmp_path, capsys):
         in msg
     )
     assert "recorded without them, with --merged keep" in msg
-    fixed = re.search(r"fixed links (\[.*?\])", msg).group(1)
+    fixed = re.search(r"links merged into it (\[.*?\])", msg).group(1)
     hand = sum(  # masses of the fixed links named, read from the template's text
         float(re.search(rf'<link name="{name}">.*?<mass value="([^"]+)"', text, re.S).group(1))
         for name in re.findall(r"'([^']+)'", fixed)
@@ -369,8 +411,10 @@ def _truth_with_fingers(seed):
 def test_template_export_counts_fingers_once(tmp_path, caplog, merged):
     """An arm recorded with its hand and fingers: Pinocchio's RNEA of the patched template
     (fingers locked) equals the truth's to 1e-10 and the file's total mass is the truth's;
-    the fingers lose their inertials, and a note says so (before: the template's 0.03 kg of
-    fingers were added again, a Panda trial 0.515 % off its truth instead of 0.031 %)."""
+    the fingers keep the template's inertials and link 7 is written without them, and a
+    note says so (before: the template's 0.03 kg of fingers were added again, a Panda
+    trial 0.515 % off its truth instead of 0.031 %; then the fingers lost their inertials,
+    which a simulator needs for a moving link)."""
     pin = pytest.importorskip("pinocchio")
     path, truth, identified = _truth_with_fingers(seed=11)
     out = tmp_path / "p.urdf"
@@ -381,9 +425,9 @@ def test_template_export_counts_fingers_once(tmp_path, caplog, merged):
     notes = [r.getMessage() for r in caplog.records if r.levelno == dynid.progress.NOTE]
     out.write_text(patch)
     assert any("panda_leftfinger (0.015 kg" in n and "--merged keep" in n for n in notes), notes
+    text = open(path).read()
     for finger in ("panda_leftfinger", "panda_rightfinger"):
-        block = re.search(rf'<link name="{finger}">.*?</link>', patch, re.S).group(0)
-        assert "<inertial" not in block and "<visual" in block
+        assert _link_inertial(patch, finger) == _link_inertial(text, finger)
     full = pin.buildModelFromUrdf(str(out))
     total = sum(full.inertias[j].mass for j in range(1, full.njoints))
     np.testing.assert_allclose(total, sum(truth.inertias[j].mass for j in range(1, 8)), 1e-12)
@@ -410,8 +454,9 @@ def test_merged_keep_leaves_the_fingers(tmp_path):
 
 def test_a_branch_off_an_earlier_body_keeps_its_inertial():
     """Only links past the tip are the identified last body's: a slider on link a (moving
-    on its own while the chain is recorded) keeps its inertial, the finger on link b loses
-    its own; Pinocchio's total mass is the identified one plus the slider's."""
+    on its own while the chain is recorded) keeps its inertial and is no part of the
+    identified bodies; the finger on link b keeps its own too, but is lumped into the
+    identified b: Pinocchio's total mass is the identified one plus the slider's."""
     pin = pytest.importorskip("pinocchio")
     inertial = '<inertial><mass value="{m}"/><inertia ixx="0.01" iyy="0.01" izz="0.01"/></inertial>'
     slider = '<limit lower="0" upper="0.1" effort="1" velocity="1"/>'
@@ -437,7 +482,57 @@ def test_a_branch_off_an_earlier_body_keeps_its_inertial():
         chain = robot_from_urdf_string(text, "base", "b")
     new = chain.with_params(chain.phi * np.array([[1.2], [1.3]]))
     out = patch_urdf_inertials(text, new, base="base", tip="b")
-    assert '<link name="slide"><inertial>' in out and '<link name="finger"></link>' in out
+    assert '<link name="slide"><inertial>' in out and '<link name="finger"><inertial>' in out
     model = pin.buildModelFromXML(out)
     total = sum(model.inertias[j].mass for j in range(1, model.njoints))
     np.testing.assert_allclose(total, new.phi[:, 0].sum() + 0.5, rtol=1e-12)
+
+
+def _arm_with_finger(finger_inertia):
+    """Two links a, b and a prismatic finger (0.1 kg) past the tip b."""
+    inertial = '<inertial><mass value="{m}"/><inertia ixx="{i}" iyy="{i}" izz="{i}"/></inertial>'
+    hinge = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+    return f"""<robot name="r">
+  <link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+    <axis xyz="0 0 1"/>{hinge}</joint>
+  <link name="a">{inertial.format(m=2.0, i=0.01)}</link>
+  <joint name="j2" type="revolute"><parent link="a"/><child link="b"/>
+    <origin xyz="0.5 0 0"/><axis xyz="0 1 0"/>{hinge}</joint>
+  <link name="b">{inertial.format(m=1.0, i=0.01)}</link>
+  <joint name="f" type="prismatic"><parent link="b"/><child link="finger"/>
+    <origin xyz="0.3 0 0"/><axis xyz="0 1 0"/>{hinge}</joint>
+  <link name="finger">{inertial.format(m=0.1, i=finger_inertia)}</link>
+</robot>
+"""
+
+
+def test_fingers_heavier_than_the_identified_body_lose_their_inertials_with_a_warning():
+    """A template whose finger alone has more inertia (0.05 kg m^2) than the identified
+    last body holds (0.03 kg m^2 about each axis; a Baxter trial's fingers: 0.01 kg m^2
+    each against J7zz 0.039): the body cannot be split into the finger and a rest, so the
+    whole body goes on the moving link and the finger's inertial goes, in a warning that
+    names it, instead of an error; Pinocchio with the finger locked reads back the
+    identified bodies."""
+    pin = pytest.importorskip("pinocchio")
+    text = _arm_with_finger(0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        chain = robot_from_urdf_string(text, "base", "b")
+    # b: 1.1 kg, its rotational inertia about the CoM 0.03 kg m^2 about each axis
+    c = chain.phi[1, 1:4] / chain.phi[1, 0]
+    new = chain.with_inertials(
+        chain.phi[:, 0], [chain.com[0], c], [chain.inertia[0], 0.03 * np.eye(3)]
+    )
+    for merged in ("subtract", "move"):
+        with pytest.warns(DynidWarning, match="written without their inertials") as caught:
+            out = patch_urdf_inertials(text, new, base="base", tip="b", merged=merged)
+        assert any("finger (0.1 kg" in str(w.message) for w in caught)
+        assert '<link name="finger"></link>' in out
+        model = pin.buildModelFromXML(out)
+        model = pin.buildReducedModel(model, [model.getJointId("f")], pin.neutral(model))
+        for j, phi in zip((1, 2), new.phi, strict=True):
+            Y = model.inertias[j]
+            np.testing.assert_allclose([Y.mass, *(Y.mass * Y.lever)], phi[:4], atol=1e-12)
+    out = patch_urdf_inertials(_arm_with_finger(0.001), new, base="base", tip="b")
+    assert "finger" in out and '<link name="finger"><inertial>' in out

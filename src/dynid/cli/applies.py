@@ -54,12 +54,18 @@ def is_urdf(spec: object) -> bool:
 
 
 def urdf_chain(
-    robot: str = "robot", options: tuple[str, ...] = ("base", "tip", "snap_angles")
+    robot: str = "robot",
+    options: tuple[str, ...] = ("base", "tip", "snap_angles"),
+    also: tuple[str, ...] = (),
 ) -> Applies:
     """``--base``/``--tip`` (and ``--snap-angles``) apply to a URDF ``--robot`` (the
-    option ``robot``) only: a built-in robot, a TOML or a feasible.json has one chain."""
-    flag = "--" + robot.replace("_", "-")
-    return Applies(options, lambda a: is_urdf(getattr(a, robot, None)), f"a URDF {flag}")
+    option ``robot``, or one of ``also``: a ``--params`` read as ``--robot`` reads it)
+    only: a built-in robot, a TOML or a feasible.json has one chain."""
+    names = (robot, *also)
+    flags = " or ".join("--" + x.replace("_", "-") for x in names)
+    return Applies(
+        options, lambda a: any(is_urdf(getattr(a, x, None)) for x in names), f"a URDF {flags}"
+    )
 
 
 def given_options(parser: argparse.ArgumentParser, argv: Sequence[str]) -> frozenset[str]:

@@ -17,9 +17,11 @@ gets the whole identified body (--merged keep: identified without them, such as 
 identified without its hand exported into the vendor's URDF with the hand); or the moving
 link gets the whole body and they lose their inertials (--merged move). Links moving on
 joints of their own past the tip (a gripper's fingers) were on the arm when it was
-recorded, so the identified last body holds them: with subtract and move their inertials
-are removed (a note names them; the file's total mass is the identified one); with keep
-they stay.
+recorded, so the identified last body holds them (the reader lumps them into it at their
+joints' zero): they keep their inertials, and with subtract and move the moving link gets
+the body without them (a note names them; the file's total mass is the identified one);
+when the template gives them more inertia than the body holds, they lose their inertials
+instead, in a warning. The file opens with a comment of what dynid wrote into it.
 
 MJCF (MuJoCo): bodies, hinge/slide joints with ranges, full inertials, gravity, motors, and
 the friction as frictionloss + damping: the linear friction a consistent identification

@@ -96,7 +96,7 @@ NAME = "payload"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
-APPLIES = (urdf_chain(),)
+APPLIES = (urdf_chain(also=("params",)),)
 #: The arm carrying the load: a robot's (what ``dynid export`` writes of it, as TOML), an
 #: identified model's (its base parameters with the load's).
 ROBOT_WITH_LOAD = "robot_with_payload.toml"
@@ -116,8 +116,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         type=Path,
         help="feasible.json of the arm (a .urdf, .toml or .xml: read as --robot reads it)",
     )
-    p.add_argument("--base", default=None, help="URDF base link (with --robot)")
-    p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
+    p.add_argument("--base", default=None, help="URDF base link (with --robot or --params)")
+    p.add_argument("--tip", default=None, help="URDF tip link (with --robot or --params)")
     add_snap_angles_option(p)
     p.add_argument(
         "--data",

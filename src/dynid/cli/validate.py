@@ -120,7 +120,7 @@ NAME = "validate"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
-APPLIES = (urdf_chain(),)
+APPLIES = (urdf_chain(also=("params",)),)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -140,8 +140,8 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="feasible.json of retrieved link parameters (RNEA); a .urdf, .toml or .xml is "
         "read as --robot reads it",
     )
-    p.add_argument("--base", default=None, help="URDF base link (with --robot)")
-    p.add_argument("--tip", default=None, help="URDF tip link (with --robot)")
+    p.add_argument("--base", default=None, help="URDF base link (with --robot or --params)")
+    p.add_argument("--tip", default=None, help="URDF tip link (with --robot or --params)")
     add_snap_angles_option(p)
     fr = p.add_mutually_exclusive_group()
     fr.add_argument("--friction", type=Path, help="friction.json to add to the model")

@@ -218,7 +218,25 @@ def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
         except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
             raise DataError("a single array, not an NPZ archive", file=path.name) from None
         return "torque_log" if "t" in keys or "tau" in keys else "static"
-    raise DataError("a data file must be .csv or .npz", file=path.name)
+    raise DataError(f"a data file must be .csv or .npz{_bag_file_hint(path)}", file=path.name)
+
+
+def _bag_file_hint(path: Path) -> str:
+    """``: ...``: the ``dynid import`` that converts a ROS bag file (a ROS 1 ``.bag``, or
+    the ``.db3``/``.mcap`` store of a ROS 2 bag, whose folder is the bag) into a torque
+    log; empty for any other file."""
+    suffix = path.suffix.lower()
+    if suffix == ".bag":
+        bag, what = path, "a ROS 1 bag"
+    elif suffix in (".db3", ".mcap"):
+        bag, what = path.parent, f"the {suffix} store of a ROS 2 bag, its folder"
+    else:
+        return ""
+    name = bag.name or str(bag)
+    return (
+        f"; it is {what}: convert it into a torque log with 'dynid import {name} --robot "
+        f"ROBOT --out {Path(name).stem}.csv' and give that file to --data"
+    )
 
 
 def check_file_entries(cmap: ColumnMap | None, paths: Sequence[str | Path]) -> None:

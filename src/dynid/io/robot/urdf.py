@@ -297,8 +297,28 @@ def save_urdf(
                     original, base, tip, source=f"URDF template {tpath.name!r}", note_angles=False
                 )
             text = patch_urdf_dynamics(text, list(chain.joint_names), dynamics)
+        friction = None if not template_dynamics else dynamics is not None
+        text = with_caveat(text, _template_header(robot, tpath.name, friction), xml=True)
     write_text(path, with_caveat(text, caveat, xml=True))
     return path
+
+
+def _template_header(robot: Robot, template: str, friction: bool | None) -> str:
+    """The comment a template export opens with: what dynid wrote into the template
+    (``friction``: True the identified joint friction written, False the template's
+    removed, None the template's kept) and what the file leaves out."""
+    said = {
+        True: "the joints' friction as <dynamics damping friction> (identified)",
+        False: "the joints' <dynamics> friction removed (the model has none)",
+        None: "the joints' <dynamics> as the template has them",
+    }[friction]
+    return (
+        f"written by dynid {__version__} into the template {template}: the <inertial> of "
+        f"the chain's {robot.n} moving links ({robot.link_names[1]} to "
+        f"{robot.link_names[-1]}) identified, about the CoM in link axes [kg, m, kg m^2]; "
+        f"{said}; every other element as the template has it; gravity, rotor inertia and "
+        "friction offsets are not part of URDF"
+    )
 
 
 #: An armature below this fraction of its joint's inertia (the diagonal ``M_jj`` of the

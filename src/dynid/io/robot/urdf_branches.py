@@ -3,28 +3,36 @@
 A chain (:mod:`dynid.io.robot.urdf_parse`) holds the links from its base to its tip.
 Links hanging off a moving link of the chain through fixed joints only (a hand, a
 tool-centre-point frame) are merged into that link: their inertials are added to it. A
-link hanging off it through a moving joint (a gripper's jaw, fingers, the joints past the
-tip) cannot be merged exactly, as it moves: it is left out with everything below it, and
-its mass is in no link of the model. :func:`off_chain` names both, with their masses (the
-reader warns about a branch with mass and logs a massless one; it notes the merged links
-with mass that hang off the chain, a hand beyond the tip, and logs the others).
+link hanging off the last body through a moving joint past the tip (a gripper's fingers,
+the joints past a tip chosen mid-arm) moves with that body wherever its own joints stand:
+it is lumped into the last body with everything below it at their joints' zero position
+(a gripper at rest, as Pinocchio's model with those joints locked at their neutral
+position), the best description there is of what the arm carries. A branch off an earlier
+body (another arm on a torso) moves on its own while the chain is recorded: it is left
+out with everything below it, and its mass is in no link of the model. :func:`off_chain`
+names them all, with their masses and inertias (the reader notes the branches lumped,
+warns about a branch left out with mass and logs a massless one; it notes the merged
+links with mass that hang off the chain, a hand beyond the tip, and logs the others).
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ...model.inertia import inertial_from_phi
 from .urdf_tree import _child, _float, _Joint
+
+_RIGID_AT_ZERO = {"revolute", "continuous", "prismatic", "fixed"}
 
 __all__ = ["Branch", "OffChain", "off_chain"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Branch:
     """A link hanging off the chain through a moving joint, and what it carries.
 
@@ -36,6 +44,15 @@ class Branch:
         The joint's child link, then every link below it.
     mass : float
         Their masses summed [kg].
+    body : int
+        The chain's body (1 the first moving link) the branch hangs off.
+    phi : ndarray, shape (10,)
+        Their standard parameters summed in body ``body``'s frame [SI], every joint of the
+        branch at zero (zeros when the branch holds a joint that has no zero position, a
+        floating or planar one).
+    lumpable : bool
+        Every joint of the branch is revolute, continuous, prismatic or fixed: the branch
+        has a rigid pose at its joints' zero.
     """
 
     joint: str
@@ -43,40 +60,84 @@ class Branch:
     parent: str
     links: tuple[str, ...]
     mass: float
+    body: int = 0
+    phi: NDArray[np.float64] = field(default_factory=lambda: np.zeros(10))
+    lumpable: bool = False
+
+    @property
+    def inertia(self) -> float:
+        """The largest principal moment [kg m^2] of the branch's inertia about its own
+        centre of mass, its joints at zero (0 when massless)."""
+        if not self.phi[0] > 0.0:
+            return 0.0
+        _, _, I = inertial_from_phi(self.phi)
+        return float(np.max(np.linalg.eigvalsh(I)))
+
+    def said(self) -> str:
+        """The branch in a few words: its links, mass, inertia and joint."""
+        below = f" and {len(self.links) - 1} link(s) below it" if len(self.links) > 1 else ""
+        return (
+            f"{self.links[0]}{below} ({self.mass:.4g} kg, inertia up to {self.inertia:.4g} "
+            f"kg m^2 about its CoM, through {self.type} joint {self.joint!r} on {self.parent})"
+        )
 
 
 @dataclass(frozen=True, slots=True)
 class OffChain:
-    """What the chain leaves out (``branches``) and merges (``merged``: fixed link, the
-    moving link it is merged into, its mass [kg]; ``hanging``: the merged links off the
-    chain, below its links rather than between them, as a hand beyond the tip);
-    :attr:`left_out`, :attr:`merged_line` and :attr:`hanging_line` say it."""
+    """What the chain lumps, leaves out (``branches``: every branch off a moving body through
+    a moving joint; those off the last body, ``last``, with a zero pose are lumped into it)
+    and merges (``merged``: fixed link, the moving link it is merged into, its mass [kg];
+    ``hanging``: the merged links off the chain, below its links rather than between them,
+    as a hand beyond the tip); :attr:`lumped_line`, :attr:`left_out`, :attr:`merged_line`
+    and :attr:`hanging_line` say it."""
 
     source: str
     branches: tuple[Branch, ...]
     merged: tuple[tuple[str, str, float], ...]
     hanging: tuple[str, ...] = ()
+    last: int = -1
+
+    @property
+    def lumped(self) -> tuple[Branch, ...]:
+        """The branches past the tip lumped into the last body at their joints' zero."""
+        return tuple(b for b in self.branches if b.body == self.last and b.lumpable)
+
+    @property
+    def outside(self) -> tuple[Branch, ...]:
+        """The branches left out of the model."""
+        return tuple(b for b in self.branches if not (b.body == self.last and b.lumpable))
 
     @property
     def mass_left_out(self) -> float:
         """The mass [kg] of every branch left out."""
-        return float(sum(b.mass for b in self.branches))
+        return float(sum(b.mass for b in self.outside))
 
     @property
     def left_out(self) -> str | None:
-        """One line naming the branches left out and their masses, or None."""
-        if not self.branches:
+        """One line naming the branches left out, their masses and inertias, or None."""
+        if not self.outside:
             return None
-        said = "; ".join(
-            f"{b.links[0]}"
-            + (f" and {len(b.links) - 1} link(s) below it" if len(b.links) > 1 else "")
-            + f" ({b.mass:.4g} kg, through {b.type} joint {b.joint!r} on {b.parent})"
-            for b in self.branches
-        )
+        said = "; ".join(b.said() for b in self.outside)
         return (
             f"{self.source}: left out of the chain, as they move on joints of their own: "
-            f"{said}; their mass is in no link of the model (a fixed joint in place of "
-            "the moving one merges a link into the one it hangs from)"
+            f"{said}; their mass and inertia are in no link of the model (a fixed joint in "
+            "place of the moving one merges a link into the one it hangs from)"
+        )
+
+    @property
+    def lumped_line(self) -> str | None:
+        """One line naming the branches past the tip lumped into the last body, or None."""
+        said = [b for b in self.lumped if b.mass != 0.0]
+        if not said:
+            return None
+        total = sum(b.mass for b in said)
+        return (
+            f"{self.source}: links moving on joints of their own past the tip lumped into "
+            f"the last body at their joints' zero position ({total:.4g} kg in all): "
+            + "; ".join(b.said() for b in said)
+            + "; they ride on the arm at whatever opening they have, and at rest is the "
+            "best description of them there is (for an arm run without them, leave them out "
+            "of the URDF)"
         )
 
     @property
@@ -130,6 +191,7 @@ def off_chain(
     placed: Mapping[str, tuple[int, NDArray[np.float64]]],
     link_names: Sequence[str],
     fixed_joint: Mapping[str, str],
+    branch_phi: Callable[[_Joint, NDArray[np.float64]], NDArray[np.float64]] | None = None,
 ) -> OffChain:
     """The links a chain leaves out and those it merges (module docstring).
 
@@ -147,9 +209,13 @@ def off_chain(
         The chain's bodies (base first).
     fixed_joint : mapping
         The links placed through a fixed joint, with its name.
+    branch_phi : callable, optional
+        ``(joint, T_k_parent) -> phi`` (10,): the standard parameters of the joint's child
+        link and everything below it in body ``k``'s frame, every joint at zero, given the
+        pose (4, 4) [m] of the joint's parent link in body ``k``; None: zeros.
     """
     branches = []
-    for link, (k, _) in placed.items():
+    for link, (k, T_k_link) in placed.items():
         if k == 0:  # fixed to the base: no joint torque feels it
             continue
         for joint in child_joints.get(link, ()):
@@ -157,11 +223,18 @@ def off_chain(
                 continue
             below = _below(joint.child, child_joints)
             mass = sum(_mass(links[x], x) for x in below)
-            branches.append(Branch(joint.name, joint.type, link, tuple(below), mass))
+            types = {joint.type} | {j.type for x in below for j in child_joints.get(x, ())}
+            lumpable = types <= _RIGID_AT_ZERO
+            phi = np.zeros(10)
+            if lumpable and branch_phi is not None:
+                phi = branch_phi(joint, T_k_link)
+            branches.append(
+                Branch(joint.name, joint.type, link, tuple(below), mass, k, phi, lumpable)
+            )
     merged = tuple(
         (link, link_names[k], _mass(links[link], link))
         for link, (k, _) in placed.items()
         if k > 0 and link in fixed_joint
     )
     hanging = tuple(link for link, _, _ in merged if fixed_joint[link] not in on_chain)
-    return OffChain(source, tuple(branches), merged, hanging)
+    return OffChain(source, tuple(branches), merged, hanging, len(link_names) - 1)

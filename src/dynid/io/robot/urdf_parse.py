@@ -40,13 +40,17 @@ Conventions
   log line names those joints; zeros everywhere mean no friction. dynid's export writes
   its friction there (:func:`~dynid.io.robot.urdf.export_urdf`), so it reads back. A
   negative coefficient is refused.
-* Left out, said once (:mod:`dynid.io.robot.urdf_branches`): the links hanging off the
-  chain's moving links through moving joints (a gripper's jaw, the joints past the tip),
-  a warning naming them and their mass, which no link of the model holds (a log line when
+* Lumped, left out, said once (:mod:`dynid.io.robot.urdf_branches`): the links hanging
+  off the last body through moving joints past the tip (a gripper's fingers, the joints
+  past a tip chosen mid-arm) are lumped into it at their joints' zero position, as
+  Pinocchio's model with those joints locked at neutral, in a note naming them, their
+  mass and inertia (level :data:`~dynid.progress.NOTE`); they are no frames of the robot.
+  The links hanging off earlier moving links through moving joints (another arm on a
+  torso), or past the tip through a floating or planar joint, are left out: a warning
+  names them, their mass and inertia, which no link of the model holds (a log line when
   they are massless); the links with mass hanging off the chain through fixed joints
   and merged into its bodies (a hand beyond the tip) in a note naming them and their
-  mass (level :data:`~dynid.progress.NOTE`); every link merged through a fixed joint in a
-  log line (``-v``).
+  mass; every link merged through a fixed joint in a log line (``-v``).
 * Ignored: mimic joints off the chain, transmissions, gazebo tags, visual and collision
   geometry, ``<dynamics>`` of fixed joints, the other attributes of ``<dynamics>``
   (Gazebo's ``K``, ``D``, ``mu_coulomb``, ...), ``<safety_controller>``.
@@ -288,9 +292,9 @@ def chain_with_branches(
     robot : Robot
         The chain, read as :func:`robot_from_urdf_string` reads it.
     off : OffChain
-        The branches left out (links hanging off a moving body through moving joints:
-        fingers) and the fixed links merged
-        (:func:`~dynid.io.robot.urdf_branches.off_chain`).
+        The branches (links hanging off a moving body through moving joints: those past
+        the tip, fingers, lumped into the last body; the others left out) and the fixed
+        links merged (:func:`~dynid.io.robot.urdf_branches.off_chain`).
 
     Raises
     ------
@@ -435,6 +439,29 @@ def _place_fixed_links(w: _Walk, path: list[_Joint], child_joints: dict[str, lis
             stack.append(joint.child)
 
 
+def _subtree_phi(
+    joint: _Joint,
+    T_k_parent: NDArray[np.float64],
+    links: dict[str, ET.Element],
+    child_joints: dict[str, list[_Joint]],
+) -> NDArray[np.float64]:
+    """Standard parameters (10,) of ``joint``'s child link and every link below it in the
+    frame of the body whose frame holds the parent at pose ``T_k_parent`` (4, 4) [m],
+    every joint at zero (its child at the joint's origin)."""
+    phi = np.zeros(10)
+    stack = [(joint, T_k_parent)]
+    while stack:
+        j, T_k = stack.pop()
+        T_k_child = T_k @ _origin(j.elem, f"joint {j.name!r}")
+        inertial = _inertial(j.child, links[j.child])
+        if inertial is not None:
+            mass, c, I = inertial
+            R, p = T_k_child[:3, :3], T_k_child[:3, 3]
+            phi += phi_from_inertial(mass, R @ c + p, R @ I @ R.T)
+        stack.extend((c_j, T_k_child) for c_j in child_joints[j.child])
+    return phi
+
+
 def _body_phi(w: _Walk, links: dict[str, ET.Element]) -> NDArray[np.float64]:
     """Standard parameters (n, 10) of each body: its links' inertials summed in its frame."""
     phi = np.zeros((len(w.joint_names), 10))
@@ -462,6 +489,8 @@ def _robot_from_text(
     """Body of the two public readers (called directly by both, so warnings point at the caller)."""
     angles = AngleRounding(snap=snap_angles)
     robot, found = _read_chain(text, base_link, tip_link, source, angles)
+    if (lumped := found.lumped_line) is not None:
+        _log.log(NOTE, "%s", lumped)
     if (left := found.left_out) is not None:
         if found.mass_left_out > 0.0:  # a mass the model misses
             warnings.warn(left, DynidWarning, stacklevel=3)
@@ -532,7 +561,18 @@ def _read_chain(
     n = len(w.joint_names)
     lim = np.array(w.limits)
     on_chain = {j.name for j in path}
-    found = off_chain(source, links, child_joints, on_chain, w.placed, w.link_names, w.fixed_joint)
+    found = off_chain(
+        source,
+        links,
+        child_joints,
+        on_chain,
+        w.placed,
+        w.link_names,
+        w.fixed_joint,
+        lambda joint, T: _subtree_phi(joint, T, links, child_joints),
+    )
+    for branch in found.lumped:  # past the tip (fingers): at their joints' zero
+        phi[n - 1] += branch.phi
     robot = Robot(
         name=name,
         joint_names=tuple(w.joint_names),

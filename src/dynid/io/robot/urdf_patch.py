@@ -22,12 +22,14 @@ hand) into body ``k`` (:mod:`dynid.io.robot.urdf_parse`). Three ways to write bo
   exported into the vendor's URDF with the hand).
 
 Links moving below the last body on joints of their own, past the tip (a gripper's
-fingers), are not in the chain, but a body identified from torques with them on the arm
-holds them (they moved with it, at whatever opening they had). With ``subtract`` and
-``move`` their ``<inertial>`` is removed, so that the file counts them once and its total
-mass is the identified one, and a note names them; with ``keep`` (a body identified
-without the hand) they stay. Branches off earlier bodies (another arm on a torso) move on
-their own and stay.
+fingers), are lumped into the last body by the reader at their joints' zero position
+(:mod:`dynid.io.robot.urdf_branches`), and a body identified from torques with them on the
+arm holds them. They keep their ``<inertial>`` with every policy (a simulator drops a
+moving link without one): with ``subtract`` and ``move`` the moving link gets the body
+without them at rest, so that the file counts them once and its total mass is the
+identified one, and a note names them; with ``keep`` (a body identified without the hand)
+the moving link gets the whole body. Branches off earlier bodies (another arm on a torso)
+move on their own and stay.
 
 With ``subtract`` and ``move`` the template read back between the same ``base`` and ``tip``
 gives exactly the robot's ``phi``; with ``keep``, the robot's ``phi`` plus the fixed links'
@@ -252,8 +254,11 @@ def patch_urdf_inertials(
     scale = max(float(np.max(np.abs(expected))), 1e-300)
     if not np.allclose(back.phi, expected, rtol=1e-9, atol=1e-12 * scale):
         raise ModelError("the patched inertials do not read back as the robot's", file=source)
-    if merged != "keep" and (said := _branches_line(off.branches, chain, source)):
-        _log.log(NOTE, "%s", said)
+    if merged != "keep" and (said := _branches_line(off.branches, chain, source, new_xml)):
+        if any(x in new_xml and new_xml[x] is None for b in off.lumped for x in b.links):
+            warnings.warn(said, DynidWarning, stacklevel=2)
+        else:
+            _log.log(NOTE, "%s", said)
     return out
 
 
@@ -266,13 +271,16 @@ def _bodies(
     source: str,
 ) -> tuple[dict[str, NDArray[np.float64] | None], NDArray[np.float64]]:
     """The inertials to write (link -> phi (10,), None: remove) and the ``phi`` (n, 10) the
-    patched template's chain must read back as (its branches left out, as a reader does).
+    patched template's chain must read back as (as a reader reads it: the branches past the
+    tip lumped at rest, the others left out).
 
     ``subtract`` and ``move`` take the identified body ``k`` to hold everything that moved
     with it on the arm: the fixed links merged into it and, for the last body, the
-    branches hanging off it past the tip (fingers), whose inertials are removed so that
-    the file counts them once; ``keep`` holds neither. A branch off an earlier body
-    (another arm on a torso) moves on its own while the chain is recorded and stays."""
+    branches hanging off it past the tip (fingers), which keep their inertials while the
+    moving link gets the body without them at their joints' zero (as the reader lumps
+    them), so that the file counts them once; ``keep`` holds neither. A branch off an
+    earlier body (another arm on a torso) moves on its own while the chain is recorded
+    and stays."""
     new_xml: dict[str, NDArray[np.float64] | None] = {}
     expected = np.array(robot.phi, dtype=float)
     moving = set(chain.link_names[1:])
@@ -287,49 +295,77 @@ def _bodies(
         ]  # fmt: skip
         _check_masses(fixed, elems, source)
         phi: NDArray[np.float64] = np.array(robot.phi[k - 1])
-        if merged == "subtract":
+        lumped = [b for b in branches if k == robot.n == b.body and b.lumpable]
+        carried = [x for b in lumped for x in b.links if elems[x].find("inertial") is not None]
+        held = np.sum([b.phi for b in lumped], axis=0) if lumped else np.zeros(10)
+        if merged == "subtract":  # chain.phi holds the fixed links and the lumped branches
             phi = robot.phi[k - 1] - (chain.phi[k - 1] - own)
-            _check_consistent(link, phi, fixed, robot.phi[k - 1], source)
+            if carried and not _is_body(phi) and _is_body(phi + held):
+                phi = phi + held  # the body holds less than the fingers' own inertia
+                new_xml.update(dict.fromkeys(carried))
+            _check_consistent(link, phi, fixed + carried, robot.phi[k - 1], source)
         elif merged == "move":
             new_xml.update(dict.fromkeys(fixed))
+            if carried and _is_body(robot.phi[k - 1] - held):  # they stay, counted once
+                phi = robot.phi[k - 1] - held
+            else:
+                new_xml.update(dict.fromkeys(carried))
         else:  # keep: the fixed links stay, the body goes on the moving link
             expected[k - 1] += chain.phi[k - 1] - own
-        if merged != "keep" and k == robot.n:  # past the tip (a gripper): counted once
-            below = [b for b in branches if _body_of(chain, b.parent) == k]
-            carried = [x for b in below for x in b.links if elems[x].find("inertial") is not None]
-            new_xml.update(dict.fromkeys(carried))
         new_xml[link] = phi
     return new_xml, expected
 
 
-def _body_of(chain: Robot, link: str) -> int:
-    """The body (0 the base) that a link of the chain or fixed to it moves with."""
-    if link in chain.link_names:
-        return chain.link_names.index(link)
-    return chain.frames[link].link
-
-
-def _branches_line(branches: tuple[Branch, ...], chain: Robot, source: str) -> str | None:
-    """The note naming the branches past the tip the identified last body held, and what
-    was done with them; None when there are none with mass."""
-    held = [b for b in branches if b.mass > 0 and _body_of(chain, b.parent) == chain.n]
+def _branches_line(
+    branches: tuple[Branch, ...],
+    chain: Robot,
+    source: str,
+    new_xml: dict[str, NDArray[np.float64] | None],
+) -> str | None:
+    """The line naming the branches past the tip the identified last body held, and what
+    was done with them: kept, the moving link written without them; or, when the body
+    holds less than their own inertia, their inertials removed; None when there are none
+    with mass."""
+    held = [b for b in branches if b.mass > 0 and b.body == chain.n and b.lumpable]
     if not held:
         return None
-    names = ", ".join(f"{b.links[0]} ({b.mass:.4g} kg, joint {b.joint!r})" for b in held)
+    names = ", ".join(
+        f"{b.links[0]} ({b.mass:.4g} kg, inertia up to {b.inertia:.4g} kg m^2, joint {b.joint!r})"
+        for b in held
+    )
     total = sum(b.mass for b in held)
+    last = _checks.short(chain.link_names[-1])
+    if any(x in new_xml and new_xml[x] is None for b in held for x in b.links):
+        return (
+            f"{source}: links moving on joints of their own past the tip written without "
+            f"their inertials ({total:.4g} kg in all: {names}): the identified {last} holds "
+            "them, but less inertia than the template gives them alone, so it cannot be "
+            "split into them and the rest; the whole body is on the moving link, and a "
+            "simulator that drops a moving link without <inertial> (Gazebo) drops them: "
+            "give them an inertial of their size in the template, or --merged keep keeps "
+            "them as they are (counted twice)"
+        )
     return (
-        f"{source}: links moving on joints of their own past the tip, below the identified "
-        f"{_checks.short(chain.link_names[-1])}, written without their inertials "
-        f"({total:.4g} kg in all: "
-        f"{names}): the identified body already holds them, as they were on the arm when it "
-        "was recorded, so the file counts them once and its total mass is the identified "
-        "one; for a body identified without them, --merged keep leaves them as they are"
+        f"{source}: links moving on joints of their own past the tip keep their inertials "
+        f"({total:.4g} kg in all: {names}) and the identified {last} is written without "
+        "them at their joints' zero: the identified body holds them, as they were on the "
+        "arm when it was recorded, so the file counts them once and its total mass is the "
+        "identified one; for a body identified without them, --merged keep writes the "
+        "whole body"
     )
 
 
 def _indent_step(indent: str, link_indent: str) -> str:
     step = indent[len(link_indent) :] if indent.startswith(link_indent) else ""
     return step or "  "
+
+
+def _is_body(phi: NDArray[np.float64]) -> bool:
+    """A positive mass whose principal moments about its CoM are >= 0 and meet the
+    triangle inequality."""
+    m, _, I = inertial_from_phi(phi)
+    lam = np.linalg.eigvalsh(I)
+    return bool(m > 0 and lam[0] >= 0 and lam[0] + lam[1] >= lam[2])
 
 
 def _check_consistent(
@@ -341,10 +377,10 @@ def _check_consistent(
 ) -> None:
     """Raise when the rest of body ``link`` after subtracting its ``fixed`` links is not a
     body; the message gives both masses and the remedy for each way the arm was recorded."""
+    if _is_body(phi):
+        return
     m, _, I = inertial_from_phi(phi)
     lam = np.linalg.eigvalsh(I)
-    if m > 0 and lam[0] >= 0 and lam[0] + lam[1] >= lam[2]:
-        return
     them = float(identified[0] - m)
     hint = (
         f"the identified body is {float(identified[0]):.6g} kg, they are {them:.6g} kg; if "
@@ -355,7 +391,7 @@ def _check_consistent(
     )
     raise ModelError(
         f"link {_checks.short(link)}: the identified body minus the template's "
-        f"fixed links {_checks.short(fixed)} is not physically consistent (mass "
+        f"links merged into it {_checks.short(fixed)} is not physically consistent (mass "
         f"{float(m):.6g} kg, principal moments {[float(f'{x:.4g}') for x in lam]} kg m^2), "
         f"so --merged subtract cannot split it: {hint}",
         file=source,
