@@ -240,7 +240,8 @@ def test_the_constants_line_says_a_factor_clear_of_1_in_sample_and_why_not_named
 def test_validate_and_identify_print_the_constants_line(fits, other_currents, tmp_path, capsys):
     """``dynid validate`` of a current log prints the line after its verdict (and
     validation.json's ``drive_gains`` records it); ``dynid identify`` prints it after its
-    held-out verdict (heldout.json's ``drive_gains`` records it)."""
+    held-out verdict (heldout.json's ``drive_gains`` records it); each report's verdict
+    box says it."""
     from dynid.io.model_json import save_model_json
 
     model = save_model_json(tmp_path / "identification.json", fits["near"].model)
@@ -251,6 +252,8 @@ def test_validate_and_identify_print_the_constants_line(fits, other_currents, tm
     assert out[verdict + 1].startswith("torque constants: the data check the torque_constant")
     doc = json.loads((tmp_path / "v" / "validation.json").read_text())
     assert doc["drive_gains"]["constants"] == out[verdict + 1]
+    page = (tmp_path / "v" / "report.html").read_text()
+    assert "Torque constants: the data check the torque_constant of joint(s)" in page
     kt = ", ".join(f"{x:.17g}" for x in KT * np.asarray(NEAR))
     drive = tmp_path / "drive.toml"
     drive.write_text(
@@ -265,3 +268,5 @@ def test_validate_and_identify_print_the_constants_line(fits, other_currents, tm
     assert out[verdict + 1].startswith("torque constants: the data check")
     doc = json.loads((tmp_path / "i" / "heldout.json").read_text())
     assert doc["drive_gains"]["constants"] == out[verdict + 1]
+    page = (tmp_path / "i" / "report.html").read_text()
+    assert "Torque constants: the data check" in page
