@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import warnings
 
 import numpy as np
@@ -214,3 +215,58 @@ def test_the_mass_std_note_names_the_torque_constants_error(tmp_path, capsys):
     assert f"({0.01 * d['mass']:.2g} kg" in note and "per 1 %" in note
     assert "leaves out the error of the drive's torque_constant" in printed.out
     assert d["load_mass"] is not None
+
+
+def test_the_constants_line_says_a_factor_clear_of_1_in_sample_and_why_not_named(fits):
+    """Constants within 2 % of the true ones (joint 4's exact): joint 4 reads about 0.92,
+    many in-sample standard deviations from 1, yet its spread over the folds holds the
+    truth; the line says why it is not named (under 10 %, within 5 spreads at the floor)
+    with an uncertainty that holds the truth, and names the joints the data cannot check
+    (5 to 7: their own rotor and friction) as right as the drive file's constants."""
+    gains = fits["near"].heldout.gains
+    assert gains is not None and gains.floor and gains.heldout_std is not None
+    words = gains.constants_words()
+    assert words is not None
+    k = 3  # joint 4: the drive file's constant is the true one
+    assert abs(gains.factor[k] - 1.0) > 5 * gains.std[k]  # clear of 1 in-sample
+    assert abs(gains.factor[k] - 1.0) < 3 * gains.heldout_std[k]  # not over the folds
+    assert f"joint 4's {gains.factor[k]:.3g} +- {gains.heldout_std[k]:.2g} (over the folds" in words
+    said = re.search(r"joint\(s\) ([\d, ]+) not named: ([^;]+)", words)
+    assert said is not None and "4" in said[1].split(", "), words
+    assert "under the 10 % from 1" in said[2] and "within 5 spreads over the folds" in said[2]
+    assert "the torques of joint(s) 5, 6, 7 are as right as the drive file's constants" in words
+
+
+def test_validate_and_identify_print_the_constants_line(fits, other_currents, tmp_path, capsys):
+    """``dynid validate`` of a current log prints the line after its verdict (and
+    validation.json's ``drive_gains`` records it); ``dynid identify`` prints it after its
+    held-out verdict (heldout.json's ``drive_gains`` records it); each report's verdict
+    box says it."""
+    from dynid.io.model_json import save_model_json
+
+    model = save_model_json(tmp_path / "identification.json", fits["near"].model)
+    argv = ["validate", "--model", str(model), "--data", str(other_currents)]
+    assert main([*argv, "--no-figures", "--out", str(tmp_path / "v")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    verdict = next(i for i, line in enumerate(out) if line.startswith("verdict: "))
+    assert out[verdict + 1].startswith("torque constants: the data check the torque_constant")
+    doc = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert doc["drive_gains"]["constants"] == out[verdict + 1]
+    page = (tmp_path / "v" / "report.html").read_text()
+    assert "Torque constants: the data check the torque_constant of joint(s)" in page
+    kt = ", ".join(f"{x:.17g}" for x in KT * np.asarray(NEAR))
+    drive = tmp_path / "drive.toml"
+    drive.write_text(
+        f'schema = "dynid-drive/1"\nside = "joint"\neffort = "current"\n'
+        f"gear_ratio = [1, 1, 1, 1, 1, 1, 1]\ntorque_constant = [{kt}]\n"
+    )
+    argv = ["identify", "--robot", "panda", "--drive", str(drive), "--terms", TERMS]
+    argv += ["--data", str(other_currents), "--no-figures", "--out", str(tmp_path / "i")]
+    assert main(argv) == 0
+    out = capsys.readouterr().out.splitlines()
+    verdict = next(i for i, line in enumerate(out) if line.startswith("held-out verdict"))
+    assert out[verdict + 1].startswith("torque constants: the data check")
+    doc = json.loads((tmp_path / "i" / "heldout.json").read_text())
+    assert doc["drive_gains"]["constants"] == out[verdict + 1]
+    page = (tmp_path / "i" / "report.html").read_text()
+    assert "Torque constants: the data check" in page

@@ -344,6 +344,8 @@ def run(args: argparse.Namespace, console: Console) -> int:
         v = held.verdict
         text += _delay_first(result.torque_delay, v)
         text.append(f"held-out verdict on {held.block}, every sample: {v.label}: {v.reason}")
+        checked = None if held.gains is None else held.gains.constants_words()
+        text += [] if checked is None else [checked]  # a current log's: what the data check
     elif result.torque_delay is not None and result.torque_delay.named:
         text.append(f"note: {result.torque_delay.sentence()}")
     if result.consistent is not None:

@@ -233,3 +233,6 @@ def print_validation(
     console.print(f"relative error {val.errors.relative_error_percent:.3g} %; wrote {path}")
     v = result.verdict
     console.print(f"verdict: {v.label}: {v.reason}")
+    checked = None if result.gains is None else result.gains.constants_words()
+    if checked is not None:  # a current log's: which torque constants the data check
+        console.print(checked)

@@ -17,7 +17,9 @@ from collections.abc import Mapping, Sequence
 __all__ = [
     "ALIASES",
     "CURRENT_ALIASES",
+    "COMMANDED_WORDS",
     "column_hint",
+    "commanded_torques",
     "guessed_map",
     "holdings",
     "joint_families",
@@ -51,6 +53,26 @@ CURRENT_ALIASES = ("current", "cur", "i", "motorcurrent", "amps")
 #: ``present_position_1``, a controller's ``actual_torque_1``), left out before the names
 #: are compared with :data:`ALIASES` (lower case, without separators; longest first).
 READING_PREFIXES = ("measured", "feedback", "present", "actual", "meas", "act", "fb")
+#: Words of a column's name that say it holds what a controller asked for or its model
+#: computed, not what was measured (lower case; a word between separators or at a case
+#: change: a UR's ``target_moment_0``, libfranka's ``tau_J_d``, ``effort_desired``,
+#: ``torque_cmd``); ``d`` counts only after the first word (``tau_d``, not ``d_tau``).
+COMMANDED_WORDS = (
+    "target",
+    "desired",
+    "des",
+    "d",
+    "cmd",
+    "command",
+    "commanded",
+    "setpoint",
+    "ref",
+    "reference",
+    "demand",
+    "model",
+    "feedforward",
+    "ff",
+)
 #: How many unused columns a message names (families count as one).
 SHOWN = 6
 
@@ -322,3 +344,80 @@ def _root(template: str) -> str:
         if root.startswith(p) and len(root) > len(p):
             return root[len(p) :]
     return root
+
+
+def _words(template: str) -> list[str]:
+    """The words of a column's name or ``--columns`` template, lower case, without its
+    joint field and numbers (``target_moment_{i0}`` -> ``target, moment``; ``tauJd`` ->
+    ``tau, j, d``)."""
+    name = re.sub(r"\{[^}]*\}", " ", template)
+    name = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", " ", name)
+    return [w for w in re.split(r"[^a-z]+", name.lower()) if w]
+
+
+def commanded_torques(template: str, names: Sequence[str], n: int) -> str | None:
+    """What to warn of torques read from columns whose name says they are commanded,
+    desired, a target or a model's (:data:`COMMANDED_WORDS`): a controller's torque holds
+    no friction and almost no noise, and a model fitted to it predicts it to a fraction of
+    a percent whatever the arm does; None for a name that does not say so.
+
+    Parameters
+    ----------
+    template : str
+        The torques' column template as mapped (``target_moment_{i0}``), or an NPZ
+        array's name.
+    names : sequence of str
+        The file's header: the hint maps a family of measured torques or currents in it
+        (:data:`ALIASES`, :data:`CURRENT_ALIASES`) whose name is not a command's.
+    n : int
+        The joint count.
+
+    Returns
+    -------
+    str or None
+        ``tau is read from target_moment_0..5, a controller's target, not a measurement
+        ...; hint: ...``.
+    """
+    said = _commanded(template)
+    if not said:
+        return None
+    what = {
+        "target": "a controller's target",
+        "model": "a model's torque",
+        "feedforward": "a controller's feed-forward",
+        "ff": "a controller's feed-forward",
+    }.get(said[0], "a controller's command")
+    if "{" in template:
+        first, last = template.format(i=1, i0=0), template.format(i=n, i0=n - 1)
+        shown = f"{first}..{last.removeprefix(_common_prefix(first, last))}"
+    else:
+        shown = template
+    families = [t for t in joint_families(names, n) if not _commanded(t) and t != template]
+    found = _found(families, ("tau",)).get("tau")
+    if found is None:
+        hint = "map the measured joint torques or motor currents with --columns tau=NAME"
+    elif _root(found) in CURRENT_ALIASES:
+        hint = f"--columns tau={found} --units tau=A with a --drive whose effort is current"
+    else:
+        hint = f"--columns tau={found} reads the measured ones"
+    return (
+        f"tau is read from {shown}, {what}, not a measurement: it may hold no friction "
+        "and almost no noise, so a model fitted to it says little of the arm (its error, "
+        f"its friction and its verdict); hint: {hint}"
+    )
+
+
+def _commanded(template: str) -> list[str]:
+    """The words of a column's name that say it is commanded (:data:`COMMANDED_WORDS`;
+    ``d`` after the first word only)."""
+    words = _words(template)
+    return [w for k, w in enumerate(words) if w in COMMANDED_WORDS and (w != "d" or k > 0)]
+
+
+def _common_prefix(a: str, b: str) -> str:
+    """The longest common prefix of ``a`` and ``b`` not ending in a digit (``q_0``,
+    ``q_5``: ``q_``)."""
+    k = 0
+    while k < min(len(a), len(b)) and a[k] == b[k]:
+        k += 1
+    return a[:k].rstrip("0123456789")

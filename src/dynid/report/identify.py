@@ -42,6 +42,7 @@ from ..identification.verdict import (
     with_caveat,
     worst,
 )
+from .constants import constants_facts
 from .delay import delay_facts, delay_section
 from .html import (
     bar,
@@ -192,6 +193,7 @@ def _own_facts(
     low = held.get("low_speed")
     if isinstance(low, str) and low:  # where the rest of the error sits
         facts.append(esc(capitalised(low)))
+    facts += constants_facts(held)  # a current log's: which constants the data check
     return facts, problems, headline
 
 

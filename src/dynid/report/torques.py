@@ -29,6 +29,7 @@ from ..identification.verdict import (
     joint_levels,
     judge_prediction,
 )
+from .constants import constants_facts
 from .delay import delay_facts, delay_section
 from .html import capitalised, cell, esc, figure, is_number, percent, section, table, verdict
 from .run import Answer, RunFiles
@@ -99,6 +100,7 @@ def validate_answer(run: RunFiles) -> Answer | None:
         "more) are at best usable",
     ]
     facts[1:1] = spring_facts(doc)  # where the verdict names a spring: its stiffness
+    facts[1:1] = constants_facts(doc)  # a current log's: which constants the data check
     facts[:0] = delay_facts(doc)  # a named lag first: the hints after it may be the lag
     per = (with_ if isinstance(with_, dict) else without).get("relative_error_percent_per_joint")
     if isinstance(per, list) and per and all(is_number(p) for p in per):

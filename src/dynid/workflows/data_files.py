@@ -19,6 +19,7 @@ import dataclasses
 import hashlib
 import logging
 import re
+import warnings
 import zipfile
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -27,12 +28,12 @@ from typing import Any, Literal, TypeVar
 import numpy as np
 
 from .. import _checks
-from ..exceptions import DataError, DynidError, OptionError
+from ..exceptions import DataError, DynidError, DynidWarning, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import MILLISECONDS_HINT, TorqueLog
 from ..identification.unit_mix import unit_findings
-from ..io.column_hint import missing_joints
+from ..io.column_hint import commanded_torques, missing_joints
 from ..io.columns import (
     ColumnMap,
     header_names,
@@ -355,6 +356,9 @@ def _read_torque_log(
         log = load_torque_log(path, drop_invalid=drop_invalid)
     else:
         mapped = load_mapped_torque_log(path, columns, n=n)
+        said_of = commanded_torques(columns.template("tau"), header_names(path), mapped.log.n)
+        if said_of is not None:  # a controller's torque read as measured: once per run
+            warnings.warn(said_of, DynidWarning, stacklevel=4)
         for note in mapped.conversions:  # as asked: a note
             _log.log(NOTE, "%s: %s", path.name, note)
         for note in mapped.notes:  # velocities derived: said once for every such recording
