@@ -438,9 +438,9 @@ def test_the_constants_line_says_what_the_data_check_and_what_they_cannot(panda)
     for k, (f, u) in read.items():
         assert abs(f - truth[k - 1]) <= max(5 * u, 0.02) and abs(f - truth[k - 1]) < 0.02, words
     assert abs(1 - read[2][0]) > 5 * read[2][1]  # off 1 by more than its uncertainty allows
-    assert "motor(s) 2 not named: under the 10 % from 1" in words
-    assert "at the description's masses' scale, which the data do not check" in words
-    assert "the torques of motor(s) 7 are as right as the drive file's constants" in words
-    assert "a known payload or torque sensor checks them" in words
+    assert "motor(s) 2 not named: within 10 % of 1" in words
+    assert "scaled by the description's masses, which the data do not check" in words
+    assert "the data cannot check motor(s) 7: their torques are as right as the drive" in words
+    assert "(a known payload or a torque sensor checks them)" in words
     assert words.endswith("(docs: tutorials/motor-currents.md#what-the-data-check)")
     assert current.as_dict()["constants"] == words

@@ -233,8 +233,9 @@ def test_the_constants_line_says_a_factor_clear_of_1_in_sample_and_why_not_named
     assert f"joint 4's {gains.factor[k]:.3g} +- {gains.heldout_std[k]:.2g} (over the folds" in words
     said = re.search(r"joint\(s\) ([\d, ]+) not named: ([^;]+)", words)
     assert said is not None and "4" in said[1].split(", "), words
-    assert "under the 10 % from 1" in said[2] and "within 5 spreads over the folds" in said[2]
-    assert "the torques of joint(s) 5, 6, 7 are as right as the drive file's constants" in words
+    assert "within 10 % of 1, the least" in said[2]
+    assert "within 5 of its spreads over the folds of 1" in said[2]
+    assert "cannot check joint(s) 5, 6, 7: their torques are as right as the drive file's" in words
 
 
 def test_validate_and_identify_print_the_constants_line(fits, other_currents, tmp_path, capsys):

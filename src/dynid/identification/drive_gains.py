@@ -326,12 +326,15 @@ class DriveGains:
         said = []
         if d < OFF:
             said.append(
-                f"under the {100 * OFF:g} % from 1 a factor is named at"
-                + (" (their common scale the description's masses')" if self.scaled else "")
+                f"within {100 * OFF:g} % of 1, the least a factor is named at"
+                + (" (their common scale is the description's masses')" if self.scaled else "")
             )
         spread = np.inf if self.heldout_std is None else float(self.heldout_std[k])
         if self.floor and not d >= SIGNIFICANT * spread:
-            said.append(f"at the noise floor within {SIGNIFICANT:g} spreads over the folds of 1")
+            said.append(
+                f"the fit is at the noise floor and it lies within {SIGNIFICANT:g} of its "
+                "spreads over the folds of 1"
+            )
         if said:
             return ", and ".join(said)
         if not self.uneven:
@@ -358,20 +361,20 @@ class DriveGains:
             return None
         unit, std, spread = self.per, self.std, self.heldout_std
         checked = np.flatnonzero(self.determined)  # the uncertainty each is read with: _read
-        parts = [f"the data check no {unit}'s"]
+        parts = [f"these data check no {unit}'s"]
         if checked.size:
             reads = ", ".join(
                 f"{unit} {k + 1}'s " + _read(float(self.factor[k]), float(std[k]), spread, int(k))
                 for k in checked
             )
             scale = (
-                "at the description's masses' scale, which the data do not check"
+                "scaled by the description's masses, which the data do not check"
                 if self.scaled
                 else "relative to each other, their common scale not known"
             )
             parts = [
-                f"the data check the torque_constant of {unit}(s) {_ids(checked)}, the true "
-                f"over the drive file's: {reads}, {scale}"
+                f"the data check the torque_constant of {unit}(s) {_ids(checked)} (the true "
+                f"one over the drive file's): {reads}, {scale}"
             ]
         if self.named:
             parts.append(f"{unit}(s) {_ids(self.named)} named above, with the fix")
@@ -383,8 +386,9 @@ class DriveGains:
         parts += [f"{unit}(s) {_ids(ks)} not named: {reason}" for reason, ks in why.items()]
         if self.unknown_scale:
             parts.append(
-                f"the torques of {unit}(s) {_ids(self.unknown_scale)} are as right as the drive "
-                "file's constants: a known payload or torque sensor checks them"
+                f"the data cannot check {unit}(s) {_ids(self.unknown_scale)}: their torques are "
+                "as right as the drive file's constants (a known payload or a torque sensor "
+                "checks them)"
             )
         return f"torque constants: {'; '.join(parts)} ({CONSTANTS_DOC})"
 
