@@ -114,6 +114,7 @@ from .recordings import (
     check_units,
     checked_accelerations,
     given_start,
+    given_units,
     unwrapped_recorded,
     usable_recorded,
 )
@@ -867,7 +868,7 @@ def _read_logs(
     rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
     check_derived_velocities(rec, cmap)
     checked = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
-    check_unit_findings(checked, robot)
+    check_unit_findings(checked, robot, given_units(cmap, (opt.columns or (None, None))[1]))
     check_limits(checked, robot)
     rec, checked = usable_recorded(rec, checked, robot, opt.max_gap_s)
     check_units(checked)

@@ -63,6 +63,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
+from ..identification.angle_time_units import GivenUnits
 from ..identification.derivative_columns import (
     DDQ_NOISE_RATIO,
     acceleration_noise_ratio,
@@ -120,6 +121,7 @@ __all__ = [
     "recorded_sign_map_findings",
     "check_torque_unit",
     "check_unit_findings",
+    "given_units",
     "check_units",
     "despiked_recordings",
     "given_start",
@@ -270,7 +272,7 @@ def read_recordings(
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths), drive)
     checked = unwrapped_recorded(out, robot, max_gap_s)  # as the preparation reads them
-    check_unit_findings(checked, robot)  # the time unit and degrees, named first
+    check_unit_findings(checked, robot, given_units(cmap, units))  # the units, named first
     check_limits(checked, robot)
     out, checked = usable_recorded(out, checked, robot, max_gap_s)  # units known right
     check_units(checked)
@@ -535,11 +537,19 @@ def check_derived_velocities(rec: Recorded, cmap: ColumnMap | None = None) -> No
     _log.log(NOTE, "%s: %s", which, said)
 
 
-def check_unit_findings(rec: Recorded, robot: Robot) -> None:
-    """Refuse a recording whose time column (ms, us, ns) or positions (degrees) are in
-    other units, every unit found said at once with one ``--units`` hint
-    (:func:`~dynid.identification.unit_mix.unit_findings`): a log in ms and degrees was
-    told ``--units t=ms`` and, run again, ``--units q=deg``.
+def given_units(cmap: ColumnMap | None, text: str | None) -> GivenUnits:
+    """The units the logs were read with (``cmap``'s factors) and the ``--units`` text
+    given, for the unit findings' hint."""
+    factors = {} if cmap is None else {k: cmap.factor(k) for k in ("t", "q", "dq", "ddq")}
+    return GivenUnits(text, factors)
+
+
+def check_unit_findings(rec: Recorded, robot: Robot, given: GivenUnits | None = None) -> None:
+    """Refuse a recording whose time column (ms, us, ns), positions (degrees) or velocity
+    columns (another angle unit than the positions) are in other units than read with
+    (``given``), every unit found said at once with one ``--units`` hint, the whole
+    option to run again (:func:`~dynid.identification.unit_mix.unit_findings`): a log in
+    ms and degrees was told ``--units t=ms`` and, run again, ``--units q=deg``.
 
     A recording in degrees among recordings in radians is said first
     (:func:`check_degrees`): the file to convert, as ``--units`` applies to every file.
@@ -551,7 +561,7 @@ def check_unit_findings(rec: Recorded, robot: Robot) -> None:
     """
     check_degrees(rec, robot)
     for name, log, side in zip(rec.names, rec.logs, rec.joint_side, strict=True):
-        if (found := unit_findings(robot, log, rec.drive, side=side)) is not None:
+        if (found := unit_findings(robot, log, rec.drive, side=side, given=given)) is not None:
             raise DataError(found, file=name)
 
 
