@@ -35,15 +35,22 @@ def truth():
     t = sample_times(3.0, 500.0)
     traj = random_fourier(panda, np.random.default_rng(3))(t)
     g = simulate_measurement(panda, traj, rng=np.random.default_rng(4))
-    return panda, TorqueLog(g.t, g.q, g.dq, g.tau)
+    return panda, TorqueLog(g.t, g.q, g.dq, g.tau, traj.ddq)
 
 
-def _vendor_csv(path: Path, log: TorqueLog, q_scale: float, dq_scale: float) -> Path:
-    """Stamps in us from a boot clock, positions and velocities times the scales given."""
+def _vendor_csv(
+    path: Path, log: TorqueLog, q_scale: float, dq_scale: float, ddq_scale: float | None = None
+) -> Path:
+    """Stamps in us from a boot clock, positions and velocities times the scales given
+    (and accelerations, with ``ddq_scale``)."""
     n = log.n
     head = ["t", *(f"q{j + 1}" for j in range(n))]
     head += [*(f"dq{j + 1}" for j in range(n)), *(f"tau{j + 1}" for j in range(n))]
-    rows = np.column_stack([8.1e9 + log.t * 1e6, log.q * q_scale, log.dq * dq_scale, log.tau])
+    cols = [8.1e9 + log.t * 1e6, log.q * q_scale, log.dq * dq_scale, log.tau]
+    if ddq_scale is not None:
+        head += [f"ddq{j + 1}" for j in range(n)]
+        cols.append(log.ddq * ddq_scale)
+    rows = np.column_stack(cols)
     np.savetxt(path, rows, delimiter=",", header=",".join(head), comments="", fmt="%.17g")
     return path
 
@@ -78,6 +85,24 @@ def test_velocities_57_times_slower_name_the_column_read_wrong(truth, tmp_path):
     assert msg.endswith("hint: --units t=us,q=deg,dq=rad/s"), msg
     ok = read_recordings([path], panda, columns=(None, "t=us,q=deg,dq=rad/s"))
     np.testing.assert_allclose(ok.logs[0].dq, log.dq, atol=1e-12)
+
+
+def test_acceleration_columns_are_converted_alike_or_named_alone(truth, tmp_path):
+    """Accelerations in deg/s^2 beside velocities in deg/s: with dq=deg/s forgotten the
+    hint converts both; with ddq=deg/s^2 alone forgotten it names the accelerations (57.3
+    times the derivative of the velocities), not their noise; read so, the simulation."""
+    panda, log = truth
+    path = _vendor_csv(tmp_path / "a.csv", log, DEG, DEG, DEG)
+    with pytest.raises(DataError) as e:
+        read_recordings([path], panda, columns=(None, "t=us,q=deg"))
+    assert str(e.value).endswith("hint: --units t=us,q=deg,dq=deg/s,ddq=deg/s^2"), str(e.value)
+    with pytest.raises(DataError) as e:
+        read_recordings([path], panda, columns=(None, "t=us,q=deg,dq=deg/s"))
+    msg = str(e.value)
+    assert "its acceleration columns are 57.3 times the derivative of its velocities" in msg
+    assert msg.endswith("hint: --units t=us,q=deg,dq=deg/s,ddq=deg/s^2"), msg
+    ok = read_recordings([path], panda, columns=(None, "t=us,q=deg,dq=deg/s,ddq=deg/s^2"))
+    np.testing.assert_allclose(ok.logs[0].ddq, log.ddq, atol=1e-10)
 
 
 def test_rate_factors_are_the_units_ratio_and_agreeing_columns_pass(truth):

@@ -37,6 +37,7 @@ from .log import TorqueLog
 
 __all__ = [
     "MAX_SAMPLES",
+    "acceleration_rate_factors",
     "SHAPE_CORRELATION",
     "WINDOW_S",
     "joint_rate_factors",
@@ -63,34 +64,65 @@ def _box(x: NDArray[np.float64], w: int) -> NDArray[np.float64]:
     return (c[w:] - c[:-w]) / w
 
 
+def _rate_factors(
+    t: NDArray[np.float64], x: NDArray[np.float64], v: NDArray[np.float64], wrap: bool
+) -> NDArray[np.float64]:
+    """Per column, ``k`` of ``d x / dt ~ k v`` by least squares over the steps of ``t``
+    [s] (module docstring); the steps at a gap, and with ``wrap`` a jump of half a turn or
+    more of ``x``, left out; NaN for a column not judged."""
+    out = np.full(x.shape[1], np.nan)
+    dt = np.diff(t)
+    step = float(np.median(dt))
+    dx = np.diff(x, axis=0)
+    keep = (dt <= 1.5 * step)[:, None] & ((np.abs(dx) <= np.pi) if wrap else True)
+    a = np.where(keep, dx / dt[:, None], 0.0)
+    b = np.where(keep, 0.5 * (v[1:] + v[:-1]), 0.0)
+    w = max(1, min(int(round(WINDOW_S / step)), (t.size - 1) // 4))
+    a, b = _box(a, w), _box(b, w)
+    for j in range(x.shape[1]):
+        aj, bj = a[:, j], b[:, j]
+        sa, sb = float(np.std(aj)), float(np.std(bj))
+        if not (sa > 0 and sb > 0):
+            continue
+        c = float(np.mean((aj - aj.mean()) * (bj - bj.mean()))) / (sa * sb)
+        if c >= SHAPE_CORRELATION:
+            out[j] = float(aj @ bj) / float(bj @ bj)
+    return out
+
+
 def joint_rate_factors(log: TorqueLog) -> NDArray[np.float64]:
     """Per joint (n,), ``k`` [1] of ``d q / dt ~ k dq``: 1 when positions and velocities
     share a unit, ``pi / 180`` for velocities in deg/s beside positions in rad (module
     docstring); NaN for a joint not judged, and for every joint of velocities derived from
     the positions or a log of fewer than 8 samples."""
-    n = log.n
-    out = np.full(n, np.nan)
     if log.dq_derived or log.n_samples < 8:
-        return out
+        return np.full(log.n, np.nan)
     m = min(log.n_samples, MAX_SAMPLES)
-    t, q, dq = log.t[:m], np.asarray(log.q[:m]), np.asarray(log.dq[:m])
-    dt = np.diff(t)
-    step = float(np.median(dt))
-    dqs = np.diff(q, axis=0)
-    keep = (dt <= 1.5 * step)[:, None] & (np.abs(dqs) <= np.pi)
-    x = np.where(keep, dqs / dt[:, None], 0.0)
-    y = np.where(keep, 0.5 * (dq[1:] + dq[:-1]), 0.0)
-    w = max(1, min(int(round(WINDOW_S / step)), (m - 1) // 4))
-    x, y = _box(x, w), _box(y, w)
-    for j in range(n):
-        xj, yj = x[:, j], y[:, j]
-        sx, sy = float(np.std(xj)), float(np.std(yj))
-        if not (sx > 0 and sy > 0):
-            continue
-        c = float(np.mean((xj - xj.mean()) * (yj - yj.mean()))) / (sx * sy)
-        if c >= SHAPE_CORRELATION:
-            out[j] = float(xj @ yj) / float(yj @ yj)
-    return out
+    return _rate_factors(log.t[:m], np.asarray(log.q[:m]), np.asarray(log.dq[:m]), True)
+
+
+def acceleration_rate_factors(log: TorqueLog) -> NDArray[np.float64]:
+    """Per joint (n,), ``k`` [1] of ``d dq / dt ~ k ddq``: 1 when velocities and
+    accelerations share a unit, ``pi / 180`` for accelerations in deg/s^2 beside
+    velocities in rad/s; NaN for a joint not judged, and for every joint of a log without
+    acceleration columns or of fewer than 8 samples."""
+    if log.ddq is None or log.n_samples < 8:
+        return np.full(log.n, np.nan)
+    m = min(log.n_samples, MAX_SAMPLES)
+    return _rate_factors(log.t[:m], np.asarray(log.dq[:m]), np.asarray(log.ddq[:m]), False)
+
+
+def _scaled(k: NDArray[np.float64]) -> tuple[NDArray[np.bool_], float] | None:
+    """The joints whose factors ``k`` read ``pi / 180`` (or ``180 / pi``, whichever more),
+    and that scale [1] (the true values over those read), when they are at least half
+    of those judged; None otherwise."""
+    judged = np.isfinite(k)
+    fast = judged & (np.abs(k * _DEG - 1.0) < RATE_AGREES)
+    slow = judged & (np.abs(k / _DEG - 1.0) < RATE_AGREES)
+    scaled, c = (fast, math.pi / 180) if fast.sum() >= slow.sum() else (slow, _DEG)
+    if not scaled.any() or 2 * int(scaled.sum()) < int(judged.sum()):
+        return None
+    return scaled, c
 
 
 def _blamed(
@@ -135,9 +167,9 @@ def _said(blame: str, c: float, given: GivenUnits) -> str:
 def velocity_scale_finding(
     robot: Robot, log: TorqueLog, given: GivenUnits | None = None, skip: Sequence[int] = ()
 ) -> str | None:
-    """One line saying a joint-side ``log``'s velocity columns are in another angle unit
-    than its positions, with the ``--units`` entries that read them right given the units
-    ``given`` applied (module docstring); None otherwise.
+    """One line saying a joint-side ``log``'s velocity (or acceleration) columns are in
+    another angle unit than its positions (velocities), with the ``--units`` entries that
+    read them right given the units ``given`` applied (module docstring); None otherwise.
 
     Parameters
     ----------
@@ -153,14 +185,10 @@ def velocity_scale_finding(
     given = given or GivenUnits()
     k = joint_rate_factors(log)
     k[list(skip)] = np.nan
-    judged = np.isfinite(k)
-    fast = judged & (np.abs(k * _DEG - 1.0) < RATE_AGREES)
-    slow = judged & (np.abs(k / _DEG - 1.0) < RATE_AGREES)
-    scaled = fast if fast.sum() >= slow.sum() else slow
-    if not scaled.any() or 2 * int(scaled.sum()) < int(judged.sum()):
-        return None
+    if (found := _scaled(k)) is None:
+        return _acceleration_finding(robot, log, given)
+    scaled, c = found
     joints = np.flatnonzero(scaled)
-    c = math.pi / 180 if scaled is fast else _DEG  # the velocities' true scale
     blame = _blamed(robot, log, joints, c, given)
     if blame == "dq":
         entries = {"dq": unit_name("dq", given.factor("dq") * c)}
@@ -168,21 +196,62 @@ def velocity_scale_finding(
             entries["ddq"] = unit_name("ddq", given.factor("ddq") * c)
     else:
         entries = {"q": unit_name("q", given.factor("q") / c)}
-    names = robot.joint_names
-    ks = ", ".join(f"{names[j]} {1 / k[j]:.3g}" for j in joints[:3])
-    more = f" (and {joints.size - 3} more)" if joints.size > 3 else ""
-    what = f"its velocity columns are {1 / float(np.median(k[joints])):.3g} times the derivative"
+    what = f"its velocity columns are {_times(k, joints, robot, 'positions')}"
     said = (
-        f"{what} of its positions ({ks}{more}): {_said(blame, c, given)}, a unit, not a lag "
-        "(a fit would take the velocities as they are)"
+        f"{what}: {_said(blame, c, given)}, a unit, not a lag (a fit would take them as they are)"
     )
+    judged = np.isfinite(k)
+    return _with_hint(
+        said, entries, robot, joints, judged & ~scaled, "velocity" if blame == "dq" else "position"
+    )
+
+
+def _acceleration_finding(robot: Robot, log: TorqueLog, given: GivenUnits) -> str | None:
+    """:func:`velocity_scale_finding` of acceleration columns against the derivative of
+    velocities of the right unit: ``ddq=deg/s^2`` forgotten beside ``dq=deg/s``."""
+    k = acceleration_rate_factors(log)
+    if (found := _scaled(k)) is None:
+        return None
+    scaled, c = found
+    joints = np.flatnonzero(scaled)
+    entries = {"ddq": unit_name("ddq", given.factor("ddq") * c)}
+    read = unit_name("ddq", given.factor("ddq"))
+    read = read if "/" in read else f"{read} x rad/s^2"
+    unit = "degrees" if c < 1.0 else "radians"
+    said = (
+        f"its acceleration columns are {_times(k, joints, robot, 'velocities')}: "
+        f"accelerations in {unit} per second squared read as {read}, a unit (a "
+        "fit would take them as they are)"
+    )
+    judged = np.isfinite(k)
+    return _with_hint(said, entries, robot, joints, judged & ~scaled, "acceleration")
+
+
+def _times(k: NDArray[np.float64], joints: NDArray[np.intp], robot: Robot, of: str) -> str:
+    """``57.3 times the derivative of its positions (joint1 57.3, ...)``: ``of`` the
+    derivative of what, and the joints' own factors (three at most)."""
+    names = robot.joint_names
+    each = ", ".join(f"{names[j]} {1 / k[j]:.3g}" for j in joints[:3])
+    more = f" (and {joints.size - 3} more)" if joints.size > 3 else ""
+    return f"{1 / float(np.median(k[joints])):.3g} times the derivative of its {of} ({each}{more})"
+
+
+def _with_hint(
+    said: str,
+    entries: dict[str, str],
+    robot: Robot,
+    joints: NDArray[np.intp],
+    others: NDArray[np.bool_],
+    column: str,
+) -> str:
+    """``said`` and its ``--units`` hint; when ``others`` (joints judged right) remain,
+    the columns of ``joints`` to convert in the file instead."""
     hint = "--units " + ",".join(f"{q}={u}" for q, u in entries.items())
-    if not np.array_equal(scaled, judged):
-        others = ", ".join(names[j] for j in np.flatnonzero(judged & ~scaled))
-        return (
-            f"{said}, while those of {others} agree with their positions; hint: convert "
-            f"the {'velocity' if blame == 'dq' else 'position'} columns of "
-            f"{', '.join(names[j] for j in joints)} in the file ({hint} converts every "
-            "joint alike)"
-        )
-    return f"{said}; hint: {hint}"
+    if not others.any():
+        return f"{said}; hint: {hint}"
+    names = robot.joint_names
+    return (
+        f"{said}, while those of {', '.join(names[j] for j in np.flatnonzero(others))} "
+        f"agree; hint: convert the {column} columns of "
+        f"{', '.join(names[j] for j in joints)} in the file ({hint} converts every joint alike)"
+    )

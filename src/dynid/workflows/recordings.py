@@ -66,6 +66,7 @@ from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.angle_time_units import GivenUnits
 from ..identification.derivative_columns import (
     DDQ_NOISE_RATIO,
+    SCALE_OFF,
     acceleration_noise_ratio,
     velocity_finding,
 )
@@ -88,6 +89,7 @@ from ..identification.unit_mix import (
     unit_findings,
 )
 from ..identification.velocity_noise import moving_joints
+from ..identification.velocity_scale import acceleration_rate_factors
 from ..io.columns import CURRENT_UNITS, LEFT_OUT, ColumnMap, parse_column_map
 from ..io.sign_entries import tau_negated, units_negating, units_reading
 from ..io.torque_log import declared_tau_unit
@@ -447,11 +449,16 @@ def checked_accelerations(
     (:func:`~dynid.identification.derivative_columns.acceleration_noise_ratio`) left out,
     the accelerations derived from the velocities instead, with a note naming each and the
     ratio; a note names the logs whose acceleration columns are used (exact to round-off,
-    or no noisier than that): without it nothing said a recorded ``ddq`` was read."""
+    or no noisier than that): without it nothing said a recorded ``ddq`` was read. Columns
+    off the scale of the velocities' derivative
+    (:func:`~dynid.identification.velocity_scale.acceleration_rate_factors`, beyond
+    :data:`~dynid.identification.derivative_columns.SCALE_OFF`) are kept for the unit
+    check (:func:`check_unit_findings`) to name: their noise is their unit's."""
     out, used = [], []
     for name, log in zip(names, logs, strict=True):
-        if log.ddq is None:
-            out.append(log)
+        k = acceleration_rate_factors(log)
+        if log.ddq is None or np.any(np.abs(np.log(k[np.isfinite(k)])) > np.log(SCALE_OFF)):
+            out.append(log)  # columns in another unit: the unit check names it, not noise
             continue
         ratio = acceleration_noise_ratio(log, cutoff_hz)
         worst = float(np.max(ratio)) if ratio is not None and ratio.size else 0.0
