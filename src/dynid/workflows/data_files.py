@@ -41,7 +41,6 @@ from ..io.columns import (
     load_mapped_static_data,
     load_mapped_torque_log,
     parse_column_map,
-    unread_note,
 )
 from ..io.input_files import regular_file
 from ..io.static_data import load_static_data
@@ -362,8 +361,6 @@ def _read_torque_log(
             warnings.warn(said_of, DynidWarning, stacklevel=4)
         for note in mapped.conversions:  # as asked: a note
             _log.log(NOTE, "%s: %s", path.name, note)
-        if mapped.unread:  # kept in the file, not read: named once
-            _log.log(NOTE, "%s: %s", path.name, unread_note(mapped.unread, mapped.log.n))
         for note in mapped.notes:  # velocities derived: said once for every such recording
             _log.info("%s: %s", path.name, note)  # (recordings.check_derived_velocities)
         c = mapped.log.cleaning

@@ -116,6 +116,7 @@ from .recordings import (
     checked_accelerations,
     given_start,
     given_units,
+    note_unread_columns,
     unwrapped_recorded,
     usable_recorded,
 )
@@ -888,6 +889,7 @@ def _read_logs(
         held.append((heldout, Path(opt.validate_on)))
     rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
     check_derived_velocities(rec, cmap)
+    note_unread_columns(rec, cmap)
     checked = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
     check_unit_findings(checked, robot, given_units(cmap, (opt.columns or (None, None))[1]))
     check_limits(checked, robot)

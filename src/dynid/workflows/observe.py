@@ -146,6 +146,7 @@ from .recordings import (
     despiked_recordings,
     given_start,
     given_units,
+    note_unread_columns,
     unwrapped_recorded,
     usable_recorded,
 )
@@ -780,6 +781,7 @@ def _read_logs(
     read, checked = usable_recorded(read, checked, model.robot, opts.max_gap)
     check_units(checked)
     check_derived_velocities(read, cmap)
+    note_unread_columns(read, cmap)
     # detection logs hold contacts; a model's recorded sign map judged first
     check_signs(
         checked, model.robot, among=opts.calibrate, recorded=recorded, units=opts.columns[1]

@@ -90,7 +90,15 @@ from ..identification.unit_mix import (
 )
 from ..identification.velocity_noise import moving_joints
 from ..identification.velocity_scale import acceleration_rate_factors
-from ..io.columns import CURRENT_UNITS, LEFT_OUT, ColumnMap, parse_column_map
+from ..io.columns import (
+    CURRENT_UNITS,
+    LEFT_OUT,
+    ColumnMap,
+    header_names,
+    parse_column_map,
+    unread_columns,
+    unread_note,
+)
 from ..io.sign_entries import tau_negated, units_negating, units_reading
 from ..io.torque_log import declared_tau_unit
 from ..model.drive import Drive
@@ -124,6 +132,7 @@ __all__ = [
     "check_torque_unit",
     "check_unit_findings",
     "given_units",
+    "note_unread_columns",
     "check_units",
     "despiked_recordings",
     "given_start",
@@ -279,6 +288,7 @@ def read_recordings(
     out, checked = usable_recorded(out, checked, robot, max_gap_s)  # units known right
     check_units(checked)
     check_derived_velocities(out, cmap)
+    note_unread_columns(out, cmap)
     if sign_map:
         check_sign_map(checked, robot if reference is None else reference, mine[1], recorded)
     if signs:  # said, naming the joints: the verdict judges the log as it is
@@ -542,6 +552,25 @@ def check_derived_velocities(rec: Recorded, cmap: ColumnMap | None = None) -> No
     if cmap is not None and cmap.ignored("dq"):
         said = said.replace("no velocity columns", LEFT_OUT, 1)
     _log.log(NOTE, "%s: %s", which, said)
+
+
+def note_unread_columns(rec: Recorded, cmap: ColumnMap | None) -> None:
+    """Say once, as a note, the columns of the recordings read through ``cmap`` that no
+    entry maps (:func:`~dynid.io.columns.unread_columns`: a vendor's motor currents beside
+    its torques), the recordings of the same ones named together; they were dropped
+    without a word."""
+    if cmap is None:
+        return
+    said: dict[str, list[str]] = {}
+    for path, log in zip(rec.paths, rec.logs, strict=True):
+        unread = unread_columns(header_names(path), cmap.for_file(path.name))
+        if unread:
+            said.setdefault(unread_note(unread, log.n), []).append(path.name)
+    for note, names in said.items():
+        which = (
+            ", ".join(names) if len(names) <= 4 else f"{len(names)} recordings ({names[0]}, ...)"
+        )
+        _log.log(NOTE, "%s: %s", which, note)
 
 
 def given_units(cmap: ColumnMap | None, text: str | None) -> GivenUnits:
