@@ -9,15 +9,21 @@
   (``--units q=deg``; both in degrees: ``--units q=deg,dq=deg/s``).
 * **Milliseconds**: logged velocities ``1e3`` times the derivative of the positions (or a
   median time step of at least 0.5 s with integer steps when no velocities were logged):
-  ``--units t=ms`` (:func:`time_unit_finding`).
+  ``--units t=ms`` (:func:`time_unit_finding`). The unit is read from the data against
+  the one the time column was read in (:class:`GivenUnits`): stamps in microseconds read
+  with ``--units t=ms`` are told ``t=us``, not the ``t=ms`` already given.
 
 A log may hold both (times in ms and positions in degrees): the checks that find them say
-them in one message with one hint, ``--units t=ms,q=deg`` (:func:`joined_unit_findings`).
+them in one message with one hint, ``--units t=ms,q=deg`` (:func:`joined_unit_findings`),
+written into the ``--units`` given (:func:`units_with`: ``--units t=us,q=deg,dq=deg/s,tau=-1``,
+the whole option to run again).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -27,6 +33,9 @@ from .log import TorqueLog
 
 __all__ = [
     "RATE_AGREES",
+    "GivenUnits",
+    "unit_name",
+    "units_with",
     "degrees_findings",
     "joined_unit_findings",
     "time_unit",
@@ -44,6 +53,68 @@ __all__ = [
 RATE_AGREES = 0.25
 #: Speed [rad/s] above which velocities are too fast for radians on a joint without dq_max.
 _FAST_RAD_S = 2 * np.pi
+
+#: The ``--units`` spellings of each quantity a unit finding names, and their factor to SI.
+_UNIT_NAMES: dict[str, dict[str, float]] = {
+    "t": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9},
+    "q": {"rad": 1.0, "deg": math.pi / 180},
+    "dq": {"rad/s": 1.0, "deg/s": math.pi / 180},
+    "ddq": {"rad/s^2": 1.0, "deg/s^2": math.pi / 180},
+}
+#: The quantities in the order ``--units`` entries are written (a new one goes after its
+#: neighbour: ``q=deg,dq=deg/s``).
+_ORDER = ("t", "q", "dq", "ddq")
+
+
+@dataclass(frozen=True, slots=True)
+class GivenUnits:
+    """The ``--units`` a log was read with, for the unit findings to say the whole option.
+
+    Attributes
+    ----------
+    text : str or None
+        The ``--units`` text as given (``"t=us,q=deg,tau=-1"``); None when not known (a
+        TOML map, the defaults).
+    factors : mapping of str to float
+        Quantity -> the factor to SI it was read with (``{"q": pi / 180}``); missing: 1.
+    """
+
+    text: str | None = None
+    factors: Mapping[str, float] = field(default_factory=dict)
+
+    def factor(self, quantity: str) -> float:
+        """The factor [1] ``quantity`` was read with, its sign left out (a sign flip is no
+        unit)."""
+        return abs(float(self.factors.get(quantity, 1.0)))
+
+
+def unit_name(quantity: str, factor: float) -> str:
+    """The ``--units`` spelling of ``factor`` [1, to SI] for ``quantity``: ``deg/s`` for
+    ``dq`` at ``pi / 180``, ``us`` for ``t`` at ``1e-6``; the number otherwise."""
+    for name, f in _UNIT_NAMES.get(quantity, {}).items():
+        if math.isclose(factor, f, rel_tol=1e-9):
+            return name
+    return f"{factor:.10g}"
+
+
+def units_with(text: str | None, entries: Mapping[str, str]) -> str:
+    """The ``--units`` text ``text`` with ``entries`` (quantity -> unit) in place of its
+    own for those quantities, a new one written after its neighbour in ``t, q, dq, ddq``
+    (``units_with("t=us,q=deg,tau=-1", {"dq": "deg/s"})`` is
+    ``"t=us,q=deg,dq=deg/s,tau=-1"``); ``entries`` alone without a text."""
+    parts = [p.strip() for p in (text or "").split(",") if p.strip()]
+    keys = [p.partition("=")[0].strip() for p in parts]
+    for key, unit in entries.items():
+        entry = f"{key}={unit}"
+        if key in keys:
+            parts[keys.index(key)] = entry
+            continue
+        before = _ORDER[: _ORDER.index(key)] if key in _ORDER else ()
+        at = max((i + 1 for i, k in enumerate(keys) if k in before), default=0)
+        at = at if key in _ORDER else len(parts)
+        parts.insert(at, entry)
+        keys.insert(at, key)
+    return ",".join(parts)
 
 
 def degrees_findings(robot: Robot, log: TorqueLog) -> list[str]:
@@ -165,24 +236,28 @@ def velocity_rate_factor(log: TorqueLog) -> float:
     return num / den if den > 0 else float("nan")
 
 
-def time_unit(log: TorqueLog) -> tuple[str, float] | None:
-    """The unit of ``log``'s time column when its recorded velocities are a power of ten
-    (1e3, 1e6, 1e9, within 25 %) times the rate of change of its positions per unit of it:
-    its ``--units t=`` spelling and its length [s] (``("ms", 1e-3)``); None otherwise
+def time_unit(log: TorqueLog, given: float = 1.0) -> tuple[str, float] | None:
+    """The unit of ``log``'s time column when it is not the one it was read in: its
+    recorded velocities a power of ten (within 25 %) times the rate of change of its
+    positions per second as read, so that the column's unit is ``given`` [s] (the factor
+    it was read with: 1e-3 for ``--units t=ms``) times that factor, one of s, ms, us, ns:
+    its ``--units t=`` spelling and its length [s] (``("ms", 1e-3)``; ``("us", 1e-6)`` for
+    stamps in microseconds read as ms); None otherwise, or when it is ``given``
     (:func:`velocity_rate_factor`)."""
     k = velocity_rate_factor(log)
     if not np.isfinite(k) or k <= 0:
         return None
-    for unit, size in _TIME_UNITS:
-        if abs(k / size - 1.0) < RATE_AGREES:
-            return unit, size
+    for unit, size in (("s", 1.0), *_TIME_UNITS):
+        if abs(k * given / size - 1.0) < RATE_AGREES:
+            return None if math.isclose(size, given, rel_tol=1e-9) else (unit, size)
     return None
 
 
-def joined_unit_findings(findings: Sequence[str]) -> str:
+def joined_unit_findings(findings: Sequence[str], given: str | None = None) -> str:
     """One line of several unit findings of one file, each ``what; hint: --units a=b``:
     their reasons joined, and one hint, ``--units t=ms,q=deg`` (a hint that is not a
-    plain ``--units`` list is kept after it)."""
+    plain ``--units`` list is kept after it), written into the ``--units`` text ``given``
+    when there is one (:func:`units_with`: the whole option to run again)."""
     whats, units, others = [], [], []
     for f in findings:
         what, _, hint = f.partition("; hint: ")
@@ -192,27 +267,37 @@ def joined_unit_findings(findings: Sequence[str]) -> str:
             units.append(rest)
         elif hint:
             others.append(hint)
+    if units and given:
+        pairs = (u.partition("=") for u in ",".join(units).split(","))
+        units = [units_with(given, {k: v for k, _, v in pairs})]
     hints = ([f"--units {','.join(units)}"] if units else []) + others
     return "; and ".join(whats) + (f"; hint: {'; '.join(hints)}" if hints else "")
 
 
-def time_unit_finding(name: str, log: TorqueLog) -> str | None:
-    """One line naming the file ``name`` when its time column is in ms, us or ns, not
-    seconds (:func:`time_unit`); None otherwise."""
-    said = time_unit_said(log)
+def time_unit_finding(name: str, log: TorqueLog, given: float = 1.0) -> str | None:
+    """One line naming the file ``name`` when its time column is in another unit than
+    the one it was read in, ``given`` [s] (:func:`time_unit`); None otherwise."""
+    said = time_unit_said(log, given)
     return None if said is None else f"{name}: {said}"
 
 
-def time_unit_said(log: TorqueLog) -> str | None:
+def time_unit_said(log: TorqueLog, given: float = 1.0) -> str | None:
     """:func:`time_unit_finding` without the file's name."""
-    found = time_unit(log)
+    found = time_unit(log, given)
     if found is None:
         return None
     unit, size = found
     k = velocity_rate_factor(log)
+    read = unit_name("t", given)
+    if math.isclose(given, 1.0, rel_tol=1e-9):
+        per, said = "per unit of its time column", f"{unit}, not seconds (t x {1 / size:g})"
+    else:
+        per = f"per second of its time column as read (--units t={read})"
+        r = given / size
+        too = "long" if r > 1 else "short"
+        said = f"{unit}, not {read} (its times read {max(r, 1 / r):g} times too {too})"
     return (
-        f"its recorded velocities are {1 / k:.4g} times the rate of change of "
-        f"its positions per unit of its time column: the time column looks like "
-        f"{unit}, not seconds (t x {1 / size:g}); every filter, derivative and "
-        f"frequency read from it would be off by that factor; hint: --units t={unit}"
+        f"its recorded velocities are {1 / k:.4g} times the rate of change of its positions "
+        f"{per}: the time column looks like {said}; every filter, derivative and frequency "
+        f"read from it would be off by that factor; hint: --units t={unit}"
     )

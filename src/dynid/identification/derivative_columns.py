@@ -31,6 +31,12 @@ ways a logger breaks that, each found here on the log as read (SI, joint order):
   (the accelerations the preparation derives without them); above
   :data:`DDQ_NOISE_RATIO` the columns are better left out.
 
+A lag is read only of velocity columns at the scale of the positions' derivative: columns
+:data:`SCALE_OFF` times larger or smaller than it on some joint
+(:func:`~dynid.identification.velocity_scale.joint_rate_factors`) are said to be off by
+that scale, not to lag (velocities in deg/s beside positions in rad read as a lag of 12.86
+samples on a Kinova log, and as a lead of 0.91 on another).
+
 The remedy for the first two is to read the log without its velocity columns
 (``--columns dq=none``, :mod:`dynid.io.columns`): the velocities are then derived from the
 positions.
@@ -38,6 +44,7 @@ positions.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,6 +55,7 @@ from .input_noise import derived_noise_gains, quantized_noise_std
 from .log import TorqueLog
 from .rate import cutoff_from_motion
 from .velocity_noise import at_round_off, moving_joints, velocity_noise_std
+from .velocity_scale import joint_rate_factors
 
 __all__ = [
     "DDQ_NOISE_RATIO",
@@ -55,6 +63,7 @@ __all__ = [
     "LAG_FILTER_SHARE",
     "MAX_LAG_SAMPLES",
     "MAX_SHIFT",
+    "SCALE_OFF",
     "STILL_SHARE",
     "VelocityCheck",
     "acceleration_noise_ratio",
@@ -82,6 +91,9 @@ DDQ_NOISE_RATIO = 3.0
 #: A step of the positions this many robust standard deviations (of the steps' second
 #: differences) off its neighbours and the recorded velocity is a jump (samples lost).
 JUMP_SPREAD = 20.0
+#: Velocity columns this many times larger or smaller than the positions' derivative on a
+#: joint are off by a scale (a unit), not read for a lag.
+SCALE_OFF = 1.5
 #: Samples read at most (the first ones): enough for a lag to a hundredth of a sample.
 MAX_SAMPLES = 200_000
 
@@ -196,6 +208,20 @@ def velocity_finding(log: TorqueLog, joint_names: tuple[str, ...] | None = None)
     if found is None:
         return None
     parts = []
+    k = joint_rate_factors(log)
+    off = tuple(
+        int(j) for j in np.flatnonzero(np.isfinite(k) & (np.abs(np.log(k)) > np.log(SCALE_OFF)))
+    )
+    if off:  # a scale shifts the lag read where jumps are told from the velocities
+        found = dataclasses.replace(found, lag_joints=())
+        parts.append(
+            "its velocity columns are off the scale of the derivative of its positions ("
+            + ", ".join(
+                f"{joint_names[j] if joint_names else f'joint {j + 1}'} {1 / k[j]:.3g} times it"
+                for j in off
+            )
+            + "): a unit or a scale, not a lag"
+        )
     if found.still:
         parts.append(
             f"its velocity columns hold no motion (zero or constant) on "

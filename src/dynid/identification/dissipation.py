@@ -13,12 +13,18 @@ that joint, when the data need it (:func:`reversed_sign_finding`): the sign flip
 gravity check of :mod:`~dynid.identification.sanity` cannot see on a joint gravity does
 not load.
 
+The hint of that finding adds to the sign flips ``--units`` applied already, when given
+(:class:`ReversedSignError`, :meth:`ReversedSignError.beside`): ``tau2=-1,...,tau5=-1``
+applied and joints 1 and 6 found are every joint, told ``--units tau=-1``, as the sign
+check of the torques against the model's tells every joint opposite.
+
 The velocity limit of a motor is ``sum_j |K_mj| dq_max_j`` (``K`` the drive's friction
 transmission, the identity at the joints); joints without a limit are not checked.
 """
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -27,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..exceptions import DynidWarning
+from ..exceptions import DataError, DynidWarning
 from ..regressors.terms import PART_LABELS, LinearFriction, ModelTerm
 
 if TYPE_CHECKING:
@@ -38,6 +44,7 @@ __all__ = [
     "GRID",
     "SIGNIFICANCE",
     "NegativeViscous",
+    "ReversedSignError",
     "Violation",
     "friction_columns",
     "friction_violations",
@@ -298,6 +305,8 @@ def reversed_sign_finding(
     names: Sequence[str],
     instead: Structure | None = None,
     coupled: frozenset[int] = frozenset(),
+    applied: Sequence[int] | None = None,
+    text: str | None = None,
 ) -> str | None:
     """The finding that the torques of some joints (motors) have the opposite sign to the
     model's, read from friction that puts energy in at every speed
@@ -317,6 +326,13 @@ def reversed_sign_finding(
         The joints (motors) a drive couples to another: there the coupling's sign is
         named too (a coupling of the wrong sign left ``fv6 = -0.247`` on a wrist, and the
         hint to flip ``tau6`` came back after it was followed).
+    applied : sequence of int, optional
+        The joints (from 0) whose torque columns ``--units`` flipped already
+        (``tau2=-1``): the hint gives the flips to read every column right, those and the
+        ones found (``--units tau=-1`` in place of them when that is every joint); None
+        when not known (the hint flips the joints found, beside whatever was given).
+    text : str, optional
+        The ``--units`` text given, which the hint beside ``applied`` is written into.
     """
     flipped = [v for v in violations if v.everywhere]
     if not flipped:
@@ -329,9 +345,8 @@ def reversed_sign_finding(
         f"to the limit ({'; '.join(v.coefficients for v in flipped)}): the torque sign of "
         f"{which} is probably opposite to the model's (the check of the torques against "
         f"the model's does not tell it on a joint whose torques gravity and the links "
-        f"barely make); hint: --units "
-        + ",".join(f"tau{v.joint + 1}=-1" for v in flipped)
-        + f" reads {its} flipped (beside the torques' unit, if one is given)"
+        f"barely make); hint: "
+        + _flip_hint([v.joint for v in flipped], len(names), applied, its, text)
         + (
             f"; or the drive's coupling of {', '.join(_named(v, names) for v in linked)} has "
             "the wrong sign (a flipped column there makes the coupled one push instead)"
@@ -345,6 +360,61 @@ def reversed_sign_finding(
             f"{','.join(instead.terms) or 'links'} fits without that friction"
         )
     )
+
+
+def _flip_hint(
+    found: Sequence[int],
+    n: int,
+    applied: Sequence[int] | None,
+    its: str,
+    text: str | None = None,
+) -> str:
+    """The ``--units`` of :func:`reversed_sign_finding`'s hint: the joints ``found`` (from
+    0) flipped beside the flips ``applied`` (a joint in both read as it is), ``tau=-1``
+    when that is every one of the ``n`` joints; written into the ``--units`` text given,
+    ``text``, when known (the whole option to run again)."""
+    entries = ",".join(f"tau{j + 1}=-1" for j in found)
+    if applied is None or not applied:
+        return f"--units {entries} reads {its} flipped (beside the torques' unit, if one is given)"
+    given = ",".join(f"tau{j + 1}=-1" for j in sorted(applied))
+    every = sorted(set(applied) ^ set(found))
+    now = "tau=-1" if every == list(range(n)) else ",".join(f"tau{j + 1}=-1" for j in every)
+    if text is not None:
+        kept = [e.strip() for e in text.split(",") if e.strip()]
+        kept = [e for e in kept if not re.fullmatch(r"tau\d+", e.partition("=")[0].strip())]
+        option = ",".join([*kept, *([now] if now else [])])
+    else:
+        option = now or "without the tau flips"
+    if now == "tau=-1":
+        return (
+            f"--units {option} (tau=-1 in place of {given}: with {entries} every joint's "
+            "torque reads flipped)"
+        )
+    return f"--units {option} ({now or 'no flip'} in place of {given}: {entries} flipped too)"
+
+
+class ReversedSignError(DataError):
+    """:func:`reversed_sign_finding` raised, with what says it again beside the sign
+    flips ``--units`` applied (:meth:`beside`), which the fit does not know."""
+
+    def __init__(
+        self,
+        violations: Sequence[Violation],
+        names: Sequence[str],
+        instead: Structure | None = None,
+        coupled: frozenset[int] = frozenset(),
+    ) -> None:
+        self.violations, self.names = tuple(violations), tuple(names)
+        self.instead, self.coupled = instead, coupled
+        super().__init__(reversed_sign_finding(violations, names, instead, coupled))
+
+    def beside(self, applied: Sequence[int], text: str | None = None) -> DataError:
+        """The same finding, its hint given the joints (from 0) ``--units`` flipped and
+        the ``--units`` text given (``text``, when known)."""
+        said = reversed_sign_finding(
+            self.violations, self.names, self.instead, self.coupled, applied, text
+        )
+        return DataError(said)
 
 
 def friction_columns(

@@ -47,6 +47,7 @@ from .sanity import too_few_samples
 
 __all__ = [
     "wrapped_finding",
+    "wrapped_range",
     "Q_START_TOLERANCE",
     "WRAP_SPAN",
     "check_below_nyquist",
@@ -417,17 +418,20 @@ def wrapped_finding(
     robot: Robot | None = None,
     log: TorqueLog | None = None,
 ) -> str:
-    """The finding of the joints (0-based; ``motors``: the motors) recorded wrapped into
-    ``[-pi, pi]`` and unwrapped, without the file's name (:func:`recording_pieces` says it
-    per recording; several recordings say it once, naming them). Given the ``robot`` and
+    """The finding of the joints (0-based; ``motors``: the motors) recorded wrapped within a
+    turn and unwrapped, without the file's name (:func:`recording_pieces` says it per
+    recording; several recordings say it once, naming them); the turn is the one the
+    ``log``'s positions show (:func:`wrapped_range`: ``[0, 2 pi)`` for a vendor's 0 to 360
+    degrees; ``[-pi, pi]`` without a log). Given the ``robot`` and
     the joint-side ``log`` as recorded, a joint whose limits span less than a turn
     (:func:`turn_limited`) and whose motion, unwrapped, no whole turns put within them
     (:func:`_within_limits`: limits across ``pi`` let a joint cross it) is named with the
     times [s] of its jumps and its limits, which do not allow that motion: the log or the
     description is wrong (not degrees)."""
     what = "motor(s)" if motors else "joint(s)"
+    within = "[-pi, pi]" if log is None else wrapped_range(log.q[:, list(joints)])
     said = (
-        f"{what} {', '.join(str(j + 1) for j in joints)} recorded wrapped into [-pi, pi] "
+        f"{what} {', '.join(str(j + 1) for j in joints)} recorded wrapped into {within} "
         "(jumps of a whole turn): unwrapped"
     )
     if robot is None or log is None or motors:
@@ -445,6 +449,22 @@ def wrapped_finding(
             "(not degrees: those would be 57 times the radians)"
         )
     return said
+
+
+#: Slack [rad] of a recorded range against the turn it is said to be wrapped into.
+_RANGE_SLACK = 0.05
+
+
+def wrapped_range(q: NDArray[np.float64]) -> str:
+    """The turn positions ``q`` (N, k) [rad] recorded wrapped lie in, as a message says it:
+    ``[-pi, pi]``, ``[0, 2 pi)`` (a vendor's 0 to 360 degrees), else their least and
+    greatest values (``[-0.2, 6.1]``)."""
+    lo, hi = float(np.min(q)), float(np.max(q))
+    if lo >= -np.pi - _RANGE_SLACK and hi <= np.pi + _RANGE_SLACK:
+        return "[-pi, pi]"
+    if lo >= -_RANGE_SLACK and hi <= 2 * np.pi + _RANGE_SLACK:
+        return "[0, 2 pi)"
+    return f"[{lo:.3g}, {hi:.3g}]"
 
 
 #: Slack [rad] of a joint's unwrapped motion against its limits (:func:`_within_limits`).

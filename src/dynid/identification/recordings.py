@@ -449,7 +449,7 @@ class Recordings(TorqueRoute):
             notes += (
                 ("motor(s) " if motors else "joint(s) ")
                 + ", ".join(str(j + 1) for j in self.unwrapped)
-                + " recorded wrapped into [-pi, pi]: unwrapped",
+                + " recorded wrapped (jumps of a whole turn): unwrapped",
             )
         return IdentificationInfo(
             reference="Gaz et al. 2019, Sec. IV-B, eq. 24 (classical friction)",

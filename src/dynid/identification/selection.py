@@ -59,7 +59,7 @@ from typing import Any, Literal, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import DataError, DynidWarning, OptionError
+from ..exceptions import DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..progress import stage
@@ -82,6 +82,7 @@ from .candidates import (
 )
 from .core import model_advice, model_columns, shared_bases
 from .dissipation import (
+    ReversedSignError,
     Violation,
     friction_columns,
     friction_violations,
@@ -1525,7 +1526,7 @@ def _fitted_structure(
         judged |= sign_confirmed(robot, logs)
         unseen = [v for v in pushing if not judged[v.joint]]
         coupled = frozenset(() if data.drive is None else data.drive.coupled)
-        if found := reversed_sign_finding(unseen, robot.joint_names, selection.chosen, coupled):
-            raise DataError(found)
+        if reversed_sign_finding(unseen, robot.joint_names, selection.chosen, coupled):
+            raise ReversedSignError(unseen, robot.joint_names, selection.chosen, coupled)
     chosen = Structure() if selection is None else selection.chosen
     return chosen if friction is None else Structure(chosen.armature, friction, at=chosen.at)

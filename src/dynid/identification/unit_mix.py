@@ -32,13 +32,16 @@ degrees the hint is ``--units q=deg,dq=deg/s``; when every joint with limits doe
 continuous ones do not tell (slow), it is still that first, the conversion of the joints
 named second: a file is written in one unit.
 
-:func:`unit_findings` checks a file's time unit and its degrees in one pass (the
-positions judged on the time column read in its unit): a log in ms and degrees is told
-``--units t=ms,q=deg`` at once, not one unit a run.
+:func:`unit_findings` checks a file's time unit, its degrees and its velocity columns'
+unit against its positions' (:mod:`~dynid.identification.velocity_scale`: ``dq=deg/s``
+forgotten beside ``q=deg``) in one pass (the positions judged on the time column read in
+its unit): a log in ms and degrees is told ``--units t=ms,q=deg`` at once, not one unit a
+run, written into the ``--units`` given.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
@@ -48,6 +51,7 @@ from ..model.drive import Drive
 from ..model.robot import Robot
 from .angle_time_units import (
     RATE_AGREES,
+    GivenUnits,
     joined_unit_findings,
     joint_rate_factor,
     rate_verdict,
@@ -55,6 +59,7 @@ from .angle_time_units import (
     time_unit_said,
 )
 from .log import TorqueLog, joint_side_log
+from .velocity_scale import velocity_scale_finding
 
 __all__ = [
     "DEGREE_TOLERANCE",
@@ -284,9 +289,13 @@ def unit_findings(
     time: tuple[str, float] | None = None,
     time_said: str | None = None,
     side: TorqueLog | None = None,
+    given: GivenUnits | None = None,
 ) -> str | None:
     """Every unit finding of one log as read, in one line with one ``--units`` hint
-    (:func:`~dynid.identification.angle_time_units.joined_unit_findings`), or None.
+    (:func:`~dynid.identification.angle_time_units.joined_unit_findings`), or None: the
+    time column's unit, joints in degrees, and velocity columns in another angle unit than
+    the positions (:func:`~dynid.identification.velocity_scale.velocity_scale_finding`, on
+    the joints not found in degrees).
 
     Parameters
     ----------
@@ -303,19 +312,26 @@ def unit_findings(
         for in the velocities (:func:`~dynid.identification.angle_time_units.time_unit`).
     side : TorqueLog, optional
         ``log`` on the joint side, when mapped already (default: mapped through ``drive``).
+    given : GivenUnits, optional
+        The ``--units`` the log was read with: the time unit judged against the one given,
+        the hint written into them.
     """
     found = []
-    if time is None and (time := time_unit(log)) is not None:
-        time_said = time_unit_said(log)
+    given = given or GivenUnits()
+    if time is None and (time := time_unit(log, given.factor("t"))) is not None:
+        time_said = time_unit_said(log, given.factor("t"))
     mapped = drive is not None and drive.n == log.n
     if side is None:
         side = joint_side_log(log, drive) if mapped else log
     if time is not None and time_said is not None:
         found.append(time_said)  # the velocities were per second: the time column alone
-        log = TorqueLog(log.t * time[1], log.q, log.dq, log.tau, log.ddq)
-        side = TorqueLog(side.t * time[1], side.q, side.dq, side.tau, side.ddq)
+        scale = time[1] / given.factor("t")
+        log = dataclasses.replace(log, t=log.t * scale)
+        side = dataclasses.replace(side, t=side.t * scale)
     motor = mapped and drive is not None and drive.side == "motor"
     joints, said = joints_in_degrees(robot, side, LIMIT_MARGIN, log if motor else None)
     if joints:
         found.append(said)
-    return joined_unit_findings(found) if found else None
+    if (scaled := velocity_scale_finding(robot, side, given, joints)) is not None:
+        found.append(scaled)
+    return joined_unit_findings(found, given.text) if found else None

@@ -7,6 +7,11 @@ per joint numbered ``1..n`` (``{i}``) or ``0..n-1`` (``{i0}``), is offered as th
 reads it (``--columns 'tau=effort{i}'``), never read by itself: a JointState's ``effort``
 is whatever its driver puts there, a joint torque on one arm and a motor current on
 another, and a wrong column silently read is a wrong answer.
+
+The joint's number may stand inside the name, a word for the joint before it and the
+signal's after (a vendor API's ``joint_0_position_deg``: ``joint_{i0}_position_deg``), and
+a unit may end it (``_deg``, ``_degps``, ``_Nm``, ``_A``, ``_mNm``): the units other than
+SI are offered with the map (``--units 'q=deg,dq=deg/s'``, :data:`UNIT_WORDS`).
 """
 
 from __future__ import annotations
@@ -18,6 +23,8 @@ __all__ = [
     "ALIASES",
     "CURRENT_ALIASES",
     "COMMANDED_WORDS",
+    "JOINT_WORDS",
+    "UNIT_WORDS",
     "column_hint",
     "commanded_torques",
     "guessed_map",
@@ -75,22 +82,44 @@ COMMANDED_WORDS = (
 )
 #: How many unused columns a message names (families count as one).
 SHOWN = 6
+#: Words naming the joint before its number inside a column's name (``joint_0_position``),
+#: left out before the names are compared with :data:`ALIASES`.
+JOINT_WORDS = ("joint", "jnt", "j", "axis", "actuator")
+#: A unit ending a column's name (lower case, without separators), by signal: its
+#: ``--units`` entry (``None``: SI, nothing to say). A unit of another signal than the one
+#: the name reads as is left alone.
+UNIT_WORDS: dict[str, dict[str, str | None]] = {
+    "q": {"deg": "deg", "degrees": "deg", "rad": None},
+    "dq": {
+        "degps": "deg/s",
+        "degs": "deg/s",
+        "degpersec": "deg/s",
+        "dps": "deg/s",
+        "radps": None,
+        "rads": None,
+    },
+    "tau": {"nm": None, "mnm": "mNm", "a": "A", "ma": "mA", "amp": "A"},
+}
+_ALL_UNITS = frozenset(w for d in UNIT_WORDS.values() for w in d)
+#: A column name with the joint's number in it: what comes before, the number, the rest.
+_NUMBERED = re.compile(r"(.*?\D)?(\d+)(\D.*)?")
 
 
 def joint_families(names: Sequence[str], n: int) -> dict[str, list[str]]:
     """The families of one column per joint in ``names``: ``--columns`` template ->
     its columns in joint order (``effort{i}`` -> ``effort1..effortn``, ``effort_{i0}`` ->
     ``effort_0..effort_{n-1}``); only families of exactly ``n`` columns."""
-    found: dict[str, dict[int, str]] = {}
+    found: dict[tuple[str, str], dict[int, str]] = {}
     for c in names:
-        m = re.fullmatch(r"(.*?\D)?(\d+)", c)
+        m = _NUMBERED.fullmatch(c)
         if m is not None:
-            found.setdefault(m.group(1) or "", {})[int(m.group(2))] = c
+            key = (m.group(1) or "", m.group(3) or "")
+            found.setdefault(key, {})[int(m.group(2))] = c
     out = {}
-    for prefix, cols in found.items():
+    for (prefix, suffix), cols in found.items():
         for first, field in ((1, "{i}"), (0, "{i0}")):
             if sorted(cols) == list(range(first, first + n)):
-                out[prefix + field] = [cols[first + j] for j in range(n)]
+                out[prefix + field + suffix] = [cols[first + j] for j in range(n)]
     return out
 
 
@@ -143,8 +172,8 @@ def column_hint(
     current = "tau" in found and _root(found["tau"]) in CURRENT_ALIASES
     if all(s in found for s in missing):
         spec = ",".join(f"{s}={found[s]}" for s in ("q", "dq", "tau") if s in found)
-        if current:
-            spec += "' --units 'tau=A"
+        if units := unit_entries(found):
+            spec += f"' --units '{','.join(units)}"
         caveat = (
             (
                 " with a --drive whose effort is current (motor currents in A)"
@@ -264,8 +293,7 @@ def guessed_map(names: Sequence[str], given: Mapping[str, str] | None = None) ->
     units = []
     if "t" in cols and (unit := re.search(r"(ms|us|ns)$", cols["t"].lower())):
         units.append(f"t={unit[1]}")
-    if "tau" in cols and _root(cols["tau"]) in CURRENT_ALIASES:
-        units.append("tau=A")
+    units += unit_entries({k: v for k, v in cols.items() if k != "t"})
     return f"--columns '{spec}'" + (f" --units '{','.join(units)}'" if units else "")
 
 
@@ -326,20 +354,66 @@ def no_torques(names: Sequence[str], n: int, used: set[str]) -> str:
 def position_count(names: Sequence[str]) -> int:
     """The joint count of a header without ``q1..qn`` read from a family of positions by
     another name (``position_0..position_6``: 7), 0 when there is none or several."""
-    found: dict[str, set[int]] = {}
+    found: dict[tuple[str, str], set[int]] = {}
     for c in names:
-        m = re.fullmatch(r"(.*?\D)?(\d+)", c)
-        if m is not None and _root((m.group(1) or "") + "{") in ALIASES["q"]:
-            found.setdefault(m.group(1) or "", set()).add(int(m.group(2)))
+        m = _NUMBERED.fullmatch(c)
+        if m is None:
+            continue
+        key = (m.group(1) or "", m.group(3) or "")
+        if _root(key[0] + "{i}" + key[1]) in ALIASES["q"]:
+            found.setdefault(key, set()).add(int(m.group(2)))
     counts = {len(k) for k in found.values() if k in ({*range(len(k))}, {*range(1, len(k) + 1)})}
     return counts.pop() if len(counts) == 1 else 0
 
 
+def _name_unit(template: str) -> tuple[str, str]:
+    """A family's name without its joint field (before it: a word for the joint left out,
+    :data:`JOINT_WORDS`, when a name follows) and its unit's word (:data:`UNIT_WORDS`, the
+    last words of the name), lower case without separators: ``joint_{i0}_position_deg``
+    -> ``("position", "deg")``, ``position_deg_{i}`` -> ``("position", "deg")``,
+    ``effort{i}`` -> ``("effort", "")``."""
+    before, _, after = template.partition("{")
+
+    def split(text: str) -> list[str]:
+        return [w for w in re.split(r"[^a-z]+", text.lower()) if w]
+
+    head, words = split(before), split(after.partition("}")[2])
+    if words and "".join(head) in JOINT_WORDS:
+        head = []
+    if not words:  # the number ends the name: its unit before it
+        head, words = [], head
+    unit = ""
+    for k in (3, 2, 1):  # deg_per_sec, deg_s, degps
+        if len(words) > k and "".join(words[-k:]) in _ALL_UNITS:
+            unit, words = "".join(words[-k:]), words[:-k]
+            break
+    return "".join(head + words), unit
+
+
+def unit_entries(found: Mapping[str, str]) -> list[str]:
+    """The ``--units`` entries the unit words ending the families ``found`` (signal ->
+    template) say, in signal order: ``["q=deg", "dq=deg/s"]`` for
+    ``joint_{i0}_position_deg`` and ``joint_{i0}_velocity_degps``; ``tau=A`` for a
+    current's family without a unit word."""
+    out = []
+    for signal in ("q", "dq", "tau"):
+        if signal not in found:
+            continue
+        name, unit = _name_unit(found[signal])
+        said = UNIT_WORDS[signal].get(unit)
+        if said is None and signal == "tau" and _root(found[signal]) in CURRENT_ALIASES:
+            said = "A"  # a current's family without a unit's word
+        if said is not None:
+            out.append(f"{signal}={said}")
+    return out
+
+
 def _root(template: str) -> str:
-    """A family's name without its joint field, separators and a reading's prefix
-    (:data:`READING_PREFIXES`), lower case (``Effort_{i0}`` -> ``effort``,
-    ``present_current_{i}`` -> ``current``)."""
-    root = re.sub(r"[^a-z]", "", template.split("{")[0].lower())
+    """A family's name without its joint field, separators, a word for the joint, a unit
+    (:func:`_name_unit`) and a reading's prefix (:data:`READING_PREFIXES`), lower case
+    (``Effort_{i0}`` -> ``effort``, ``present_current_{i}`` -> ``current``,
+    ``joint_{i0}_torque_Nm`` -> ``torque``)."""
+    root = _name_unit(template)[0]
     for p in READING_PREFIXES:
         if root.startswith(p) and len(root) > len(p):
             return root[len(p) :]

@@ -59,7 +59,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
-from .column_hint import guessed_map, no_torques
+from .column_hint import guessed_map, joint_families, no_torques
 from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .joint_state_csv import import_hint
@@ -83,6 +83,8 @@ __all__ = [
     "load_joint_columns",
     "load_label_column",
     "load_time_column",
+    "unread_columns",
+    "unread_note",
 ]
 
 _DEFAULT = {
@@ -703,12 +705,40 @@ class MappedLog:
     invalid_rows : str
         The first rows holding NaN or inf, which cleaning dropped, as the strict reader
         names them: ``row 55 (line 58), row 303 (line 306), ...``; empty for none.
+    unread : tuple of str
+        The file's columns (arrays) the map names for no quantity and no command reads
+        (:func:`unread_columns`: a vendor's motor currents beside its torques), said in
+        one note.
     """
 
     log: TorqueLog
     notes: tuple[str, ...] = ()
     conversions: tuple[str, ...] = ()
     invalid_rows: str = ""
+    unread: tuple[str, ...] = ()
+
+
+def unread_columns(header: Sequence[str], columns: ColumnMap) -> tuple[str, ...]:
+    """The columns of a file of header ``header`` that a torque log read through
+    ``columns`` leaves unread: named by none of its quantities' templates (``t, q, dq, tau,
+    ddq``; a quantity left out, ``dq=none``, names none), and neither contact labels nor
+    true external torques, which ``dynid observe`` reads."""
+    quantities = ("t", "q", "dq", "tau", "ddq")
+    read = _referenced(list(header), columns, quantities)
+    label = {columns.template("label")} if columns.mapped("label") else set(LABEL_COLUMNS)
+    return tuple(
+        c for c in header if c not in read and c not in label and not re.fullmatch(r"tau_ext\d*", c)
+    )
+
+
+def unread_note(unread: Sequence[str], n: int) -> str:
+    """One line naming the columns ``unread`` (a family of ``n`` joints' columns as
+    ``first..last``) of a file read through ``--columns``."""
+    families = joint_families(list(unread), n)
+    grouped = {c for cols in families.values() for c in cols}
+    shown = [f"{cols[0]}..{cols[-1]}" for cols in families.values()]
+    shown += [c for c in unread if c not in grouped]
+    return f"column(s) {', '.join(shown)} named by no --columns entry: not read"
 
 
 def load_mapped_torque_log(
@@ -758,6 +788,7 @@ def load_mapped_torque_log(
     said = conversion_notes(
         columns, [k for k in _DEFAULT if k in {**columns.factors, **columns.flips}]
     )
+    unread = unread_columns(table.header, columns)
     ok = np.isfinite(t)
     for a in (q, dq, tau, ddq):
         if a is not None:
@@ -765,9 +796,8 @@ def load_mapped_torque_log(
     invalid = "" if ok.all() else _where(np.flatnonzero(~ok), table.lines)
     try:
         if dq is not None:
-            return MappedLog(
-                TorqueLog.from_raw(t, q, dq, tau, ddq, gap_factor=gap_factor), (), said, invalid
-            )
+            log = TorqueLog.from_raw(t, q, dq, tau, ddq, gap_factor=gap_factor)
+            return MappedLog(log, (), said, invalid, unread)
         raw = TorqueLog.from_raw(t, q, np.zeros_like(q), tau, ddq, gap_factor=gap_factor)
     except DataError as exc:
         raise DataError(str(exc), file=path.name) from exc
@@ -778,7 +808,7 @@ def load_mapped_torque_log(
         log = with_derived_velocities(raw, columns.velocity_cutoff_hz)
     except DataError as exc:  # a rate too low for the cut-off: the file named
         raise DataError(str(exc), file=path.name) from exc
-    return MappedLog(log, notes, said, invalid)
+    return MappedLog(log, notes, said, invalid, unread)
 
 
 def conversion_notes(columns: ColumnMap, quantities: Sequence[str]) -> tuple[str, ...]:

@@ -53,6 +53,7 @@ from ..feasibility.payload_arm import model_structure
 from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
+from ..identification.dissipation import ReversedSignError
 from ..identification.estimators import ESTIMATORS, EstimatorName
 from ..identification.gravity_scale import (
     GRAVITY_SCALE,
@@ -114,6 +115,8 @@ from .recordings import (
     check_units,
     checked_accelerations,
     given_start,
+    given_units,
+    note_unread_columns,
     unwrapped_recorded,
     usable_recorded,
 )
@@ -477,7 +480,16 @@ def identify_files(
     )
 
     def fit() -> IdentifyResult:
-        return identify_logs(robot, logs, read, names=[p.name for p in paths], validate_on=separate)
+        try:
+            return identify_logs(
+                robot, logs, read, names=[p.name for p in paths], validate_on=separate
+            )
+        except ReversedSignError as exc:  # its hint beside the flips --units applied
+            if (applied := _applied_flips(cmap)) is None:
+                raise
+            spec = opt.columns or (None, None)
+            toml = str(spec[0] or "").lower().endswith(".toml")  # its own flips: unknown text
+            raise exc.beside(applied, None if toml else spec[1]) from None
 
     got = in_file(path, fit) if len(paths) == 1 else fit()
     result = got.consistent
@@ -485,6 +497,17 @@ def identify_files(
         result = dataclasses.replace(result, identified=_record(result.identified, opt))
     model = _record(got.model, opt)
     return IdentifyResult(model, result, tuple(paths), got.heldout, got.torque_delay, got.gravity)
+
+
+def _applied_flips(cmap: Any) -> tuple[int, ...] | None:
+    """The joints (from 0) whose torque columns the column map flips for every file
+    (``--units tau2=-1``), or None when a file's own flips or a negated unit make the
+    whole reading unknown to a hint."""
+    if cmap is None:
+        return ()
+    if cmap.file_flips or cmap.file_signs or cmap.factor("tau") < 0:
+        return None
+    return tuple(cmap.flips.get("tau", ()))
 
 
 def identify_logs(
@@ -866,8 +889,9 @@ def _read_logs(
         held.append((heldout, Path(opt.validate_on)))
     rec = Recorded((*logs, *(g for g, _ in held)), (*paths, *(p for _, p in held)), opt.drive)
     check_derived_velocities(rec, cmap)
+    note_unread_columns(rec, cmap)
     checked = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
-    check_unit_findings(checked, robot)
+    check_unit_findings(checked, robot, given_units(cmap, (opt.columns or (None, None))[1]))
     check_limits(checked, robot)
     rec, checked = usable_recorded(rec, checked, robot, opt.max_gap_s)
     check_units(checked)

@@ -145,6 +145,8 @@ from .recordings import (
     check_units,
     despiked_recordings,
     given_start,
+    given_units,
+    note_unread_columns,
     unwrapped_recorded,
     usable_recorded,
 )
@@ -550,7 +552,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     files = data_files(opts.data)
     columns = recorded_columns(recorded, *opts.columns, files)  # (names, units), said once
     cmap = column_map(*columns, drive=model.drive)
-    read = _read_logs(files, model, cmap, opts, recorded)
+    read = _read_logs(files, model, cmap, opts, recorded, columns[1])
     read, _ = despiked_recordings(
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )
@@ -750,8 +752,10 @@ def _read_logs(
     cmap: ColumnMap | None,
     opts: ObserveOptions,
     recorded: Mapping[str, str | None] | None = None,
+    units: str | None = None,
 ) -> Recorded:
-    """The logs ``paths`` read strictly for the model through ``cmap``; a log in other
+    """The logs ``paths`` read strictly for the model through ``cmap`` (of the ``--units``
+    text ``units``, for the unit findings' hint); a log in other
     units than the others, with joints in degrees, with torques of the opposite sign to the
     model's or in mN m read as N m refused (the model's ``recorded`` column map, when it
     looks wrong for a file, named first), and one far outside the joint limits warned
@@ -772,11 +776,12 @@ def _read_logs(
     logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
     read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
     checked = unwrapped_recorded(read, model.robot, opts.max_gap)  # as prepared_log reads
-    check_unit_findings(checked, model.robot)
+    check_unit_findings(checked, model.robot, given_units(cmap, units))
     check_limits(checked, model.robot)
     read, checked = usable_recorded(read, checked, model.robot, opts.max_gap)
     check_units(checked)
     check_derived_velocities(read, cmap)
+    note_unread_columns(read, cmap)
     # detection logs hold contacts; a model's recorded sign map judged first
     check_signs(
         checked, model.robot, among=opts.calibrate, recorded=recorded, units=opts.columns[1]

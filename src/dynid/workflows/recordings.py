@@ -63,8 +63,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import DataError, DynidWarning, OptionError
+from ..identification.angle_time_units import GivenUnits
 from ..identification.derivative_columns import (
     DDQ_NOISE_RATIO,
+    SCALE_OFF,
     acceleration_noise_ratio,
     velocity_finding,
 )
@@ -87,7 +89,16 @@ from ..identification.unit_mix import (
     unit_findings,
 )
 from ..identification.velocity_noise import moving_joints
-from ..io.columns import CURRENT_UNITS, LEFT_OUT, ColumnMap, parse_column_map
+from ..identification.velocity_scale import acceleration_rate_factors
+from ..io.columns import (
+    CURRENT_UNITS,
+    LEFT_OUT,
+    ColumnMap,
+    header_names,
+    parse_column_map,
+    unread_columns,
+    unread_note,
+)
 from ..io.sign_entries import tau_negated, units_negating, units_reading
 from ..io.torque_log import declared_tau_unit
 from ..model.drive import Drive
@@ -120,6 +131,8 @@ __all__ = [
     "recorded_sign_map_findings",
     "check_torque_unit",
     "check_unit_findings",
+    "given_units",
+    "note_unread_columns",
     "check_units",
     "despiked_recordings",
     "given_start",
@@ -270,11 +283,12 @@ def read_recordings(
     logs = given_start(logs, [p.name for p in paths], robot, drive, q_start, max_gap_s)
     out = Recorded(logs, tuple(paths), drive)
     checked = unwrapped_recorded(out, robot, max_gap_s)  # as the preparation reads them
-    check_unit_findings(checked, robot)  # the time unit and degrees, named first
+    check_unit_findings(checked, robot, given_units(cmap, units))  # the units, named first
     check_limits(checked, robot)
     out, checked = usable_recorded(out, checked, robot, max_gap_s)  # units known right
     check_units(checked)
     check_derived_velocities(out, cmap)
+    note_unread_columns(out, cmap)
     if sign_map:
         check_sign_map(checked, robot if reference is None else reference, mine[1], recorded)
     if signs:  # said, naming the joints: the verdict judges the log as it is
@@ -445,11 +459,16 @@ def checked_accelerations(
     (:func:`~dynid.identification.derivative_columns.acceleration_noise_ratio`) left out,
     the accelerations derived from the velocities instead, with a note naming each and the
     ratio; a note names the logs whose acceleration columns are used (exact to round-off,
-    or no noisier than that): without it nothing said a recorded ``ddq`` was read."""
+    or no noisier than that): without it nothing said a recorded ``ddq`` was read. Columns
+    off the scale of the velocities' derivative
+    (:func:`~dynid.identification.velocity_scale.acceleration_rate_factors`, beyond
+    :data:`~dynid.identification.derivative_columns.SCALE_OFF`) are kept for the unit
+    check (:func:`check_unit_findings`) to name: their noise is their unit's."""
     out, used = [], []
     for name, log in zip(names, logs, strict=True):
-        if log.ddq is None:
-            out.append(log)
+        k = acceleration_rate_factors(log)
+        if log.ddq is None or np.any(np.abs(np.log(k[np.isfinite(k)])) > np.log(SCALE_OFF)):
+            out.append(log)  # columns in another unit: the unit check names it, not noise
             continue
         ratio = acceleration_noise_ratio(log, cutoff_hz)
         worst = float(np.max(ratio)) if ratio is not None and ratio.size else 0.0
@@ -535,11 +554,38 @@ def check_derived_velocities(rec: Recorded, cmap: ColumnMap | None = None) -> No
     _log.log(NOTE, "%s: %s", which, said)
 
 
-def check_unit_findings(rec: Recorded, robot: Robot) -> None:
-    """Refuse a recording whose time column (ms, us, ns) or positions (degrees) are in
-    other units, every unit found said at once with one ``--units`` hint
-    (:func:`~dynid.identification.unit_mix.unit_findings`): a log in ms and degrees was
-    told ``--units t=ms`` and, run again, ``--units q=deg``.
+def note_unread_columns(rec: Recorded, cmap: ColumnMap | None) -> None:
+    """Say once, as a note, the columns of the recordings read through ``cmap`` that no
+    entry maps (:func:`~dynid.io.columns.unread_columns`: a vendor's motor currents beside
+    its torques), the recordings of the same ones named together; they were dropped
+    without a word."""
+    if cmap is None:
+        return
+    said: dict[str, list[str]] = {}
+    for path, log in zip(rec.paths, rec.logs, strict=True):
+        unread = unread_columns(header_names(path), cmap.for_file(path.name))
+        if unread:
+            said.setdefault(unread_note(unread, log.n), []).append(path.name)
+    for note, names in said.items():
+        which = (
+            ", ".join(names) if len(names) <= 4 else f"{len(names)} recordings ({names[0]}, ...)"
+        )
+        _log.log(NOTE, "%s: %s", which, note)
+
+
+def given_units(cmap: ColumnMap | None, text: str | None) -> GivenUnits:
+    """The units the logs were read with (``cmap``'s factors) and the ``--units`` text
+    given, for the unit findings' hint."""
+    factors = {} if cmap is None else {k: cmap.factor(k) for k in ("t", "q", "dq", "ddq")}
+    return GivenUnits(text, factors)
+
+
+def check_unit_findings(rec: Recorded, robot: Robot, given: GivenUnits | None = None) -> None:
+    """Refuse a recording whose time column (ms, us, ns), positions (degrees) or velocity
+    columns (another angle unit than the positions) are in other units than read with
+    (``given``), every unit found said at once with one ``--units`` hint, the whole
+    option to run again (:func:`~dynid.identification.unit_mix.unit_findings`): a log in
+    ms and degrees was told ``--units t=ms`` and, run again, ``--units q=deg``.
 
     A recording in degrees among recordings in radians is said first
     (:func:`check_degrees`): the file to convert, as ``--units`` applies to every file.
@@ -551,7 +597,7 @@ def check_unit_findings(rec: Recorded, robot: Robot) -> None:
     """
     check_degrees(rec, robot)
     for name, log, side in zip(rec.names, rec.logs, rec.joint_side, strict=True):
-        if (found := unit_findings(robot, log, rec.drive, side=side)) is not None:
+        if (found := unit_findings(robot, log, rec.drive, side=side, given=given)) is not None:
             raise DataError(found, file=name)
 
 
