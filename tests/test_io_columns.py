@@ -407,7 +407,9 @@ def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
     """Regression: a model read with --units alone warned "columns None, units 'q=deg'"."""
     from dynid.workflows.data_files import recorded_columns
 
-    with caplog.at_level("WARNING"):
+    from dynid.progress import NOTE
+
+    with caplog.at_level(NOTE):
         used = recorded_columns({"columns": None, "units": "q=deg"}, None, None)
         recorded_columns({"columns": None, "units": "q=deg"}, None, "tau=Nm")
     assert used == (None, "q=deg")
@@ -419,8 +421,10 @@ def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
 def test_the_recorded_sign_flips_reused_are_a_note(caplog):
     """Regression: validate and payload warned "reading the data as the model's data were
     read (--units tau2=-1,tau5=-1)", though reusing the arm's sign convention is right; it
-    is a note, while a recorded unit (mN m: a new file in SI would read 1000 x off) and a
-    map given that differs from the recorded one stay warnings."""
+    is a note, and so are named units of times and angles (a new file in other units is
+    refused by the time and degrees checks, with its hint), while a recorded torque unit
+    (mN m: a new file in SI would read 1000 x off), a factor and a map given that differs
+    from the recorded one stay warnings."""
     from dynid.progress import NOTE
     from dynid.workflows.data_files import recorded_columns
 
@@ -429,6 +433,8 @@ def test_the_recorded_sign_flips_reused_are_a_note(caplog):
         "rec2.csv:tau=-1,tau3=1": NOTE,
         "tau=mNm,tau2=-1": logging.WARNING,
         "tau=-0.001": logging.WARNING,
+        "t=us,q=deg,dq=deg/s,tau=-1": NOTE,  # a new file in other units is refused
+        "q=0.01745": logging.WARNING,  # a factor: no unit to check a file against
     }
     for units, level in cases.items():
         caplog.clear()

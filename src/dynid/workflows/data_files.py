@@ -505,8 +505,8 @@ def recorded_columns(
     given = (columns, units)
     used = tuple(g if g is not None else r for g, r in zip(given, rec, strict=True))
     if used == rec and used != given and _applies(rec, files):
-        _log.log(  # sign flips alone: the arm's own convention, reused as it should be
-            NOTE if rec[0] is None and _signs_only(str(rec[1] or "")) else logging.WARNING,
+        _log.log(  # the arm's own convention and units its checks judge: reused as it should be
+            NOTE if _checked_units(str(rec[1] or "")) else logging.WARNING,
             "reading the data as the model's data were read (%s); a file of other names or "
             "units is read with its own --columns/--units (%s)",
             _read_with(*used),
@@ -521,10 +521,29 @@ def recorded_columns(
     return used[0], used[1]
 
 
-def _signs_only(units: str) -> bool:
-    """True when a ``--units`` text holds sign flips alone (``tau2=-1,rec2.csv:tau=-1``)."""
+#: Quantities whose named units a file read wrongly with them gets refused for: times
+#: (:mod:`~dynid.identification.angle_time_units`), angles and their derivatives (the
+#: degrees and velocity-scale checks); a torque's unit or factor has no such check short
+#: of the gravity scale, so reusing one stays a warning.
+_CHECKED_QUANTITIES = ("t", "q", "dq", "ddq")
+
+
+def _checked_units(units: str) -> bool:
+    """True when a ``--units`` text holds only sign flips (``tau2=-1,rec2.csv:tau=-1``) and
+    named units of :data:`_CHECKED_QUANTITIES` (``t=us,q=deg,dq=deg/s``): a new file they
+    do not fit is refused with its own hint, so reusing them is a note (a column map of
+    other names fails on the first missing column just as plainly)."""
     entries = [e.split("=", 1) for e in units.split(",") if e.strip()]
-    return bool(entries) and all(len(e) == 2 and e[1].strip() in ("-1", "1", "+1") for e in entries)
+    if not entries or any(len(e) != 2 for e in entries):
+        return False
+    for key, value in entries:
+        quantity = key.strip().rsplit(":", 1)[-1].rstrip("0123456789")
+        v = value.strip()
+        if v in ("-1", "1", "+1"):
+            continue
+        if quantity not in _CHECKED_QUANTITIES or not v or v[0].isdigit() or v[0] in "+-.":
+            return False
+    return True
 
 
 def _reads_alike(
