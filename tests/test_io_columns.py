@@ -405,9 +405,8 @@ def test_single_joints_are_flipped_as_read_after_their_quantitys_unit(tmp_path):
 
 def test_recorded_column_map_warning_names_flags_not_python_none(caplog):
     """Regression: a model read with --units alone warned "columns None, units 'q=deg'"."""
-    from dynid.workflows.data_files import recorded_columns
-
     from dynid.progress import NOTE
+    from dynid.workflows.data_files import recorded_columns
 
     with caplog.at_level(NOTE):
         used = recorded_columns({"columns": None, "units": "q=deg"}, None, None)
