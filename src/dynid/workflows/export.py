@@ -17,7 +17,9 @@ command applies, so that the Python API behaves as the command does.
   approximated and the fit is part of the result
   (:func:`~dynid.friction.mujoco.coulomb_viscous_from_sigmoid`); ``frictionloss`` is
   MuJoCo's soft dry friction, its slope at rest set per joint
-  (:mod:`dynid.friction.mujoco_soft`).
+  (:mod:`dynid.friction.mujoco_soft`); how far ``mj_inverse``'s friction is from the
+  law's near velocity reversals is said in a warning, and ``frictionloss=False`` leaves
+  it out.
 """
 
 from __future__ import annotations
@@ -70,6 +72,10 @@ class ExportRobotOptions:
     allow_rejected : bool
         Write a ``feasible.json`` whose fit was not accepted (``"feasible": false``),
         with a warning that says why, instead of refusing it.
+    frictionloss : bool
+        MJCF: the Coulomb friction as ``frictionloss``, MuJoCo's dry friction as a
+        constraint (whose ``mj_inverse`` torque near a velocity reversal follows the
+        acceleration, said in a warning); False: left out, ``damping`` only.
 
     Raises
     ------
@@ -87,6 +93,7 @@ class ExportRobotOptions:
     all_frames: bool = False
     drive: Drive | str | Path | None = None
     allow_rejected: bool = False
+    frictionloss: bool = True
 
     def __post_init__(self) -> None:
         check_choice(self, "format", EXPORT_FORMATS)
@@ -156,6 +163,10 @@ def export_robot(
     fmt = export_format(out, opt.format)
     if opt.urdf_template is not None and not ROBOT_FORMATS[fmt].template:
         raise OptionError(f"applies to the urdf format only; got {fmt}", field="urdf_template")
+    if not opt.frictionloss and fmt != "mjcf":
+        raise OptionError(
+            f"(no frictionloss) applies to the mjcf format only; got {fmt}", field="frictionloss"
+        )
     base, tip = (opt.base, opt.tip) if urdf else (None, None)  # also the template's
     robot = load_robot(params, base=base, tip=tip, snap_angles=opt.snap_angles)
     linear, drive = model_terms_of(params, robot.n)
@@ -177,10 +188,11 @@ def export_robot(
         drive=drive,
         source=_friction_source(params, linear is not None and opt.friction),
         caveat=_caveat(params, rejected),
+        frictionloss=opt.frictionloss,
     )
     approx = None
     sigmoid = sigmoid_parameters(robot.friction)
-    if fmt == "mjcf" and friction is True and sigmoid is not None:
+    if fmt == "mjcf" and friction is True and sigmoid is not None and opt.frictionloss:
         approx = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
     return RobotExport(robot, fmt, written, approx)
 

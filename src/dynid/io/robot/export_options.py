@@ -60,6 +60,9 @@ class ExportOptions:
     caveat : str or None
         A line every format writes at the top of the file, as a comment: why the fit
         whose parameters it holds was not accepted (:func:`with_caveat`).
+    frictionloss : bool
+        MJCF: write the dry friction as ``frictionloss`` (MuJoCo's constraint); False:
+        left out, the viscous friction only.
     """
 
     template: Path | None = None
@@ -72,6 +75,7 @@ class ExportOptions:
     beside: Mapping[str, str] = field(default_factory=dict)
     source: str | None = None
     caveat: str | None = None
+    frictionloss: bool = True
 
 
 @dataclass(frozen=True, slots=True)

@@ -56,6 +56,7 @@ Numbers use Python's shortest round-trip representation.
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -74,7 +75,7 @@ from ...friction.mujoco import (
     joint_coulomb_viscous,
     unheld_friction,
 )
-from ...friction.mujoco_soft import SoftFrictionLoss, soft_frictionloss
+from ...friction.mujoco_soft import SoftFrictionLoss, dry_friction_error, soft_frictionloss
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
@@ -173,12 +174,59 @@ def _soft(
     )
     if not smooth or np.max(soft.rms_error) < ROUND_OFF_NM:
         return soft, ()
-    j = int(np.argmax(soft.rms_error))
     return soft, (
         f"{model.kind} friction: written with its rounding fc tanh(dq / width) as the "
-        "slope at rest of MuJoCo's soft frictionloss (solreffriction, solimpfriction; RMS "
-        f"difference at the joints up to {soft.rms_error[j]:.3g} N m, at joint {j + 1} "
-        "moving alone)",
+        "slope at rest of MuJoCo's soft frictionloss (solreffriction, solimpfriction)",
+    )
+
+
+def _reversal_note(
+    model: FrictionModel | FrictionSum,
+    approx: CoulombViscous,
+    soft: SoftFrictionLoss,
+    robot: Robot,
+) -> tuple[str, ...]:
+    """The line saying how far ``mj_inverse``'s friction of the file is from the law's
+    along the representative motion (:func:`~dynid.friction.mujoco_soft.dry_friction_error`:
+    RMS, and the worst case with where it happens, at a velocity reversal) and what to do
+    where it matters; none without dry friction or below round-off."""
+    if not np.any(approx.coulomb > 0):
+        return ()
+    vmax = _velocity_range(robot)
+    err = dry_friction_error(model, approx.viscous, approx.coulomb, soft, vmax)
+    if np.max(err.worst) < ROUND_OFF_NM:
+        return ()
+    j, w = int(np.argmax(err.rms)), int(np.argmax(err.worst))
+    where = f"dq {err.worst_dq[w]:+.2g} rad/s, ddq {err.worst_ddq[w]:+.3g} rad/s^2"
+    if abs(err.worst_dq[w]) < 0.01 * vmax[w]:
+        where = f"at a velocity reversal: {where}"
+    rate, period = err.reversals_per_s, 2.0 / err.reversals_per_s
+    return (
+        "mj_inverse's friction: frictionloss is MuJoCo's dry friction as a constraint, "
+        "whose torque near a velocity reversal follows the acceleration's sign (for about "
+        f"{1e3 * err.window_s[w]:.2g} ms before it), not the velocity's; along a sine of "
+        f"each joint's velocity ({period:g} s period, {rate:g} reversals a second, at half "
+        f"its velocity limit) it differs from the law's by RMS up to {err.rms[j]:.3g} N m "
+        f"(joint {j + 1}; the RMS grows with the square root of the reversals a second) "
+        f"and at worst {err.worst[w]:.3g} N m (joint {w + 1}, {where}); where inverse "
+        "dynamics at reversals matters, export with frictionloss=False (--no-frictionloss) "
+        "and add the Coulomb friction as a force of the velocity (fc tanh(dq / width) as "
+        "qfrc_applied or a velocity-dependent actuator)",
+    )
+
+
+def _without_frictionloss(
+    approx: CoulombViscous, robot: Robot
+) -> tuple[CoulombViscous, tuple[str, ...]]:
+    """``approx`` with no dry friction (``frictionloss=False``), and the line that says
+    what was left out."""
+    if not np.any(approx.coulomb > 0):
+        return approx, ()
+    j = int(np.argmax(approx.coulomb))
+    return replace(approx, coulomb=np.zeros_like(approx.coulomb)), (
+        "dry friction left out (frictionloss=False): no frictionloss, the law's Coulomb "
+        f"friction (up to {approx.coulomb[j]:.4g} N m, at joint {j + 1}) to be added as a "
+        "force of the velocity",
     )
 
 
@@ -187,12 +235,14 @@ def _law_terms(
     robot: Robot,
     kept: str,
     armature: NDArray[np.float64] | None,
+    dry: bool = True,
 ) -> tuple[CoulombViscous, SoftFrictionLoss, tuple[str, ...], NDArray[np.bool_]]:
     """A friction model as MuJoCo holds it (the smooth laws' ``fv`` and ``fc`` as they
     are, their rounding as the dry friction's slope, :func:`_soft`), what it drops (one
     line each, ending with ``kept``: the files that hold it,
     :func:`~dynid.io.robot.export_options.kept_elsewhere`), and the joints whose offset the
-    robot's spring holds (:func:`spring_held_offsets`), which are not dropped."""
+    robot's spring holds (:func:`spring_held_offsets`), which are not dropped; ``dry``
+    False: the dry friction is not written, nor how its rounding would be."""
     vmax = _velocity_range(robot)
     jt = joint_coulomb_viscous(friction, vmax, sharp=False)
     z = np.zeros(friction.n)
@@ -200,7 +250,7 @@ def _law_terms(
     held = spring_held_offsets(robot, offset, friction.at_motors)
     approx = CoulombViscous(jt.frictionloss, jt.damping, offset, z, z)
     soft, rounding = _soft(friction, approx, robot, armature)
-    lost = rounding + jt.notes + unheld_friction(friction, vmax, held, sharp=False)
+    lost = (rounding if dry else ()) + jt.notes + unheld_friction(friction, vmax, held, sharp=False)
     if not lost:
         return approx, soft, (), held
     written, left = friction_losses(friction.kind, lost)
@@ -224,7 +274,11 @@ _Terms = tuple[
 
 
 def _joint_terms(
-    robot: Robot, friction: bool | FrictionModel | FrictionSum, drive: Drive | None, kept: str
+    robot: Robot,
+    friction: bool | FrictionModel | FrictionSum,
+    drive: Drive | None,
+    kept: str,
+    dry: bool = True,
 ) -> _Terms:
     """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
 
@@ -235,7 +289,9 @@ def _joint_terms(
     (:func:`dynid.friction.mujoco.drive_joint_terms`, :func:`_law_terms`) and the joints
     (n,) whose friction offset the spring's reference holds (:func:`spring_held_offsets`).
     ``friction=True`` is the robot's own friction: its sigmoid (``Robot.friction``) by the
-    fit of its odd part up to ``dq_max``, another law as that law maps itself.
+    fit of its odd part up to ``dq_max``, another law as that law maps itself. The notes
+    end with how far ``mj_inverse``'s friction is from the law's (:func:`_reversal_note`);
+    ``dry`` False: no ``frictionloss`` (:func:`_without_frictionloss`).
     """
     n = robot.n
     model = robot_friction(robot) if friction is True else friction or None
@@ -257,15 +313,19 @@ def _joint_terms(
         notes = jt.notes
         armature = jt.armature if d.rotor_inertia is not None else None
     sigmoid = sigmoid_parameters(model) if friction is True else None
-    if model is not None and sigmoid is not None:  # the description's sigmoid
-        fit = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
-        soft, _ = _soft(model, fit, robot, armature)
-        held = spring_held_offsets(robot, fit.offset, model.at_motors)
-        return fit, soft, armature, notes, held
     if model is None:
         return None, None, armature, notes, np.zeros(n, dtype=bool)
-    approx, soft, more, held = _law_terms(model, robot, kept, armature)
-    return approx, soft, armature, notes + more, held
+    if sigmoid is not None:  # the description's sigmoid
+        approx = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
+        soft, _ = _soft(model, approx, robot, armature)
+        held = spring_held_offsets(robot, approx.offset, model.at_motors)
+    else:
+        approx, soft, more, held = _law_terms(model, robot, kept, armature, dry)
+        notes += more
+    if not dry:
+        approx, left = _without_frictionloss(approx, robot)
+        return approx, soft, armature, notes + left, held
+    return approx, soft, armature, notes + _reversal_note(model, approx, soft, robot), held
 
 
 def _comment(
@@ -279,6 +339,8 @@ def _comment(
     text = f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
     if approx is None:
         text += "; frictionless joints"
+    elif not np.any(approx.coulomb > 0):
+        text += "; friction: viscous as damping"
     else:
         text += (
             "; friction: Coulomb as frictionloss (MuJoCo's soft dry friction, its slope at "
@@ -385,6 +447,7 @@ def mjcf_from_robot(
     comment: str | None = None,
     drive: Drive | None = None,
     kept: str = "",
+    frictionloss: bool = True,
 ) -> tuple[str, CoulombViscous | None]:
     """The MJCF document of a robot, and the friction approximation it holds.
 
@@ -407,6 +470,10 @@ def mjcf_from_robot(
     kept : str
         The files that hold the friction exactly, said after what MJCF drops of it
         (:func:`~dynid.io.robot.export_options.kept_elsewhere`); empty: none named.
+    frictionloss : bool
+        Write the dry friction as ``frictionloss`` (MuJoCo's constraint; the warning says
+        how far ``mj_inverse``'s friction is from the law's at velocity reversals); False:
+        ``damping`` only, the Coulomb friction left out and said so.
 
     Returns
     -------
@@ -420,7 +487,7 @@ def mjcf_from_robot(
     ModelError
         A link other than the base is named ``world`` (MuJoCo's world body).
     """
-    approx, soft, armature, notes, held = _joint_terms(robot, friction, drive, kept)
+    approx, soft, armature, notes, held = _joint_terms(robot, friction, drive, kept, frictionloss)
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     text = comment or _comment(robot, friction, approx, armature, notes)
@@ -449,11 +516,14 @@ def save_mjcf(
     drive: Drive | None = None,
     kept: str = "",
     caveat: str | None = None,
+    frictionloss: bool = True,
 ) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path. ``caveat``: a comment
     at the top, why the fit was not accepted."""
     path = Path(path)
-    text, _ = mjcf_from_robot(robot, friction=friction, drive=drive, kept=kept)
+    text, _ = mjcf_from_robot(
+        robot, friction=friction, drive=drive, kept=kept, frictionloss=frictionloss
+    )
     write_text(path, with_caveat(text, caveat, xml=True))
     return path
 
@@ -471,4 +541,5 @@ def export_mjcf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         drive=options.drive,
         kept=kept,
         caveat=options.caveat,
+        frictionloss=options.frictionloss,
     )
