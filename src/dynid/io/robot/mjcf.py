@@ -198,21 +198,28 @@ def _reversal_note(
         return ()
     j, w = int(np.argmax(err.rms)), int(np.argmax(err.worst))
     where = f"dq {err.worst_dq[w]:+.2g} rad/s, ddq {err.worst_ddq[w]:+.3g} rad/s^2"
-    if abs(err.worst_dq[w]) < 0.01 * vmax[w]:
-        where = f"at a velocity reversal: {where}"
+    reversal = abs(err.worst_dq[w]) < 0.01 * vmax[w]
+    if reversal:
+        where = (
+            f"at a velocity reversal, where for about {1e3 * err.window_s[w]:.2g} ms before "
+            f"it the constraint's torque follows the acceleration's sign: {where}"
+        )
     rate, period = err.reversals_per_s, 2.0 / err.reversals_per_s
-    return (
-        "mj_inverse's friction: frictionloss is MuJoCo's dry friction as a constraint, "
-        "whose torque near a velocity reversal follows the acceleration's sign (for about "
-        f"{1e3 * err.window_s[w]:.2g} ms before it), not the velocity's; along a sine of "
-        f"each joint's velocity ({period:g} s period, {rate:g} reversals a second, at half "
-        f"its velocity limit) it differs from the law's by RMS up to {err.rms[j]:.3g} N m "
-        f"(joint {j + 1}; the RMS grows with the square root of the reversals a second) "
-        f"and at worst {err.worst[w]:.3g} N m (joint {w + 1}, {where}); where inverse "
-        "dynamics at reversals matters, export with frictionloss=False (--no-frictionloss) "
-        "and add the Coulomb friction as a force of the velocity (fc tanh(dq / width) as "
-        "qfrc_applied or a velocity-dependent actuator)",
+    said = (
+        "mj_inverse's friction (frictionloss is MuJoCo's dry friction as a constraint): "
+        f"along a sine of each joint's velocity ({period:g} s period, {rate:g} reversals a "
+        f"second, at half its velocity limit) it differs from the law's by RMS up to "
+        f"{err.rms[j]:.3g} N m (joint {j + 1}) and at worst {err.worst[w]:.3g} N m (joint "
+        f"{w + 1}, {where})"
     )
+    if reversal:
+        said += (
+            "; the RMS grows with the square root of the reversals a second; where inverse "
+            "dynamics at reversals matters, export with frictionloss=False (--no-frictionloss)"
+            " and add the Coulomb friction as a force of the velocity (fc tanh(dq / width) "
+            "as qfrc_applied or a velocity-dependent actuator)"
+        )
+    return (said,)
 
 
 def _without_frictionloss(
