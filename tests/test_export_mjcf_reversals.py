@@ -20,6 +20,8 @@ from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning
 from dynid.friction.laws import law_named
 from dynid.friction.mujoco_soft import SoftFrictionLoss, frictionloss_slope, mujoco_dry_friction
+from dynid.io.excitation import load_trajectory
+from dynid.io.robot.export_options import Along
 from dynid.io.robot.mjcf import mjcf_from_robot
 
 from conftest import mujoco_inverse
@@ -124,3 +126,59 @@ def test_no_frictionloss_is_an_mjcf_option(tmp_path, capsys):
     urdf = tmp_path / "p.urdf"
     assert main(["export", "--params", "panda", "--out", str(urdf), "--no-frictionloss"]) == 2
     assert "--no-frictionloss applies to an MJCF export only" in capsys.readouterr().err
+
+
+def _trajectory_csv(path, robot):
+    """A 200 Hz trajectory.csv of two sines per joint's velocity (reversals at several
+    accelerations), and its positions, velocities and accelerations (N, n)."""
+    t = np.arange(0.0, 12.0, 0.005)[:, None]
+    phase = np.linspace(0.3, 2.0, 7)
+    dq = 0.4 * np.sin(1.3 * t + phase) + 0.25 * np.sin(3.1 * t + 2 * phase)
+    ddq = 0.52 * np.cos(1.3 * t + phase) + 0.775 * np.cos(3.1 * t + 2 * phase)
+    q = np.broadcast_to(0.5 * (robot.q_min + robot.q_max), dq.shape)
+    cols = ["t"] + [f"{p}{i}" for p in ("q", "dq", "ddq") for i in range(1, 8)]
+    rows = np.column_stack([t, q, dq, ddq])
+    np.savetxt(path, rows, delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
+    return t[:, 0], q.copy(), dq, ddq
+
+
+def test_along_a_trajectory_the_figures_are_mujocos_there(tmp_path):
+    """Along a trajectory file (trajectory.csv, 200 Hz): the RMS and worst case said are
+    mj_inverse's of the exported file at its samples (within 3 %), and the reversals a
+    second are counted on them."""
+    robot = dynid.panda()
+    path = tmp_path / "trajectory.csv"
+    t, q, dq, ddq = _trajectory_csv(path, robot)
+    law = law_named("smooth").model(np.column_stack([FV, FC, 0 * FV]), np.full(7, WIDTH))
+    along = Along(path.name, load_trajectory(path, 7))
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        text, _ = mjcf_from_robot(robot, friction=law, along=along)
+    lines = [str(w.message) for w in got if issubclass(w.category, DynidWarning)]
+    said = re.search(
+        r"along trajectory.csv \(2400 samples\) it differs from the law's by RMS up to "
+        r"([0-9.e+-]+) N m \(joint (\d)\) and at worst ([0-9.e+-]+) N m \(joint (\d), at a "
+        r"velocity reversal",
+        lines[0],
+    )
+    assert said is not None, lines
+    model = mujoco.MjModel.from_xml_string(text)
+    err = _friction(model, q, dq, ddq) - (FV * dq + FC * np.tanh(dq / WIDTH))
+    rms, worst = np.sqrt(np.mean(err**2, axis=0)), np.max(np.abs(err), axis=0)
+    j, w = int(said[2]) - 1, int(said[4]) - 1
+    assert j == int(np.argmax(rms)) and w == int(np.argmax(worst))
+    np.testing.assert_allclose(float(said[1]), rms[j], rtol=0.03)
+    np.testing.assert_allclose(float(said[3]), worst[w], rtol=0.03)
+    flips = np.max(np.sum(dq[1:] * dq[:-1] < 0, axis=0)) / (t[-1] - t[0])
+    assert f"reversals a second ({flips:.2g} here)" in lines[0]
+
+
+def test_trajectory_is_an_mjcf_option(tmp_path, capsys):
+    """`dynid export --trajectory FILE` names the file in the warning; refused for a URDF."""
+    path = tmp_path / "trajectory.csv"
+    _trajectory_csv(path, dynid.panda())
+    argv = ["export", "--params", "panda", "--trajectory", str(path)]
+    assert main([*argv, "--out", str(tmp_path / "p.xml")]) == 0
+    assert "mj_inverse's friction (frictionloss is " in capsys.readouterr().err
+    assert main([*argv, "--out", str(tmp_path / "p.urdf")]) == 2
+    assert "--trajectory applies to an MJCF export only" in capsys.readouterr().err

@@ -32,19 +32,20 @@ solimpfriction set its slope at rest, a smooth law's fc tanh(dq / width) as the 
 ramp (fv and fc written as identified), a sharp law as the steepest. Near a velocity
 reversal the constraint's torque in mj_inverse follows the acceleration's sign (for about 2
 ms before it): a warning says how far mj_inverse's friction is from the law's along a sine
-of each joint (RMS, and the worst case and where); --no-frictionloss leaves frictionloss
-out (damping only), for inverse dynamics that adds the Coulomb friction itself. A drive
-(feasible.json's, a robot TOML's [drive] table, or --drive) adds its rotor inertias as
-armature and reflects friction at the motors to the joints; what MJCF cannot hold (a
-coupled rotor's off-diagonal inertia) is named in a warning. TOML keeps the drive as a
-[drive] table and the identified friction as a [friction] table (exactly, as feasible.json
-does). URDF holds per joint damping and sharp Coulomb friction (<dynamics>); MJCF and URDF
-name in one warning what they cannot hold of the friction (URDF: a smooth law's rounding; a
-standstill band, the offsets, a Stribeck peak, a quadratic term, an asymmetry, friction at
-the motors, a coupled drive's off-diagonal terms: its motors' Coulomb friction, which
-follows the motors' velocities, is left out up to the N m named at each joint it acts on)
-and of the drive (MJCF: a coupled rotor's off-diagonal inertia); URDF names the rotor
-inertias it drops, by joint, in a warning of its own.
+of each joint (--trajectory: along yours; RMS, and the worst case and where);
+--no-frictionloss leaves frictionloss out (damping only), for inverse dynamics that adds
+the Coulomb friction itself. A drive (feasible.json's, a robot TOML's [drive] table, or
+--drive) adds its rotor inertias as armature and reflects friction at the motors to the
+joints; what MJCF cannot hold (a coupled rotor's off-diagonal inertia) is named in a
+warning. TOML keeps the drive as a [drive] table and the identified friction as a
+[friction] table (exactly, as feasible.json does). URDF holds per joint damping and sharp
+Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they cannot hold of
+the friction (URDF: a smooth law's rounding; a standstill band, the offsets, a Stribeck
+peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
+off-diagonal terms: its motors' Coulomb friction, which follows the motors' velocities, is
+left out up to the N m named at each joint it acts on) and of the drive (MJCF: a coupled
+rotor's off-diagonal inertia); URDF names the rotor inertias it drops, by joint, in a
+warning of its own.
 
 A feasible.json of a fit that was not accepted ("feasible": false: its held-out error too
 far above least squares', or a constraint that does not hold) is refused with the reason
@@ -102,7 +103,7 @@ def _format(args: argparse.Namespace) -> str | None:
 APPLIES = (
     Applies(("merged",), lambda a: a.urdf_template is not None, "--urdf-template"),
     Applies(("all_frames",), _urdf_chain_export, "a URDF export without --urdf-template"),
-    Applies(("no_frictionloss",), lambda a: _format(a) == "mjcf", "an MJCF export"),
+    Applies(("no_frictionloss", "trajectory"), lambda a: _format(a) == "mjcf", "an MJCF export"),
 )
 
 
@@ -151,6 +152,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="MJCF: no frictionloss (MuJoCo's dry friction as a constraint, whose "
         "mj_inverse torque near a velocity reversal follows the acceleration): damping "
         "only, the Coulomb friction to be added as a force of the velocity",
+    )
+    p.add_argument(
+        "--trajectory",
+        default=None,
+        help="MJCF: the trajectory (trajectory.csv or .json of dynid excite) along which "
+        "the warning measures mj_inverse's friction against the law's (default: a sine of "
+        "each joint, 5 s period, at half its velocity limit)",
     )
     p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")
     p.add_argument(

@@ -187,7 +187,7 @@ def soft_frictionloss(
 #: The representative motion the MJCF export measures MuJoCo's dry friction along
 #: (:func:`representative_motion`): each joint's velocity a sine of this period [s], two
 #: reversals per period (0.4 a second; ``dynid excite``'s trajectories reverse each joint
-#: 0.1 to 0.4 times a second), sampled every :data:`MOTION_STEP_S` [s], finer than the
+#: up to about 0.4 times a second), sampled every :data:`MOTION_STEP_S` [s], finer than the
 #: time the constraint takes the acceleration's sign at a reversal (``d tau_c / 2``).
 MOTION_PERIOD_S = 5.0
 MOTION_STEP_S = 1e-4
@@ -209,8 +209,6 @@ class DryFrictionError:
         ``d tau_c / 2`` [s]: how long before each velocity reversal the constraint's torque
         already takes the sign of the acceleration (the ramp shifted by ``-ddq d tau_c / 2``
         in velocity, the velocity changing at ``ddq``).
-    reversals_per_s : float
-        The motion's velocity reversals per second, per joint.
     """
 
     rms: NDArray[np.float64]
@@ -218,7 +216,6 @@ class DryFrictionError:
     worst_dq: NDArray[np.float64]
     worst_ddq: NDArray[np.float64]
     window_s: NDArray[np.float64]
-    reversals_per_s: float
 
 
 def representative_motion(
@@ -258,16 +255,15 @@ def dry_friction_error(
     damping: ArrayLike,
     frictionloss: ArrayLike,
     soft: SoftFrictionLoss,
-    dq_max: ArrayLike,
-    period: float = MOTION_PERIOD_S,
-    step: float = MOTION_STEP_S,
+    dq: ArrayLike,
+    ddq: ArrayLike,
 ) -> DryFrictionError:
     """How far the friction MuJoCo's joints hold (``damping`` [N m s/rad] and
     ``frictionloss`` [N m] (n,) with ``soft``'s slopes, :func:`mujoco_dry_friction`) is
-    from the odd part of the law ``friction`` along :func:`representative_motion`, as
-    ``mj_inverse`` of the file gives it: the joints' friction constraint rows are each
-    joint's own, so the joints moving together is each moving alone."""
-    dq, ddq = representative_motion(dq_max, period, step)
+    from the odd part of the law ``friction`` at the velocities ``dq`` [rad/s] and
+    accelerations ``ddq`` [rad/s^2] (N, n) of a motion (:func:`representative_motion`, a
+    trajectory), as ``mj_inverse`` of the file gives it there."""
+    dq, ddq = np.asarray(dq, dtype=np.float64), np.asarray(ddq, dtype=np.float64)
     odd = 0.5 * (friction.torques(dq) - friction.torques(-dq))
     err = mujoco_dry_friction(dq, ddq, frictionloss, soft) + np.asarray(damping) * dq - odd
     k = np.argmax(np.abs(err), axis=0)
@@ -278,5 +274,4 @@ def dry_friction_error(
         worst_dq=dq[k, cols],
         worst_ddq=ddq[k, cols],
         window_s=0.5 * soft.impedance * soft.timeconst,
-        reversals_per_s=2.0 / period,
     )

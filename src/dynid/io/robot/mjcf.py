@@ -75,12 +75,19 @@ from ...friction.mujoco import (
     joint_coulomb_viscous,
     unheld_friction,
 )
-from ...friction.mujoco_soft import SoftFrictionLoss, dry_friction_error, soft_frictionloss
+from ...friction.mujoco_soft import (
+    MOTION_PERIOD_S,
+    SoftFrictionLoss,
+    dry_friction_error,
+    representative_motion,
+    soft_frictionloss,
+)
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
 from .export_options import (
+    Along,
     ExportOptions,
     friction_losses,
     kept_elsewhere,
@@ -180,44 +187,64 @@ def _soft(
     )
 
 
+def _motion(robot: Robot, along: Along | None) -> tuple[NDArray, NDArray, str, str]:
+    """The velocities and accelerations (N, n) the friction is measured along, how the
+    warning names them, and the reversals a second it says the RMS grows with."""
+    if along is None:
+        dq, ddq = representative_motion(_velocity_range(robot))
+        rate = 2.0 / MOTION_PERIOD_S
+        said = (
+            f"along a sine of each joint's velocity ({MOTION_PERIOD_S:g} s period, {rate:g} "
+            "reversals a second, at half its velocity limit)"
+        )
+        return dq, ddq, said, f"{rate:g}"
+    tr = along.trajectory
+    if tr.dq.shape[1] != robot.n:
+        raise ShapeError(f"{along.name} has {tr.dq.shape[1]} joints; robot has {robot.n}")
+    span = float(tr.t[-1] - tr.t[0]) if tr.t.size > 1 else 0.0
+    flips = np.sum(tr.dq[1:] * tr.dq[:-1] < 0, axis=0)
+    per_s = f"{np.max(flips) / span:.2g}" if span > 0 else "its"
+    return tr.dq, tr.ddq, f"along {along.name} ({tr.t.size} samples)", per_s
+
+
 def _reversal_note(
     model: FrictionModel | FrictionSum,
     approx: CoulombViscous,
     soft: SoftFrictionLoss,
     robot: Robot,
+    along: Along | None,
 ) -> tuple[str, ...]:
     """The line saying how far ``mj_inverse``'s friction of the file is from the law's
-    along the representative motion (:func:`~dynid.friction.mujoco_soft.dry_friction_error`:
-    RMS, and the worst case with where it happens, at a velocity reversal) and what to do
-    where it matters; none without dry friction or below round-off."""
+    along ``along`` (None: the representative sine,
+    :func:`~dynid.friction.mujoco_soft.representative_motion`; RMS, and the worst case with
+    where it happens, at a velocity reversal:
+    :func:`~dynid.friction.mujoco_soft.dry_friction_error`) and what to do where it
+    matters; none without dry friction or below round-off."""
     if not np.any(approx.coulomb > 0):
         return ()
-    vmax = _velocity_range(robot)
-    err = dry_friction_error(model, approx.viscous, approx.coulomb, soft, vmax)
+    dq, ddq, motion, rate = _motion(robot, along)
+    err = dry_friction_error(model, approx.viscous, approx.coulomb, soft, dq, ddq)
     if np.max(err.worst) < ROUND_OFF_NM:
         return ()
     j, w = int(np.argmax(err.rms)), int(np.argmax(err.worst))
     where = f"dq {err.worst_dq[w]:+.2g} rad/s, ddq {err.worst_ddq[w]:+.3g} rad/s^2"
-    reversal = abs(err.worst_dq[w]) < 0.01 * vmax[w]
+    reversal = abs(err.worst_dq[w]) < 0.01 * _velocity_range(robot)[w]
     if reversal:
         where = (
             f"at a velocity reversal, where for about {1e3 * err.window_s[w]:.2g} ms before "
             f"it the constraint's torque follows the acceleration's sign: {where}"
         )
-    rate, period = err.reversals_per_s, 2.0 / err.reversals_per_s
     said = (
         "mj_inverse's friction (frictionloss is MuJoCo's dry friction as a constraint): "
-        f"along a sine of each joint's velocity ({period:g} s period, {rate:g} reversals a "
-        f"second, at half its velocity limit) it differs from the law's by RMS up to "
-        f"{err.rms[j]:.3g} N m (joint {j + 1}) and at worst {err.worst[w]:.3g} N m (joint "
-        f"{w + 1}, {where})"
+        f"{motion} it differs from the law's by RMS up to {err.rms[j]:.3g} N m (joint "
+        f"{j + 1}) and at worst {err.worst[w]:.3g} N m (joint {w + 1}, {where})"
     )
     if reversal:
         said += (
-            "; the RMS grows with the square root of the reversals a second; where inverse "
-            "dynamics at reversals matters, export with frictionloss=False (--no-frictionloss)"
-            " and add the Coulomb friction as a force of the velocity (fc tanh(dq / width) "
-            "as qfrc_applied or a velocity-dependent actuator)"
+            f"; the RMS grows with the square root of the reversals a second ({rate} here); "
+            "where inverse dynamics at reversals matters, export with frictionloss=False "
+            "(--no-frictionloss) and add the Coulomb friction as a force of the velocity "
+            "(fc tanh(dq / width) as qfrc_applied or a velocity-dependent actuator)"
         )
     return (said,)
 
@@ -286,6 +313,7 @@ def _joint_terms(
     drive: Drive | None,
     kept: str,
     dry: bool = True,
+    along: Along | None = None,
 ) -> _Terms:
     """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
 
@@ -297,7 +325,8 @@ def _joint_terms(
     (n,) whose friction offset the spring's reference holds (:func:`spring_held_offsets`).
     ``friction=True`` is the robot's own friction: its sigmoid (``Robot.friction``) by the
     fit of its odd part up to ``dq_max``, another law as that law maps itself. The notes
-    end with how far ``mj_inverse``'s friction is from the law's (:func:`_reversal_note`);
+    end with how far ``mj_inverse``'s friction is from the law's along ``along``
+    (:func:`_reversal_note`);
     ``dry`` False: no ``frictionloss`` (:func:`_without_frictionloss`).
     """
     n = robot.n
@@ -332,7 +361,7 @@ def _joint_terms(
     if not dry:
         approx, left = _without_frictionloss(approx, robot)
         return approx, soft, armature, notes + left, held
-    return approx, soft, armature, notes + _reversal_note(model, approx, soft, robot), held
+    return approx, soft, armature, notes + _reversal_note(model, approx, soft, robot, along), held
 
 
 def _comment(
@@ -455,6 +484,7 @@ def mjcf_from_robot(
     drive: Drive | None = None,
     kept: str = "",
     frictionloss: bool = True,
+    along: Along | None = None,
 ) -> tuple[str, CoulombViscous | None]:
     """The MJCF document of a robot, and the friction approximation it holds.
 
@@ -481,6 +511,9 @@ def mjcf_from_robot(
         Write the dry friction as ``frictionloss`` (MuJoCo's constraint; the warning says
         how far ``mj_inverse``'s friction is from the law's at velocity reversals); False:
         ``damping`` only, the Coulomb friction left out and said so.
+    along : Along, optional
+        The motion the warning measures ``mj_inverse``'s friction along (default: a sine
+        of each joint, :func:`~dynid.friction.mujoco_soft.representative_motion`).
 
     Returns
     -------
@@ -494,7 +527,9 @@ def mjcf_from_robot(
     ModelError
         A link other than the base is named ``world`` (MuJoCo's world body).
     """
-    approx, soft, armature, notes, held = _joint_terms(robot, friction, drive, kept, frictionloss)
+    approx, soft, armature, notes, held = _joint_terms(
+        robot, friction, drive, kept, frictionloss, along
+    )
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     text = comment or _comment(robot, friction, approx, armature, notes)
@@ -524,12 +559,13 @@ def save_mjcf(
     kept: str = "",
     caveat: str | None = None,
     frictionloss: bool = True,
+    along: Along | None = None,
 ) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path. ``caveat``: a comment
     at the top, why the fit was not accepted."""
     path = Path(path)
     text, _ = mjcf_from_robot(
-        robot, friction=friction, drive=drive, kept=kept, frictionloss=frictionloss
+        robot, friction=friction, drive=drive, kept=kept, frictionloss=frictionloss, along=along
     )
     write_text(path, with_caveat(text, caveat, xml=True))
     return path
@@ -549,4 +585,5 @@ def export_mjcf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         kept=kept,
         caveat=options.caveat,
         frictionloss=options.frictionloss,
+        along=options.along,
     )
