@@ -25,7 +25,11 @@ without a band the steepest slope MuJoCo holds (``d = 0.9999``). The acceleratio
 shifts the ramp by ``-ddq d tau_c / 2`` in velocity (2 mrad/s per rad/s^2 at MuJoCo's
 default timestep, 0.002 s): a longer time constant would move it further, a shorter one
 (solref's direct form) would hold it closer in ``mj_inverse`` but makes the forward step
-chatter at rest.
+chatter at rest. The shift is what ``mj_inverse`` meets at a velocity reversal: for
+``d tau_c / 2`` before it the torque takes the acceleration's sign, up to ``2 f_c`` off
+the law, and the RMS over a motion grows with the square root of its reversals a second
+(:func:`mujoco_dry_friction` is that torque, :func:`dry_friction_error` its difference
+from a law along a motion, :func:`representative_motion` the sine the export says it on).
 """
 
 from __future__ import annotations

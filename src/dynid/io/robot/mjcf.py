@@ -36,7 +36,13 @@ keeping the robot's link and joint names:
   file's own inverse weights, :func:`invweight0`), a smooth law's rounding
   ``fc tanh(dq / width)`` as the closest ramp (about ``0.8 fc / width``), any other
   law's as the ramp closest to it, a sharp law's without a band as the steepest MuJoCo
-  holds. What MJCF cannot hold (the offsets, a standstill band, an
+  holds. Near a velocity reversal the constraint's torque takes the acceleration's sign
+  (for ``d timeconst / 2``, 2 ms at the steepest): how far ``mj_inverse``'s friction of
+  the file is from the law's, RMS and the worst case with where it happens, along a sine of
+  each joint or a trajectory given (:class:`~dynid.io.robot.export_options.Along`), ends
+  the warning (:func:`~dynid.friction.mujoco_soft.dry_friction_error`); with
+  ``frictionloss=False`` the joints hold ``damping`` only and the Coulomb friction left out
+  is said instead. What MJCF cannot hold (the offsets, a standstill band, an
   asymmetry, a Stribeck peak, a quadratic term, friction at the motors, coupled terms;
   :func:`dynid.friction.mujoco.unheld_friction`) is named in one warning line with the
   files that hold it, with how a smooth law's rounding was written.
