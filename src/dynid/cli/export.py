@@ -186,7 +186,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
         console.print(f"drive: {result.options.drive.describe()}")
     approx = result.mujoco_friction
     if approx is not None:
-        console.print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")
+        console.print(
+            "friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max; how "
+            "far mj_inverse's friction is from the sigmoid: the warning):"
+        )
         console.print(
             *(
                 f"  {name}: frictionloss {approx.coulomb[j]:.4g} N m, damping "
