@@ -255,10 +255,11 @@ def test_mjcf_export_names_the_offsets_it_drops():
     (text, approx), lines = _warnings(mjcf_from_robot, _arm(), friction=fr)
     assert len(lines) == 1 and lines[0].startswith("MJCF export: "), lines
     assert "offsets fo (up to -0.44 N m at joint 2)" in lines[0], lines[0]
+    assert "; mj_inverse's friction (" in lines[0]  # at the reversals: its own note
     assert "robot.toml" not in lines[0] and "feasible.json" not in lines[0]  # none written
     model = mujoco.MjModel.from_xml_string(text)
     np.testing.assert_array_equal(model.dof_damping, FV)
     np.testing.assert_array_equal(model.dof_frictionloss, FC)
     np.testing.assert_array_equal(approx.offset, FO)
     (_, _), lines = _warnings(mjcf_from_robot, _arm(), friction=ClassicalFriction(FV, FC, 0 * FV))
-    assert lines == []
+    assert len(lines) == 1 and lines[0].startswith("MJCF export: mj_inverse's friction ("), lines

@@ -55,6 +55,7 @@ FLAGS: dict[str, str] = {
     "uncertainty": "--no-uncertainty",
     "standstill": "--no-standstill-margin",
     "loads": "--no-loads",
+    "frictionloss": "--no-frictionloss",
     "total_mass_band": "--no-total-mass",
     "radii": "--radius",
     "ranges": "--range",

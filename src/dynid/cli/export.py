@@ -28,15 +28,20 @@ the friction as frictionloss + damping: the linear friction a consistent identif
 stored in feasible.json, else the sigmoid approximated (its odd part fitted over the
 velocity range); --no-friction for frictionless joints. MuJoCo's frictionloss is a soft
 constraint, a ramp of the velocity up to frictionloss: each joint's solreffriction and
-solimpfriction set its slope at rest, a smooth law's fc tanh(dq / width) as the closest ramp
-(fv and fc written as identified), a sharp law as the steepest. A drive (feasible.json's, a
-robot TOML's [drive] table, or --drive) adds its rotor inertias as armature and reflects
-friction at the motors to the joints; what MJCF cannot hold (a coupled rotor's off-diagonal
-inertia) is named in a warning. TOML keeps the drive as a [drive] table and the identified
-friction as a [friction] table (exactly, as feasible.json does). URDF holds per joint
-damping and sharp Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they
-cannot hold of the friction (URDF: a smooth law's rounding; a standstill band, the offsets,
-a Stribeck peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
+solimpfriction set its slope at rest, a smooth law's fc tanh(dq / width) as the closest
+ramp (fv and fc written as identified), a sharp law as the steepest. Near a velocity
+reversal the constraint's torque in mj_inverse follows the acceleration's sign (for about 2
+ms before it): a warning says how far mj_inverse's friction is from the law's along a sine
+of each joint (--trajectory: along yours; RMS, and the worst case and where);
+--no-frictionloss leaves frictionloss out (damping only), for inverse dynamics that adds
+the Coulomb friction itself. A drive (feasible.json's, a robot TOML's [drive] table, or
+--drive) adds its rotor inertias as armature and reflects friction at the motors to the
+joints; what MJCF cannot hold (a coupled rotor's off-diagonal inertia) is named in a
+warning. TOML keeps the drive as a [drive] table and the identified friction as a
+[friction] table (exactly, as feasible.json does). URDF holds per joint damping and sharp
+Coulomb friction (<dynamics>); MJCF and URDF name in one warning what they cannot hold of
+the friction (URDF: a smooth law's rounding; a standstill band, the offsets, a Stribeck
+peak, a quadratic term, an asymmetry, friction at the motors, a coupled drive's
 off-diagonal terms: its motors' Coulomb friction, which follows the motors' velocities, is
 left out up to the N m named at each joint it acts on) and of the drive (MJCF: a coupled
 rotor's off-diagonal inertia); URDF names the rotor inertias it drops, by joint, in a
@@ -86,10 +91,19 @@ def _urdf_chain_export(args: argparse.Namespace) -> bool:
         return True
 
 
+def _format(args: argparse.Namespace) -> str | None:
+    """The export's format, None for an unknown suffix (said by the export itself)."""
+    try:
+        return export_format(args.out, args.format)
+    except DynidError:
+        return None
+
+
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
 APPLIES = (
     Applies(("merged",), lambda a: a.urdf_template is not None, "--urdf-template"),
     Applies(("all_frames",), _urdf_chain_export, "a URDF export without --urdf-template"),
+    Applies(("no_frictionloss", "trajectory"), lambda a: _format(a) == "mjcf", "an MJCF export"),
 )
 
 
@@ -132,6 +146,20 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         action="store_true",
         help="no friction: frictionless MJCF joints; URDF without <dynamics> friction",
     )
+    p.add_argument(
+        "--no-frictionloss",
+        action="store_true",
+        help="MJCF: no frictionloss (MuJoCo's dry friction as a constraint, whose "
+        "mj_inverse torque near a velocity reversal follows the acceleration): damping "
+        "only, the Coulomb friction to be added as a force of the velocity",
+    )
+    p.add_argument(
+        "--trajectory",
+        default=None,
+        help="MJCF: the trajectory (trajectory.csv or .json of dynid excite) along which "
+        "the warning measures mj_inverse's friction against the law's (default: a sine of "
+        "each joint, 5 s period, at half its velocity limit)",
+    )
     p.add_argument("--all-frames", action="store_true", help="URDF chain: every named frame")
     p.add_argument(
         "--allow-rejected",
@@ -145,7 +173,12 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Read, write, print a summary; returns the exit code."""
-    options = options_from(args, ExportRobotOptions, friction=not args.no_friction)
+    options = options_from(
+        args,
+        ExportRobotOptions,
+        friction=not args.no_friction,
+        frictionloss=not args.no_frictionloss,
+    )
     result = export_robot(args.params, args.out, options)
     path = save_export(args.out, result)
     console.print(f"wrote {path}")
@@ -153,7 +186,10 @@ def run(args: argparse.Namespace, console: Console) -> int:
         console.print(f"drive: {result.options.drive.describe()}")
     approx = result.mujoco_friction
     if approx is not None:
-        console.print("friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max):")
+        console.print(
+            "friction as MuJoCo holds it (odd part of the sigmoid, fitted up to dq_max; how "
+            "far mj_inverse's friction is from the sigmoid: the warning):"
+        )
         console.print(
             *(
                 f"  {name}: frictionloss {approx.coulomb[j]:.4g} N m, damping "

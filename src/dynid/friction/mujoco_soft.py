@@ -25,7 +25,11 @@ without a band the steepest slope MuJoCo holds (``d = 0.9999``). The acceleratio
 shifts the ramp by ``-ddq d tau_c / 2`` in velocity (2 mrad/s per rad/s^2 at MuJoCo's
 default timestep, 0.002 s): a longer time constant would move it further, a shorter one
 (solref's direct form) would hold it closer in ``mj_inverse`` but makes the forward step
-chatter at rest.
+chatter at rest. The shift is what ``mj_inverse`` meets at a velocity reversal: for
+``d tau_c / 2`` before it the torque takes the acceleration's sign, up to ``2 f_c`` off
+the law, and the RMS over a motion grows with the square root of its reversals a second
+(:func:`mujoco_dry_friction` is that torque, :func:`dry_friction_error` its difference
+from a law along a motion, :func:`representative_motion` the sine the export says it on).
 """
 
 from __future__ import annotations
@@ -40,9 +44,15 @@ from .model import FrictionModel, FrictionSum
 __all__ = [
     "MAX_IMPEDANCE",
     "MIN_IMPEDANCE",
+    "MOTION_PERIOD_S",
+    "MOTION_STEP_S",
+    "DryFrictionError",
     "SoftFrictionLoss",
+    "dry_friction_error",
     "frictionloss_slope",
     "impedance_for_slope",
+    "mujoco_dry_friction",
+    "representative_motion",
     "soft_frictionloss",
 ]
 
@@ -176,3 +186,96 @@ def soft_frictionloss(
     tc = np.where(slow, 2.0 / ((1.0 - MIN_IMPEDANCE) * A * np.where(slow, slope, 1.0)), tc)
     d = np.where(held, impedance_for_slope(np.where(held, slope, 1.0), tc, A), 0.9)
     return SoftFrictionLoss(slope, tc, d, rms)
+
+
+#: The representative motion the MJCF export measures MuJoCo's dry friction along
+#: (:func:`representative_motion`): each joint's velocity a sine of this period [s], two
+#: reversals per period (0.4 a second; ``dynid excite``'s trajectories reverse each joint
+#: up to about 0.4 times a second), sampled every :data:`MOTION_STEP_S` [s], finer than the
+#: time the constraint takes the acceleration's sign at a reversal (``d tau_c / 2``).
+MOTION_PERIOD_S = 5.0
+MOTION_STEP_S = 1e-4
+
+
+@dataclass(frozen=True, slots=True)
+class DryFrictionError:
+    """MuJoCo's friction of the joints against the law's along a motion (n joints).
+
+    Attributes
+    ----------
+    rms : ndarray, shape (n,)
+        RMS difference [N m] over the motion, per joint.
+    worst : ndarray, shape (n,)
+        The largest difference [N m] per joint, and the velocity ``worst_dq`` [rad/s] and
+        acceleration ``worst_ddq`` [rad/s^2] of the joint where it happens.
+    worst_dq, worst_ddq : ndarray, shape (n,)
+    window_s : ndarray, shape (n,)
+        ``d tau_c / 2`` [s]: how long before each velocity reversal the constraint's torque
+        already takes the sign of the acceleration (the ramp shifted by ``-ddq d tau_c / 2``
+        in velocity, the velocity changing at ``ddq``).
+    """
+
+    rms: NDArray[np.float64]
+    worst: NDArray[np.float64]
+    worst_dq: NDArray[np.float64]
+    worst_ddq: NDArray[np.float64]
+    window_s: NDArray[np.float64]
+
+
+def representative_motion(
+    dq_max: ArrayLike, period: float = MOTION_PERIOD_S, step: float = MOTION_STEP_S
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Velocities [rad/s] and accelerations [rad/s^2] (N, n) of the motion the export
+    measures MuJoCo's friction along: every joint's velocity ``V_j sin(2 pi t / period)``,
+    ``V_j`` half its velocity limit ``dq_max`` (n,) [rad/s] (1 rad/s where none is
+    finite), over one ``period`` [s] at the instants ``(k + 1/2) step`` [s] (none exactly
+    at a reversal)."""
+    vmax = np.asarray(dq_max, dtype=np.float64)
+    amp = 0.5 * np.where(np.isfinite(vmax) & (vmax > 0), vmax, 2.0)
+    w = 2.0 * np.pi / period
+    t = (np.arange(int(round(period / step))) + 0.5) * step
+    dq = np.sin(w * t)[:, None] * amp[None, :]
+    ddq = w * np.cos(w * t)[:, None] * amp[None, :]
+    return dq, ddq
+
+
+def mujoco_dry_friction(
+    dq: ArrayLike, ddq: ArrayLike, frictionloss: ArrayLike, soft: SoftFrictionLoss
+) -> NDArray[np.float64]:
+    """MuJoCo's dry friction torque [N m] (N, n) at joint velocities ``dq`` [rad/s] and
+    accelerations ``ddq`` [rad/s^2] (N, n), as ``mj_inverse`` gives it (the forward step's
+    constraint force alike): ``clip((ddq + b dq) / R, -fc, fc)``, with ``b / R`` the
+    slope at rest ``S`` and ``b = 2 / (d tau_c)`` (module docstring), so
+    ``clip(S (dq + ddq d tau_c / 2), -fc, fc)`` for ``frictionloss`` ``fc`` (n,) [N m] and
+    the joints' settings ``soft`` (:func:`soft_frictionloss`)."""
+    v, a = np.asarray(dq, dtype=np.float64), np.asarray(ddq, dtype=np.float64)
+    fc = np.asarray(frictionloss, dtype=np.float64)
+    shift = 0.5 * soft.impedance * soft.timeconst
+    return np.asarray(np.clip(soft.slope * (v + a * shift), -fc, fc), dtype=np.float64)
+
+
+def dry_friction_error(
+    friction: FrictionModel | FrictionSum,
+    damping: ArrayLike,
+    frictionloss: ArrayLike,
+    soft: SoftFrictionLoss,
+    dq: ArrayLike,
+    ddq: ArrayLike,
+) -> DryFrictionError:
+    """How far the friction MuJoCo's joints hold (``damping`` [N m s/rad] and
+    ``frictionloss`` [N m] (n,) with ``soft``'s slopes, :func:`mujoco_dry_friction`) is
+    from the odd part of the law ``friction`` at the velocities ``dq`` [rad/s] and
+    accelerations ``ddq`` [rad/s^2] (N, n) of a motion (:func:`representative_motion`, a
+    trajectory), as ``mj_inverse`` of the file gives it there."""
+    dq, ddq = np.asarray(dq, dtype=np.float64), np.asarray(ddq, dtype=np.float64)
+    odd = 0.5 * (friction.torques(dq) - friction.torques(-dq))
+    err = mujoco_dry_friction(dq, ddq, frictionloss, soft) + np.asarray(damping) * dq - odd
+    k = np.argmax(np.abs(err), axis=0)
+    cols = np.arange(err.shape[1])
+    return DryFrictionError(
+        rms=np.sqrt(np.mean(err**2, axis=0)),
+        worst=np.abs(err[k, cols]),
+        worst_dq=dq[k, cols],
+        worst_ddq=ddq[k, cols],
+        window_s=0.5 * soft.impedance * soft.timeconst,
+    )

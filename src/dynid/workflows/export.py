@@ -17,7 +17,9 @@ command applies, so that the Python API behaves as the command does.
   approximated and the fit is part of the result
   (:func:`~dynid.friction.mujoco.coulomb_viscous_from_sigmoid`); ``frictionloss`` is
   MuJoCo's soft dry friction, its slope at rest set per joint
-  (:mod:`dynid.friction.mujoco_soft`).
+  (:mod:`dynid.friction.mujoco_soft`); how far ``mj_inverse``'s friction is from the
+  law's near velocity reversals is said in a warning, and ``frictionloss=False`` leaves
+  it out.
 """
 
 from __future__ import annotations
@@ -30,10 +32,12 @@ from typing import Any
 from ..exceptions import OptionError
 from ..friction.model import Friction, sigmoid_parameters
 from ..friction.mujoco import CoulombViscous, coulomb_viscous_from_sigmoid
+from ..friction.mujoco_soft import MOTION_STEP_S
 from ..io.drive_file import load_drive
+from ..io.excitation import load_trajectory
 from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
 from ..io.feasible import load_fit_rejection, load_unknown_scale_caveat, rejection_caveat
-from ..io.robot.export_options import ExportOptions
+from ..io.robot.export_options import Along, ExportOptions
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..io.robot_file import ROBOT_FILE_SUFFIXES, load_robot
 from ..model.builtin import BUILTIN_ROBOTS
@@ -70,6 +74,15 @@ class ExportRobotOptions:
     allow_rejected : bool
         Write a ``feasible.json`` whose fit was not accepted (``"feasible": false``),
         with a warning that says why, instead of refusing it.
+    frictionloss : bool
+        MJCF: the Coulomb friction as ``frictionloss``, MuJoCo's dry friction as a
+        constraint (whose ``mj_inverse`` torque near a velocity reversal follows the
+        acceleration, said in a warning); False: left out, ``damping`` only.
+    trajectory : str or Path, optional
+        MJCF: the trajectory (``trajectory.csv`` or ``.json`` of ``dynid excite``; a JSON
+        sampled at 10 kHz) the warning measures ``mj_inverse``'s friction along, against
+        the law's; default: a sine of each joint
+        (:func:`~dynid.friction.mujoco_soft.representative_motion`).
 
     Raises
     ------
@@ -87,6 +100,8 @@ class ExportRobotOptions:
     all_frames: bool = False
     drive: Drive | str | Path | None = None
     allow_rejected: bool = False
+    frictionloss: bool = True
+    trajectory: str | Path | None = None
 
     def __post_init__(self) -> None:
         check_choice(self, "format", EXPORT_FORMATS)
@@ -156,6 +171,12 @@ def export_robot(
     fmt = export_format(out, opt.format)
     if opt.urdf_template is not None and not ROBOT_FORMATS[fmt].template:
         raise OptionError(f"applies to the urdf format only; got {fmt}", field="urdf_template")
+    if not opt.frictionloss and fmt != "mjcf":
+        raise OptionError(
+            f"(no frictionloss) applies to the mjcf format only; got {fmt}", field="frictionloss"
+        )
+    if opt.trajectory is not None and fmt != "mjcf":
+        raise OptionError(f"applies to the mjcf format only; got {fmt}", field="trajectory")
     base, tip = (opt.base, opt.tip) if urdf else (None, None)  # also the template's
     robot = load_robot(params, base=base, tip=tip, snap_angles=opt.snap_angles)
     linear, drive = model_terms_of(params, robot.n)
@@ -177,12 +198,22 @@ def export_robot(
         drive=drive,
         source=_friction_source(params, linear is not None and opt.friction),
         caveat=_caveat(params, rejected),
+        frictionloss=opt.frictionloss,
+        along=_along(opt.trajectory, robot.n),
     )
     approx = None
     sigmoid = sigmoid_parameters(robot.friction)
-    if fmt == "mjcf" and friction is True and sigmoid is not None:
+    if fmt == "mjcf" and friction is True and sigmoid is not None and opt.frictionloss:
         approx = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
     return RobotExport(robot, fmt, written, approx)
+
+
+def _along(path: str | Path | None, n: int) -> Along | None:
+    """The trajectory file ``path`` (``n`` joints) the MJCF's friction is measured along,
+    a JSON sampled at 10 kHz; None for none."""
+    if path is None:
+        return None
+    return Along(Path(path).name, load_trajectory(path, n, fs=1.0 / MOTION_STEP_S))
 
 
 def save_export(path: str | Path, export: RobotExport) -> Path:

@@ -18,8 +18,10 @@ from pathlib import Path
 from ...friction.model import Friction, FrictionSum
 from ...model.drive import Drive
 from ...model.robot import Robot
+from ...simulation.trajectories import Trajectory
 
 __all__ = [
+    "Along",
     "ExportOptions",
     "RobotFormat",
     "friction_losses",
@@ -27,6 +29,23 @@ __all__ = [
     "with_caveat",
     "xml_comment",
 ]
+
+
+@dataclass(frozen=True, slots=True)
+class Along:
+    """A motion an MJCF export measures ``mj_inverse``'s friction along, against the law's.
+
+    Attributes
+    ----------
+    name : str
+        How the warning names it (the file's name).
+    trajectory : Trajectory
+        Its times [s], velocities [rad/s] and accelerations [rad/s^2] (the positions are
+        not used: MuJoCo's friction rows are each joint's own velocity's).
+    """
+
+    name: str
+    trajectory: Trajectory
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,6 +79,12 @@ class ExportOptions:
     caveat : str or None
         A line every format writes at the top of the file, as a comment: why the fit
         whose parameters it holds was not accepted (:func:`with_caveat`).
+    frictionloss : bool
+        MJCF: write the dry friction as ``frictionloss`` (MuJoCo's constraint); False:
+        left out, the viscous friction only.
+    along : Along or None
+        MJCF: the motion the warning measures ``mj_inverse``'s friction along; None: a
+        sine of each joint (:func:`~dynid.friction.mujoco_soft.representative_motion`).
     """
 
     template: Path | None = None
@@ -72,6 +97,8 @@ class ExportOptions:
     beside: Mapping[str, str] = field(default_factory=dict)
     source: str | None = None
     caveat: str | None = None
+    frictionloss: bool = True
+    along: Along | None = None
 
 
 @dataclass(frozen=True, slots=True)

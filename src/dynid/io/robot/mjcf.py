@@ -36,7 +36,13 @@ keeping the robot's link and joint names:
   file's own inverse weights, :func:`invweight0`), a smooth law's rounding
   ``fc tanh(dq / width)`` as the closest ramp (about ``0.8 fc / width``), any other
   law's as the ramp closest to it, a sharp law's without a band as the steepest MuJoCo
-  holds. What MJCF cannot hold (the offsets, a standstill band, an
+  holds. Near a velocity reversal the constraint's torque takes the acceleration's sign
+  (for ``d timeconst / 2``, 2 ms at the steepest): how far ``mj_inverse``'s friction of
+  the file is from the law's, RMS and the worst case with where it happens, along a sine of
+  each joint or a trajectory given (:class:`~dynid.io.robot.export_options.Along`), ends
+  the warning (:func:`~dynid.friction.mujoco_soft.dry_friction_error`); with
+  ``frictionloss=False`` the joints hold ``damping`` only and the Coulomb friction left out
+  is said instead. What MJCF cannot hold (the offsets, a standstill band, an
   asymmetry, a Stribeck peak, a quadratic term, friction at the motors, coupled terms;
   :func:`dynid.friction.mujoco.unheld_friction`) is named in one warning line with the
   files that hold it, with how a smooth law's rounding was written.
@@ -56,6 +62,7 @@ Numbers use Python's shortest round-trip representation.
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -74,12 +81,19 @@ from ...friction.mujoco import (
     joint_coulomb_viscous,
     unheld_friction,
 )
-from ...friction.mujoco_soft import SoftFrictionLoss, soft_frictionloss
+from ...friction.mujoco_soft import (
+    MOTION_PERIOD_S,
+    SoftFrictionLoss,
+    dry_friction_error,
+    representative_motion,
+    soft_frictionloss,
+)
 from ...model.drive import Drive
 from ...model.inertia import inertia6_from_matrix
 from ...model.robot import Robot
 from ..atomic import write_text
 from .export_options import (
+    Along,
     ExportOptions,
     friction_losses,
     kept_elsewhere,
@@ -173,12 +187,86 @@ def _soft(
     )
     if not smooth or np.max(soft.rms_error) < ROUND_OFF_NM:
         return soft, ()
-    j = int(np.argmax(soft.rms_error))
     return soft, (
         f"{model.kind} friction: written with its rounding fc tanh(dq / width) as the "
-        "slope at rest of MuJoCo's soft frictionloss (solreffriction, solimpfriction; RMS "
-        f"difference at the joints up to {soft.rms_error[j]:.3g} N m, at joint {j + 1} "
-        "moving alone)",
+        "slope at rest of MuJoCo's soft frictionloss (solreffriction, solimpfriction)",
+    )
+
+
+def _motion(robot: Robot, along: Along | None) -> tuple[NDArray, NDArray, str, str]:
+    """The velocities and accelerations (N, n) the friction is measured along, how the
+    warning names them, and the reversals a second it says the RMS grows with."""
+    if along is None:
+        dq, ddq = representative_motion(_velocity_range(robot))
+        rate = 2.0 / MOTION_PERIOD_S
+        said = (
+            f"along a sine of each joint's velocity ({MOTION_PERIOD_S:g} s period, {rate:g} "
+            "reversals a second, at half its velocity limit)"
+        )
+        return dq, ddq, said, f"{rate:g}"
+    tr = along.trajectory
+    if tr.dq.shape[1] != robot.n:
+        raise ShapeError(f"{along.name} has {tr.dq.shape[1]} joints; robot has {robot.n}")
+    span = float(tr.t[-1] - tr.t[0]) if tr.t.size > 1 else 0.0
+    flips = np.sum(tr.dq[1:] * tr.dq[:-1] < 0, axis=0)
+    per_s = f"{np.max(flips) / span:.2g}" if span > 0 else "its"
+    return tr.dq, tr.ddq, f"along {along.name} ({tr.t.size} samples)", per_s
+
+
+def _reversal_note(
+    model: FrictionModel | FrictionSum,
+    approx: CoulombViscous,
+    soft: SoftFrictionLoss,
+    robot: Robot,
+    along: Along | None,
+) -> tuple[str, ...]:
+    """The line saying how far ``mj_inverse``'s friction of the file is from the law's
+    along ``along`` (None: the representative sine,
+    :func:`~dynid.friction.mujoco_soft.representative_motion`; RMS, and the worst case with
+    where it happens, at a velocity reversal:
+    :func:`~dynid.friction.mujoco_soft.dry_friction_error`) and what to do where it
+    matters; none without dry friction or below round-off."""
+    if not np.any(approx.coulomb > 0):
+        return ()
+    dq, ddq, motion, rate = _motion(robot, along)
+    err = dry_friction_error(model, approx.viscous, approx.coulomb, soft, dq, ddq)
+    if np.max(err.worst) < ROUND_OFF_NM:
+        return ()
+    j, w = int(np.argmax(err.rms)), int(np.argmax(err.worst))
+    where = f"dq {err.worst_dq[w]:+.2g} rad/s, ddq {err.worst_ddq[w]:+.3g} rad/s^2"
+    reversal = abs(err.worst_dq[w]) < 0.01 * _velocity_range(robot)[w]
+    if reversal:
+        where = (
+            f"at a velocity reversal, where for about {1e3 * err.window_s[w]:.2g} ms before "
+            f"it the constraint's torque follows the acceleration's sign: {where}"
+        )
+    said = (
+        "mj_inverse's friction (frictionloss is MuJoCo's dry friction as a constraint): "
+        f"{motion} it differs from the law's by RMS up to {err.rms[j]:.3g} N m (joint "
+        f"{j + 1}) and at worst {err.worst[w]:.3g} N m (joint {w + 1}, {where})"
+    )
+    if reversal:
+        said += (
+            f"; the RMS grows with the square root of the reversals a second ({rate} here); "
+            "where inverse dynamics at reversals matters, export with frictionloss=False "
+            "(--no-frictionloss) and add the Coulomb friction as a force of the velocity "
+            "(fc tanh(dq / width) as qfrc_applied or a velocity-dependent actuator)"
+        )
+    return (said,)
+
+
+def _without_frictionloss(
+    approx: CoulombViscous, robot: Robot
+) -> tuple[CoulombViscous, tuple[str, ...]]:
+    """``approx`` with no dry friction (``frictionloss=False``), and the line that says
+    what was left out."""
+    if not np.any(approx.coulomb > 0):
+        return approx, ()
+    j = int(np.argmax(approx.coulomb))
+    return replace(approx, coulomb=np.zeros_like(approx.coulomb)), (
+        "dry friction left out (frictionloss=False): no frictionloss, the law's Coulomb "
+        f"friction (up to {approx.coulomb[j]:.4g} N m, at joint {j + 1}) to be added as a "
+        "force of the velocity",
     )
 
 
@@ -187,12 +275,14 @@ def _law_terms(
     robot: Robot,
     kept: str,
     armature: NDArray[np.float64] | None,
+    dry: bool = True,
 ) -> tuple[CoulombViscous, SoftFrictionLoss, tuple[str, ...], NDArray[np.bool_]]:
     """A friction model as MuJoCo holds it (the smooth laws' ``fv`` and ``fc`` as they
     are, their rounding as the dry friction's slope, :func:`_soft`), what it drops (one
     line each, ending with ``kept``: the files that hold it,
     :func:`~dynid.io.robot.export_options.kept_elsewhere`), and the joints whose offset the
-    robot's spring holds (:func:`spring_held_offsets`), which are not dropped."""
+    robot's spring holds (:func:`spring_held_offsets`), which are not dropped; ``dry``
+    False: the dry friction is not written, nor how its rounding would be."""
     vmax = _velocity_range(robot)
     jt = joint_coulomb_viscous(friction, vmax, sharp=False)
     z = np.zeros(friction.n)
@@ -200,7 +290,7 @@ def _law_terms(
     held = spring_held_offsets(robot, offset, friction.at_motors)
     approx = CoulombViscous(jt.frictionloss, jt.damping, offset, z, z)
     soft, rounding = _soft(friction, approx, robot, armature)
-    lost = rounding + jt.notes + unheld_friction(friction, vmax, held, sharp=False)
+    lost = (rounding if dry else ()) + jt.notes + unheld_friction(friction, vmax, held, sharp=False)
     if not lost:
         return approx, soft, (), held
     written, left = friction_losses(friction.kind, lost)
@@ -224,7 +314,12 @@ _Terms = tuple[
 
 
 def _joint_terms(
-    robot: Robot, friction: bool | FrictionModel | FrictionSum, drive: Drive | None, kept: str
+    robot: Robot,
+    friction: bool | FrictionModel | FrictionSum,
+    drive: Drive | None,
+    kept: str,
+    dry: bool = True,
+    along: Along | None = None,
 ) -> _Terms:
     """The friction written to the joints, the rotor ``armature`` and what MJCF cannot hold.
 
@@ -235,7 +330,10 @@ def _joint_terms(
     (:func:`dynid.friction.mujoco.drive_joint_terms`, :func:`_law_terms`) and the joints
     (n,) whose friction offset the spring's reference holds (:func:`spring_held_offsets`).
     ``friction=True`` is the robot's own friction: its sigmoid (``Robot.friction``) by the
-    fit of its odd part up to ``dq_max``, another law as that law maps itself.
+    fit of its odd part up to ``dq_max``, another law as that law maps itself. The notes
+    end with how far ``mj_inverse``'s friction is from the law's along ``along``
+    (:func:`_reversal_note`);
+    ``dry`` False: no ``frictionloss`` (:func:`_without_frictionloss`).
     """
     n = robot.n
     model = robot_friction(robot) if friction is True else friction or None
@@ -257,15 +355,19 @@ def _joint_terms(
         notes = jt.notes
         armature = jt.armature if d.rotor_inertia is not None else None
     sigmoid = sigmoid_parameters(model) if friction is True else None
-    if model is not None and sigmoid is not None:  # the description's sigmoid
-        fit = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
-        soft, _ = _soft(model, fit, robot, armature)
-        held = spring_held_offsets(robot, fit.offset, model.at_motors)
-        return fit, soft, armature, notes, held
     if model is None:
         return None, None, armature, notes, np.zeros(n, dtype=bool)
-    approx, soft, more, held = _law_terms(model, robot, kept, armature)
-    return approx, soft, armature, notes + more, held
+    if sigmoid is not None:  # the description's sigmoid
+        approx = coulomb_viscous_from_sigmoid(sigmoid, robot.dq_max)
+        soft, _ = _soft(model, approx, robot, armature)
+        held = spring_held_offsets(robot, approx.offset, model.at_motors)
+    else:
+        approx, soft, more, held = _law_terms(model, robot, kept, armature, dry)
+        notes += more
+    if not dry:
+        approx, left = _without_frictionloss(approx, robot)
+        return approx, soft, armature, notes + left, held
+    return approx, soft, armature, notes + _reversal_note(model, approx, soft, robot, along), held
 
 
 def _comment(
@@ -279,6 +381,8 @@ def _comment(
     text = f"written by dynid {__version__}: inertials about the CoM in link axes [kg, m, kg m^2]"
     if approx is None:
         text += "; frictionless joints"
+    elif not np.any(approx.coulomb > 0):
+        text += "; friction: viscous as damping"
     else:
         text += (
             "; friction: Coulomb as frictionloss (MuJoCo's soft dry friction, its slope at "
@@ -385,6 +489,8 @@ def mjcf_from_robot(
     comment: str | None = None,
     drive: Drive | None = None,
     kept: str = "",
+    frictionloss: bool = True,
+    along: Along | None = None,
 ) -> tuple[str, CoulombViscous | None]:
     """The MJCF document of a robot, and the friction approximation it holds.
 
@@ -407,6 +513,13 @@ def mjcf_from_robot(
     kept : str
         The files that hold the friction exactly, said after what MJCF drops of it
         (:func:`~dynid.io.robot.export_options.kept_elsewhere`); empty: none named.
+    frictionloss : bool
+        Write the dry friction as ``frictionloss`` (MuJoCo's constraint; the warning says
+        how far ``mj_inverse``'s friction is from the law's at velocity reversals); False:
+        ``damping`` only, the Coulomb friction left out and said so.
+    along : Along, optional
+        The motion the warning measures ``mj_inverse``'s friction along (default: a sine
+        of each joint, :func:`~dynid.friction.mujoco_soft.representative_motion`).
 
     Returns
     -------
@@ -420,7 +533,9 @@ def mjcf_from_robot(
     ModelError
         A link other than the base is named ``world`` (MuJoCo's world body).
     """
-    approx, soft, armature, notes, held = _joint_terms(robot, friction, drive, kept)
+    approx, soft, armature, notes, held = _joint_terms(
+        robot, friction, drive, kept, frictionloss, along
+    )
     if notes:  # one line: what MJCF cannot hold
         warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
     text = comment or _comment(robot, friction, approx, armature, notes)
@@ -449,11 +564,15 @@ def save_mjcf(
     drive: Drive | None = None,
     kept: str = "",
     caveat: str | None = None,
+    frictionloss: bool = True,
+    along: Along | None = None,
 ) -> Path:
     """Write :func:`mjcf_from_robot` to ``path``; returns the path. ``caveat``: a comment
     at the top, why the fit was not accepted."""
     path = Path(path)
-    text, _ = mjcf_from_robot(robot, friction=friction, drive=drive, kept=kept)
+    text, _ = mjcf_from_robot(
+        robot, friction=friction, drive=drive, kept=kept, frictionloss=frictionloss, along=along
+    )
     write_text(path, with_caveat(text, caveat, xml=True))
     return path
 
@@ -471,4 +590,6 @@ def export_mjcf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         drive=options.drive,
         kept=kept,
         caveat=options.caveat,
+        frictionloss=options.frictionloss,
+        along=options.along,
     )
