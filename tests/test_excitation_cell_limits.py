@@ -140,6 +140,9 @@ def test_limit_text_reads_one_value_for_every_joint_or_per_joint(so101):
             parse_limits(text, JOINTS, "--max-velocity", "dq")
     with pytest.raises(OptionError, match=r"max_velocity \(--max-velocity\) must .* > 0"):
         ExcitationOptions(max_velocity=((0, -1.0),))
+    slow = ExcitationOptions(max_velocity=((1, 0.1),))  # below the 10 deg/s kept inside
+    with pytest.raises(OptionError, match="0.1 rad/s on joint 2 leaves no motion"):
+        design_limits(so101, slow)
     with pytest.raises(OptionError, match="--max-acceleration: joint 9 of a robot of 5"):
         design_limits(so101, _nine())
 

@@ -291,9 +291,20 @@ def design_limits(robot: Robot, options: ExcitationOptions) -> Robot:
     Raises
     ------
     OptionError
-        A joint index beyond the robot's, or a range not inside the joint's limits.
+        A joint index beyond the robot's, a range not inside the joint's limits, or a
+        velocity limit given at or below the velocity margin kept inside it (no motion
+        left).
     """
     robot = within_ranges(robot, options.ranges)
+    low = [(j, v) for j, v in options.max_velocity if v <= options.velocity_margin]
+    if low:
+        j, v = low[0]
+        m = options.velocity_margin
+        raise OptionError(
+            f"--max-velocity: {v:g} rad/s on joint {j + 1} leaves no motion within the "
+            f"velocity margin {m:.4g} rad/s ({np.rad2deg(m):.3g} deg/s) kept inside it; give a "
+            "larger limit or a smaller --velocity-margin [deg/s]"
+        )
     changes = {}
     for k, (field_name, _) in TIGHTENED.items():
         given = getattr(options, k)
