@@ -95,7 +95,7 @@ class Console:
         ``dynid CMD: <step> (12 s)`` on stderr once the run has taken
         :data:`PROGRESS_AFTER_S`, at most one line every :data:`PROGRESS_EVERY_S`; None
         with ``-q`` or when stderr is not a terminal (a file or a pipe gets no lines that
-        depend on the machine's speed; ``excite``'s bar alike)."""
+        depend on the machine's speed)."""
         try:
             tty = bool(sys.stderr.isatty())
         except (AttributeError, ValueError):  # no stream, or a closed one

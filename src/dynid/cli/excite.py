@@ -23,7 +23,9 @@ Writes DIR/trajectory.csv (t, q, dq, ddq at 1 kHz, for a position or velocity
 controller), DIR/trajectory.json (coefficients, limits, margins, obstacles, condition
 numbers, the smallest margin to every limit and obstacle at 1 kHz) and
 DIR/excitation.png (joint motion and swept workspace). Seeded; about a minute for the
-Panda. `dynid simulate --trajectory DIR/trajectory.csv` records a torque log along it.
+Panda: on a terminal, progress lines tell the iterations (-v logs each one), and the
+summary's first line ends with the time the design took.
+`dynid simulate --trajectory DIR/trajectory.csv` records a torque log along it.
 The result is the best admissible iterate, never worse than an admissible start (the
 start itself then, said in a third line, as is a result worse than a start that violated
 a limit). Exit status 1 when no admissible trajectory was found, naming the violated
@@ -44,8 +46,19 @@ frame's offset, not a load, and no command takes a load's mass by itself).
 --range qJ=LO:HI,... keeps joints within narrower ranges [rad] than their limits (qJ or J
 a joint's number from 1, or its name), the position margin kept inside them: an arm whose
 joints turn +-2 pi reaches the floor and itself in most of that range, and a motion over
-all of it seldom clears them. trajectory.json records the drive, the ranges (its
-"limits" are the ranges kept, "robot_limits" the robot's).
+all of it seldom clears them. --max-velocity, --max-acceleration and --max-torque give a
+cell's limits tighter than the robot's [rad/s, rad/s^2, N m]: one value for every joint
+(--max-velocity 1.0), per joint (dq2=0.8,ddq3=...,tau1=...; J a joint's number from 1 or
+its name), or both (1.0,dq2=0.8). Each joint keeps the smaller of its own limit and the one
+given, never a larger one (said in one note), with the margins above kept inside it. A URDF
+holds no acceleration limits: without --max-acceleration a warning says the accelerations
+are then bounded only by the design's own 10 rad/s^2 and the torque limits.
+trajectory.json records the drive, the ranges and the limits given (its "limits" are those
+kept, "robot_limits" the robot's).
+
+The condition number is that of [Y_b, F] on the trajectory's exact samples, rows
+unweighted; identify's on a log of it is of the structure it chooses, on the log's filtered
+rows weighted per joint by their noise (wls), which changes the unscaled number most.
 
 status (the first line of the summary, and trajectory.json's "status"):
   ok          the optimised trajectory keeps every limit and clearance when checked at
@@ -67,7 +80,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
@@ -77,7 +89,12 @@ from ..exceptions import OptionError
 from ..io.excitation import save_excitation_json, save_trajectory_csv
 from ..model.robot import Robot
 from ..simulation.excitation import ExcitationOptions
-from ..workflows.excite import ExcitationDesign, design_excitation
+from ..workflows.excite import (
+    ExcitationDesign,
+    design_excitation,
+    loosened_note,
+    unlimited_warnings,
+)
 from .applies import urdf_chain
 from .common import (
     add_drive_option,
@@ -163,6 +180,20 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="narrow joints' ranges for the design [rad], qJ (or J) a joint's number from 1, "
         "or its name (e.g. 'q1=-1.5:1.5,q2=-2.6:-0.5'); default: the robot's limits",
     )
+    for option, symbol, unit, what in (
+        ("--max-velocity", "dq", "rad/s", "velocity"),
+        ("--max-acceleration", "ddq", "rad/s^2", "acceleration"),
+        ("--max-torque", "tau", "N m", "torque"),
+    ):
+        p.add_argument(
+            option,
+            default=None,
+            metavar=f"V|{symbol}J=V,...",
+            help=f"the cell's {what} limit [{unit}], tighter than the robot's: one for every "
+            f"joint, or per joint ({symbol}J or J a joint's number from 1, or its name; e.g. "
+            f"'{symbol}2=0.8,{symbol}3=0.5'); each joint keeps the smaller of its own and the "
+            "one given, the margins kept inside it",
+        )
     p.add_argument("--criterion", choices=("cond", "logdet"), default=d.criterion)
     p.add_argument("--max-iter", type=int, default=d.max_iter, help="optimiser iterations (60)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -177,60 +208,22 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-#: Least time [s] between two redraws of the bar within an iteration.
-BAR_EVERY_S = 0.25
-
-
-class _Bar:
-    """The optimiser's progress on one stderr line (a terminal, without -q): iterations
-    and objective evaluations done, the bar at the larger share of their budgets (the
-    evaluations' runs out first when a line search struggles: an iteration can take a
-    minute), redrawn after each iteration and at most every :data:`BAR_EVERY_S` within
-    one."""
-
-    def __init__(self, max_iter: int) -> None:
-        self.iteration, self.max_iter, self.cond = 0, max_iter, float("nan")
-        self.evaluations, self.budget = 0, 1
-        self.last, self.width = 0.0, 0
-
-    def on_iteration(self, k: int, total: int, cond: float) -> None:
-        self.iteration, self.max_iter, self.cond = k, total, cond
-        self._draw()
-
-    def on_evaluation(self, done: int, budget: int) -> None:
-        self.evaluations, self.budget = done, budget
-        if time.monotonic() - self.last >= BAR_EVERY_S:
-            self._draw()
-
-    def _draw(self) -> None:
-        self.last = time.monotonic()
-        share = max(self.iteration / max(self.max_iter, 1), self.evaluations / max(self.budget, 1))
-        bar = "#" * int(30 * min(share, 1.0))
-        cond = f", cond {self.cond:.4g}" if self.iteration else ""
-        text = (
-            f"[{bar:<30}] iteration {self.iteration}/{self.max_iter}, "
-            f"{self.evaluations:,}/{self.budget:,} evaluations{cond}"
-        )
-        self.width = max(self.width, len(text))
-        print(f"\r{text:<{self.width}}", end="", file=sys.stderr, flush=True)
-
-
 def run(args: argparse.Namespace, console: Console) -> int:
     """Optimise, write the trajectory files and the figure; returns the exit code."""
     robot = load_robot(args)
     opts = _options(args, robot)
-    show = not console.quiet and sys.stderr.isatty()
-    bar = _Bar(opts.max_iter) if show else None
+    for line in unlimited_warnings(robot, opts, flag):
+        console.warn(line)
+    loosened = loosened_note(robot, opts, flag)
+    if loosened is not None:
+        console.note(loosened)
     design = design_excitation(
         robot,
         opts,
         obstacles=args.obstacles,
         seed=args.seed,
-        progress=None if bar is None else bar.on_iteration,
-        evaluated=None if bar is None else bar.on_evaluation,
         drive=load_drive_arg(args, robot.n),
     )
-    print(end="\n" if show else "", file=sys.stderr)
     written = _save(args, robot, design)
     console.print(*design.describe(robot, flag), *(f"wrote {p}" for p in written))
     if not design.admissible:  # a negative result, as retrieve's: exit 1, files kept
@@ -246,8 +239,12 @@ def run(args: argparse.Namespace, console: Console) -> int:
 
 def _options(args: argparse.Namespace, robot: Robot) -> ExcitationOptions:
     """The design's options from the flags (margins given in degrees)."""
+    joints = robot.joint_names
     return ExcitationOptions(
-        ranges=() if args.range is None else parse_ranges(args.range, robot.joint_names),
+        ranges=() if args.range is None else parse_ranges(args.range, joints),
+        max_velocity=parse_limits(args.max_velocity, joints, "--max-velocity", "dq"),
+        max_acceleration=parse_limits(args.max_acceleration, joints, "--max-acceleration", "ddq"),
+        max_torque=parse_limits(args.max_torque, joints, "--max-torque", "tau"),
         duration=args.duration,
         harmonics=args.harmonics,
         base_frequency=args.base_frequency,
@@ -277,17 +274,7 @@ def parse_ranges(text: str, joints: tuple[str, ...]) -> tuple[tuple[int, float, 
         lo, colon, hi = span.partition(":")
         if not (eq and colon):
             raise OptionError(f"--range: {item!r} is not qJ=LO:HI (e.g. q1=-1.5:1.5)")
-        name = name.strip()
-        number = name[1:] if name[:1] == "q" and name[1:].isdigit() else name
-        if name in joints:
-            j = joints.index(name)
-        elif number.isdigit() and 1 <= int(number) <= len(joints):
-            j = int(number) - 1
-        else:
-            raise OptionError(
-                f"--range: no joint {name!r}; give its number 1..{len(joints)} or one of "
-                f"{', '.join(joints)}"
-            )
+        j = _joint(name.strip(), joints, "--range", "q")
         try:
             lo_hi = float(lo), float(hi)
         except ValueError:
@@ -298,6 +285,68 @@ def parse_ranges(text: str, joints: tuple[str, ...]) -> tuple[tuple[int, float, 
     if not out:
         raise OptionError("--range: no J=LO:HI given")
     return tuple(out[j] for j in sorted(out))
+
+
+def parse_limits(
+    text: str | None, joints: tuple[str, ...], flag: str, symbol: str
+) -> tuple[tuple[int, float], ...]:
+    """``--max-velocity`` and its kin (``V`` for every joint, ``symbolJ=V,...`` per joint,
+    ``symbolJ`` or ``J`` a joint's number from 1, or its name, as :func:`parse_ranges`
+    reads them; a number before the items sets the joints they leave) as
+    :attr:`~dynid.simulation.excitation.ExcitationOptions.max_velocity` and its kin
+    (index from 0, the value in the option's unit); ``()`` for None.
+
+    Raises
+    ------
+    OptionError
+        An item neither a number nor ``J=V``, two numbers for every joint, an unknown
+        joint, a value that is not a number, a joint twice.
+    """
+    if text is None:
+        return ()
+    out: dict[int, float] = {}
+    every: float | None = None
+    example = f"e.g. {flag} 1.0 or {flag} {symbol}1=1.0,{symbol}2=0.8"
+    for item in (x.strip() for x in text.split(",") if x.strip()):
+        name, eq, value = item.rpartition("=")
+        try:
+            v = float(value)
+        except ValueError:
+            raise OptionError(f"{flag}: {item!r} is not a number or J=V ({example})") from None
+        if not eq:
+            if every is not None:
+                raise OptionError(f"{flag}: two values for every joint ({every:g}, {v:g})")
+            every = v
+            continue
+        j = _joint(name.strip(), joints, flag, symbol)
+        if j in out:
+            raise OptionError(f"{flag}: joint {j + 1} given twice")
+        out[j] = v
+    if every is None and not out:
+        raise OptionError(f"{flag}: no value given ({example})")
+    if every is not None:
+        out = {j: out.get(j, every) for j in range(len(joints))}
+    return tuple((j, out[j]) for j in sorted(out))
+
+
+def _joint(name: str, joints: tuple[str, ...], flag: str, symbol: str) -> int:
+    """The index from 0 of the joint ``name``: its name, its number from 1, or
+    ``symbol`` and its number (``q2``, ``dq2``).
+
+    Raises
+    ------
+    OptionError
+        No such joint.
+    """
+    rest = name[len(symbol) :] if name.startswith(symbol) else name
+    if name in joints:
+        return joints.index(name)
+    if rest.isdigit() and 1 <= int(rest) <= len(joints):
+        return int(rest) - 1
+    raise OptionError(
+        f"{flag}: no joint {name!r}; give its number 1..{len(joints)} ({symbol}1..) or one "
+        f"of {', '.join(joints)}"
+    )
 
 
 def _save(args: argparse.Namespace, robot: Robot, design: ExcitationDesign) -> list[Path]:

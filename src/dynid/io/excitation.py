@@ -36,7 +36,7 @@ from ..exceptions import DataError, DynidError
 from ..model.robot import Robot
 from ..simulation.clearance import Approach
 from ..simulation.collision import Box, Obstacles, Plane, capsule_model
-from ..simulation.excitation import ExcitationResult, ExcitingTrajectory, within_ranges
+from ..simulation.excitation import ExcitationResult, ExcitingTrajectory, design_limits
 from ..simulation.trajectories import Trajectory
 from .atomic import open_atomic
 from .csv_tables import csv_table
@@ -98,7 +98,7 @@ def save_excitation_json(
     """Write ``trajectory.json``: coefficients, limits, margins, obstacles, conditioning."""
     o = result.options
     given = robot
-    robot = within_ranges(robot, o.ranges)  # the limits the design kept to
+    robot = design_limits(robot, o)  # the limits the design kept to
     d = {
         "schema": EXCITATION_SCHEMA,
         "dynid_version": __version__,
@@ -129,7 +129,18 @@ def save_excitation_json(
             given.joint_names[j]: {"joint": j + 1, "lo_rad": lo, "hi_rad": hi}
             for j, lo, hi in o.ranges
         },
-        "robot_limits": {"q_min_rad": given.q_min.tolist(), "q_max_rad": given.q_max.tolist()},
+        # the limits given (--max-velocity, ...): the limits above, tightened from the robot's
+        "limits_given": {
+            k: {given.joint_names[j]: v for j, v in getattr(o, k)}
+            for k in ("max_velocity", "max_acceleration", "max_torque")
+        },
+        "robot_limits": {
+            "q_min_rad": given.q_min.tolist(),
+            "q_max_rad": given.q_max.tolist(),
+            "dq_max_rad_s": given.dq_max.tolist(),
+            "ddq_max_rad_s2": given.ddq_max.tolist(),
+            "tau_max_nm": given.tau_max.tolist(),
+        },
         "margins_required": {
             "position_rad": o.position_margin,
             "velocity_rad_s": o.velocity_margin,
@@ -231,6 +242,7 @@ EXCITATION = Format(
             "history": Field("any"),
             "ranges": Field("any"),
             "robot_limits": Field("any"),
+            "limits_given": Field("any"),
             "drive": Field("any"),
         }
     ),

@@ -11,7 +11,10 @@ then ``fv, fc, fo`` per joint; unscaled, as Gaz et al. report it; Swevers et al.
 13(5), 1997, and FIGAROH/FloBaRoID/BIRDy do the same) or, with ``criterion="logdet"``,
 maximise ``log det`` of its column-scaled Gram matrix (D-optimality). Constraints:
 
-* position, velocity and acceleration limits with margins hold by construction: each
+* position, velocity and acceleration limits with margins hold by construction (the
+  robot's, or narrower ones given: ``ranges``, ``max_velocity``, ``max_acceleration``,
+  ``max_torque``, :func:`design_limits`; where the robot gives no velocity or
+  acceleration limit, :data:`UNLIMITED_VELOCITY` and :data:`UNLIMITED_ACCELERATION`): each
   candidate is scaled per joint into ``[q_min + m_q, q_max - m_q]``,
   ``|dq| <= dq_max - m_dq`` and ``|ddq| <= (1 - m_ddq) ddq_max`` on a 100 Hz grid, and its
   start position is the requested one clipped to where the motion fits;
@@ -37,7 +40,8 @@ grow a motion (at the largest that fits, the scaling undoes either, and a start 
 collision was never left). Seeded and reproducible; ``progress(iteration, max_iter,
 cond)`` is called after each iteration and ``evaluated(evaluations, budget)`` after each
 evaluation of the objective (an iteration can take thousands when its line search
-struggles).
+struggles); both are also told to :mod:`dynid.progress` (the command line's progress
+lines) and each iteration logged at ``INFO`` (``-v``).
 """
 
 from __future__ import annotations
@@ -52,6 +56,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from .. import progress as _progress
 from ..dynamics.rnea import rnea
 from ..exceptions import OptionError
 from ..friction.model import robot_friction
@@ -78,6 +83,11 @@ __all__ = [
     "ExcitationOptions",
     "ExcitationResult",
     "STATUSES",
+    "TIGHTENED",
+    "UNLIMITED_ACCELERATION",
+    "UNLIMITED_VELOCITY",
+    "design_limits",
+    "not_tightened",
     "ExcitingTrajectory",
     "excitation_condition_number",
     "limit_margins",
@@ -93,6 +103,18 @@ _FS_REPORTED = 200.0
 #: Fractions of their amplitudes the random starts are also tried at when none at full
 #: amplitude keeps the torques and clearances (:func:`_start`).
 _START_FRACTIONS = (0.8, 0.6, 0.4, 0.2)
+#: The bound [rad/s] the design keeps a joint's velocity within where the robot gives no
+#: velocity limit (on its 100 Hz grid; not checked at 1 kHz).
+UNLIMITED_VELOCITY = 2.0
+#: The bound [rad/s^2] the design keeps a joint's acceleration within where the robot
+#: gives no acceleration limit (a URDF holds none; on its 100 Hz grid, not checked at 1 kHz).
+UNLIMITED_ACCELERATION = 10.0
+#: The limits the options tighten: option field -> (the robot's field, unit).
+TIGHTENED = {
+    "max_velocity": ("dq_max", "rad/s"),
+    "max_acceleration": ("ddq_max", "rad/s^2"),
+    "max_torque": ("tau_max", "N m"),
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -151,6 +173,12 @@ class ExcitationOptions:
         hi)`` with ``j`` the joint's index from 0 and ``lo < hi`` [rad] (default none: the
         limits); they replace the limits of the design and its checks
         (:func:`within_ranges`), the position margin kept inside them.
+    max_velocity, max_acceleration, max_torque : tuple of (int, float)
+        Limits of the cell tighter than the robot's: ``(j, limit)`` with ``j`` the joint's
+        index from 0 and ``limit > 0`` [rad/s, rad/s^2, N m] (default none). Each joint
+        keeps the smaller of its own limit and the one given (:func:`design_limits`; a
+        larger one never loosens it, :func:`not_tightened`), with the margins above kept
+        inside it.
     """
 
     duration: float = 20.0
@@ -172,8 +200,18 @@ class ExcitationOptions:
     fs_limits: float = 100.0
     fs_collision: float = 15.0
     ranges: tuple[tuple[int, float, float], ...] = ()
+    max_velocity: tuple[tuple[int, float], ...] = ()
+    max_acceleration: tuple[tuple[int, float], ...] = ()
+    max_torque: tuple[tuple[int, float], ...] = ()
 
     def __post_init__(self) -> None:
+        for k in TIGHTENED:
+            for j, v in getattr(self, k):
+                if not (j >= 0 and 0 < v < float("inf")):
+                    raise OptionError(
+                        f"{k} (--{k.replace('_', '-')}) must name a joint and a finite limit "
+                        f"> 0; got joint {j + 1}: {v:g}"
+                    )
         for j, lo, hi in self.ranges:
             if not (j >= 0 and np.isfinite(lo) and np.isfinite(hi) and lo < hi):
                 raise OptionError(
@@ -244,6 +282,56 @@ def within_ranges(robot: Robot, ranges: tuple[tuple[int, float, float], ...]) ->
     return robot.replace(q_min=q_min, q_max=q_max, q_neutral=qn)
 
 
+def design_limits(robot: Robot, options: ExcitationOptions) -> Robot:
+    """``robot`` with the limits the design keeps to: its position limits narrowed to
+    ``options.ranges`` (:func:`within_ranges`) and its velocity, acceleration and torque
+    limits to ``options.max_velocity``, ``max_acceleration`` and ``max_torque``, each
+    joint's the smaller of its own and the one given [rad/s, rad/s^2, N m].
+
+    Raises
+    ------
+    OptionError
+        A joint index beyond the robot's, a range not inside the joint's limits, or a
+        velocity limit given at or below the velocity margin kept inside it (no motion
+        left).
+    """
+    robot = within_ranges(robot, options.ranges)
+    low = [(j, v) for j, v in options.max_velocity if v <= options.velocity_margin]
+    if low:
+        j, v = low[0]
+        m = options.velocity_margin
+        raise OptionError(
+            f"--max-velocity: {v:g} rad/s on joint {j + 1} leaves no motion within the "
+            f"velocity margin {m:.4g} rad/s ({np.rad2deg(m):.3g} deg/s) kept inside it; give a "
+            "larger limit or a smaller --velocity-margin [deg/s]"
+        )
+    changes = {}
+    for k, (field_name, _) in TIGHTENED.items():
+        given = getattr(options, k)
+        if not given:
+            continue
+        limit = np.array(getattr(robot, field_name), dtype=np.float64)
+        for j, v in given:
+            if j >= robot.n:
+                flag = f"--{k.replace('_', '-')}"
+                raise OptionError(f"{flag}: joint {j + 1} of a robot of {robot.n} joints")
+            limit[j] = min(limit[j], v)
+        changes[field_name] = limit
+    return robot.replace(**changes) if changes else robot
+
+
+def not_tightened(
+    robot: Robot, options: ExcitationOptions
+) -> tuple[tuple[str, int, float, float], ...]:
+    """The limits given above the robot's own, which the design leaves at the robot's:
+    ``(option field, j, given, robot's limit)`` [rad/s, rad/s^2 or N m], j from 0."""
+    out = []
+    for k, (field_name, _) in TIGHTENED.items():
+        own = getattr(robot, field_name)
+        out += [(k, j, v, float(own[j])) for j, v in getattr(options, k) if j < robot.n]
+    return tuple(x for x in out if x[2] > x[3])
+
+
 def _given(value: float | None, default: float) -> float:
     return default if value is None else value
 
@@ -298,6 +386,9 @@ class ExcitationResult:
     rest_clearances : tuple of Approach
         The obstacle clearances the rest position already violates: then no trajectory
         about it is admissible.
+    n_base : int
+        Base parameters in the regressor whose condition number is optimised (its columns
+        ``n_base + 3 n``: viscous, Coulomb and offset friction per joint after them).
     """
 
     trajectory: ExcitingTrajectory
@@ -318,6 +409,7 @@ class ExcitationResult:
     drive: Drive | None = None
     rest: NDArray[np.float64] | None = None
     rest_clearances: tuple[Approach, ...] = ()
+    n_base: int = 0
 
     @property
     def start_admissible(self) -> bool:
@@ -522,9 +614,13 @@ class _Problem:
         finite = np.isfinite(robot.q_min) & np.isfinite(robot.q_max)
         self.lo = np.where(finite, robot.q_min + opts.position_margin, -np.pi)
         self.hi = np.where(finite, robot.q_max - opts.position_margin, np.pi)
-        self.vmax = np.where(np.isfinite(robot.dq_max), robot.dq_max - opts.velocity_margin, 2.0)
+        self.vmax = np.where(
+            np.isfinite(robot.dq_max), robot.dq_max - opts.velocity_margin, UNLIMITED_VELOCITY
+        )
         self.amax = np.where(
-            np.isfinite(robot.ddq_max), (1 - opts.acceleration_margin) * robot.ddq_max, 10.0
+            np.isfinite(robot.ddq_max),
+            (1 - opts.acceleration_margin) * robot.ddq_max,
+            UNLIMITED_ACCELERATION,
         )
         self.tmax = (1 - opts.torque_margin) * robot.tau_max
         self.q_start = q_start
@@ -532,6 +628,9 @@ class _Problem:
         #: Called after each evaluation with the evaluations so far and their budget.
         self.evaluated: Callable[[int, int], None] | None = None
         self.budget = opts.max_evaluations
+        #: The optimiser's iterations done and the last one's condition number (told with
+        #: each evaluation's progress).
+        self.iteration, self.cond = 0, float("nan")
         #: The drive whose known rotor inertias the torques include (None: none).
         self.drive: Drive | None = None
 
@@ -612,6 +711,11 @@ class _Problem:
         self.evaluations += 1
         if self.evaluated is not None:
             self.evaluated(self.evaluations, self.budget)
+        cond = f" (condition number {self.cond:.4g})" if self.iteration else ""
+        _progress.report(
+            f"iteration {self.iteration} of {self.opts.max_iter}{cond}, "
+            f"{self.evaluations:,} of {self.budget:,} evaluations"
+        )
         c, q0 = self.coefficients(x)
         return self.criterion(c, q0) + self.penalty(c, q0)
 
@@ -765,7 +869,7 @@ def optimise_excitation(
     """
     if drive is not None:
         drive.check(robot.n)
-    robot = within_ranges(robot, options.ranges)
+    robot = design_limits(robot, options)
     obstacles = Obstacles.floor() if obstacles is None else obstacles
     base = base_parameters(robot, kind="torque") if base is None else base
     derived = options.derived
@@ -787,8 +891,7 @@ def optimise_excitation(
         cond = float(_conds(prob.regressor(c, q0))[0])
         history.append(cond)
         best.offer(xk)
-        if progress is not None:
-            progress(len(history), options.max_iter, cond)
+        _tell_iteration(prob, len(history), cond, progress)
 
     res = _minimize(
         prob.objective,
@@ -834,7 +937,27 @@ def optimise_excitation(
         drive=drive,
         rest=centre,
         rest_clearances=_rest_clearances(robot, centre, options, obstacles, caps),
+        n_base=len(base.independent),
     )
+
+
+def _tell_iteration(
+    prob: _Problem,
+    k: int,
+    cond: float,
+    progress: Callable[[int, int, float], None] | None,
+) -> None:
+    """Iteration ``k`` done at condition number ``cond``: kept in ``prob`` (told with the
+    evaluations that follow), told to ``progress`` and :mod:`dynid.progress`, and logged
+    at INFO (``-v``)."""
+    prob.iteration, prob.cond, total = k, cond, prob.opts.max_iter
+    if progress is not None:
+        progress(k, total, cond)
+    _log.info(
+        "excitation: iteration %d of %d, condition number %.4g, %d evaluations",
+        k, total, cond, prob.evaluations,
+    )  # fmt: skip
+    _progress.report(f"iteration {k} of {total} done, condition number {cond:.4g}")
 
 
 def _rest_clearances(

@@ -13,10 +13,17 @@ command applies, so that the Python API behaves as the command does.
   is said to leave them out of the torque margins.
 * A trajectory that is not admissible is a result, not an error (``admissible`` is False;
   the command writes it for inspection and exits 1).
+* Limits of the cell tighter than the robot's (``max_velocity``, ``max_acceleration``,
+  ``max_torque``) replace its own, never loosen them (:func:`loosened_note`); a robot
+  without acceleration limits (a URDF holds none) is warned of before the design
+  (:func:`unlimited_warnings`).
+* The optimiser's iterations are told to :mod:`dynid.progress` within the stage
+  :data:`STAGE`; the time the design took is kept (``elapsed_s``) and said.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,15 +35,38 @@ from ..friction.model import own_at_motors_note
 from ..io.excitation import load_obstacles
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import stage
 from ..simulation.collision import (
     DEFAULT_OBSTACLE_CLEARANCE,
     DEFAULT_RADIUS,
     DEFAULT_SELF_CLEARANCE,
     FULL_SIZE_CHAIN,
 )
-from ..simulation.excitation import ExcitationOptions, ExcitationResult, optimise_excitation
+from ..simulation.excitation import (
+    TIGHTENED,
+    UNLIMITED_ACCELERATION,
+    UNLIMITED_VELOCITY,
+    ExcitationOptions,
+    ExcitationResult,
+    design_limits,
+    not_tightened,
+    optimise_excitation,
+)
 
-__all__ = ["EXCITE_RATE_HZ", "ExcitationDesign", "design_excitation"]
+__all__ = [
+    "EXCITE_RATE_HZ",
+    "STAGE",
+    "ExcitationDesign",
+    "design_excitation",
+    "loosened_note",
+    "unlimited_warnings",
+]
+
+#: What each option of :data:`~dynid.simulation.excitation.TIGHTENED` limits.
+_WHAT = {"max_velocity": "velocity", "max_acceleration": "acceleration", "max_torque": "torque"}
+
+#: The stage the design's progress is told in (:func:`dynid.progress.stage`).
+STAGE = "exciting trajectory"
 
 #: Rate of the sampled trajectory and of its checks [Hz].
 EXCITE_RATE_HZ = 1000.0
@@ -65,12 +95,15 @@ class ExcitationDesign:
         The seed it was optimised from.
     obstacles_file : str or None
         The obstacles file's name (None: the default floor, ``z = 0`` of the base frame).
+    elapsed_s : float
+        Wall-clock time the design took [s] (NaN: not measured).
     """
 
     result: ExcitationResult
     samples: Any
     seed: int = field(default=0)
     obstacles_file: str | None = None
+    elapsed_s: float = float("nan")
 
     @property
     def admissible(self) -> bool:
@@ -78,17 +111,20 @@ class ExcitationDesign:
         return self.result.status != "infeasible"
 
     def describe(self, robot: Robot, name: Callable[[str], str] = str) -> tuple[str, ...]:
-        """Two lines: the condition numbers and iterations; the smallest margins; a third
-        when the optimiser did not improve on its start (:meth:`start_note`); then the
-        capsule radius and clearances used (:meth:`sizes_line`) and each clearance the
-        result, or a start that mattered, violates (:meth:`clearance_lines`). Options are
-        named by ``name`` (``str``: as the Python API names them)."""
+        """Two lines: the condition numbers, iterations and the time taken; the smallest
+        margins; a third when the optimiser did not improve on its start
+        (:meth:`start_note`); which regressor the condition number is of
+        (:meth:`condition_line`); the limits given (:meth:`limits_line`); then the capsule
+        radius and clearances used (:meth:`sizes_line`) and each clearance the result, or
+        a start that mattered, violates (:meth:`clearance_lines`). Options are named by
+        ``name`` (``str``: as the Python API names them)."""
         res, m = self.result, self.result.margins
+        took = f", designed in {self.elapsed_s:.3g} s" if np.isfinite(self.elapsed_s) else ""
         first = (
             f"exciting trajectory for {robot.name}: {res.trajectory.total_duration:g} s, "
             f"condition number {res.condition_number:.4g} (unscaled; start "
             f"{res.initial_condition_number:.4g}), scaled {res.scaled_condition_number:.4g}, "
-            f"{res.iterations} iterations, status {res.status}"
+            f"{res.iterations} iterations, status {res.status}{took}"
         )
         o = res.options
         kept = (
@@ -107,6 +143,9 @@ class ExcitationDesign:
         )
         note = self.start_note()
         head: tuple[str, ...] = (first, second) if note is None else (first, second, note)
+        head += (self.condition_line(robot),)
+        limits = self.limits_line(robot, name)
+        head += () if limits is None else (limits,)
         drive = self.drive_line(name)
         head += () if drive is None else (drive,)
         at_motors = own_at_motors_note(robot, self.result.drive)
@@ -114,6 +153,40 @@ class ExcitationDesign:
         ranges = self.ranges_line(robot, name)
         head += () if ranges is None else (ranges,)
         return head + (self.sizes_line(name),) + self.clearance_lines(name)
+
+    def condition_line(self, robot: Robot) -> str:
+        """Which regressor the condition numbers are of, and why ``identify``'s on a log
+        of this trajectory differs (another matrix: its columns, rows and weights)."""
+        r, n = self.result.n_base, robot.n
+        return (
+            f"condition number of [Y_b, F]: {r} base columns, viscous, Coulomb and offset "
+            f"friction per joint ({3 * n} columns), on the trajectory's exact samples at "
+            "200 Hz, rows unweighted (scaled: unit column norms); identify's on a log of it is "
+            "of the structure it chooses (rotors, friction laws) on the log's filtered rows, "
+            "each joint's divided by its noise under wls: its unscaled number differs most by "
+            "that weighting, the scaled ones less"
+        )
+
+    def limits_line(self, robot: Robot, name: Callable[[str], str] = str) -> str | None:
+        """The velocity, acceleration and torque limits given tighter than the robot's
+        (``max_velocity``, ``max_acceleration``, ``max_torque``), as the design kept to
+        them, or None when none was given."""
+        o = self.result.options
+        kept = design_limits(robot, o)
+        parts, flags = [], []
+        for k, (field_name, unit) in TIGHTENED.items():
+            joints = sorted({j for j, _ in getattr(o, k)})
+            if not joints:
+                continue
+            flags.append(name(k))
+            limit = getattr(kept, field_name)
+            parts.append(f"{_WHAT[k]} {_per_joint(robot, joints, limit, unit)}")
+        if not parts:
+            return None
+        return (
+            f"limits kept ({', '.join(flags)}, the smaller of each joint's own and the one "
+            f"given; the margins kept inside them): {'; '.join(parts)}"
+        )
 
     def ranges_line(self, robot: Robot, name: Callable[[str], str] = str) -> str | None:
         """The joint ranges the design kept to instead of the limits (given by
@@ -302,17 +375,89 @@ def design_excitation(
         An unreadable obstacles file.
     """
     obs = None if obstacles is None else load_obstacles(obstacles)
-    res = optimise_excitation(
-        robot,
-        np.random.default_rng(seed),
-        options or ExcitationOptions(),
-        obstacles=obs,
-        progress=progress,
-        evaluated=evaluated,
-        drive=drive,
-    )
+    start = time.monotonic()
+    with stage(STAGE):
+        res = optimise_excitation(
+            robot,
+            np.random.default_rng(seed),
+            options or ExcitationOptions(),
+            obstacles=obs,
+            progress=progress,
+            evaluated=evaluated,
+            drive=drive,
+        )
     file = None if obstacles is None else Path(obstacles).name
-    return ExcitationDesign(res, res.trajectory.sample(EXCITE_RATE_HZ), seed, file)
+    samples = res.trajectory.sample(EXCITE_RATE_HZ)
+    return ExcitationDesign(res, samples, seed, file, time.monotonic() - start)
+
+
+def loosened_note(
+    robot: Robot, options: ExcitationOptions, name: Callable[[str], str] = str
+) -> str | None:
+    """One line naming the limits given above the robot's own, which the design keeps at
+    the robot's (the options tighten, never loosen), or None."""
+    above = not_tightened(robot, options)
+    if not above:
+        return None
+    units = {k: unit for k, (_, unit) in TIGHTENED.items()}
+    groups: dict[tuple[str, float], list[tuple[int, float]]] = {}
+    for k, j, v, own in above:
+        groups.setdefault((k, v), []).append((j, own))
+    items = "; ".join(
+        f"{name(k)} {v:g} {units[k]} on {', '.join(robot.joint_names[j] for j, _ in js)} "
+        f"(own {'/'.join(f'{own:g}' for own in dict.fromkeys(o for _, o in js))})"
+        for (k, v), js in groups.items()
+    )
+    return (
+        f"limits given above the description's own, kept at its own (these options only "
+        f"tighten limits; a looser one is the description's to change): {items}"
+    )
+
+
+def unlimited_warnings(
+    robot: Robot, options: ExcitationOptions, name: Callable[[str], str] = str
+) -> tuple[str, ...]:
+    """One line for the velocity, and one for the acceleration, limits that neither the
+    robot (a URDF holds no acceleration limit) nor ``options`` give: the design then
+    bounds them only by its own :data:`UNLIMITED_VELOCITY`,
+    :data:`UNLIMITED_ACCELERATION` (on its 100 Hz grid) and the torque limits."""
+    kept = design_limits(robot, options)
+    out = []
+    for k, field_name, what, bound, unit, item in (
+        ("max_velocity", "dq_max", "velocity", UNLIMITED_VELOCITY, "rad/s", "dq"),
+        ("max_acceleration", "ddq_max", "acceleration", UNLIMITED_ACCELERATION, "rad/s^2", "ddq"),
+    ):
+        free = [j for j in range(robot.n) if not np.isfinite(getattr(kept, field_name)[j])]
+        if not free:
+            continue
+        where = (
+            "on any joint"
+            if len(free) == robot.n
+            else "on " + ", ".join(robot.joint_names[j] for j in free)
+        )
+        out.append(
+            f"the description has no {what} limits {where}: the design's {what}s are bounded "
+            f"only by its own {bound:g} {unit} per joint and the torque limits (an arm's or "
+            f"a cell's limits may be lower); hint: {name(k)} A ({unit}, every joint) or "
+            f"{name(k)} {item}1=A,{item}2=B,..."
+        )
+    return tuple(out)
+
+
+def _per_joint(robot: Robot, joints: list[int], limit: Any, unit: str) -> str:
+    """``limit`` [unit] of ``joints``: one value for them all when they share it."""
+    values = [float(limit[j]) for j in joints]
+    if len(set(values)) == 1:
+        which = (
+            "every joint"
+            if len(joints) == robot.n
+            else ", ".join(robot.joint_names[j] for j in joints)
+        )
+        return f"{values[0]:.4g} {unit} on {which}"
+    return (
+        ", ".join(f"{robot.joint_names[j]} {v:.4g}" for j, v in zip(joints, values, strict=True))
+        + f" {unit}"
+    )
 
 
 def _plane_text(point: tuple[float, ...], normal: tuple[float, ...]) -> str:
