@@ -29,12 +29,14 @@ from .model import IdentifiedModel
 from .structure import ERROR_FLOOR_PERCENT, Structure
 
 __all__ = [
+    "ADMISSIBLE_STD_PERCENT",
     "DETERMINED_STD_PERCENT",
     "ODD_FLOOR_PERCENT",
     "OUTLIER_RATIO",
     "RELATIVE_TIE",
     "RULE",
     "Candidate",
+    "admissible",
     "Selection",
     "candidate_judged",
     "cut_record",
@@ -61,10 +63,24 @@ __all__ = [
 #: 8 rad/s^2) but that the fit determines to 3 % is kept: ``M(q)`` of the wrist would be
 #: 30 to 70 % too small without it.
 DETERMINED_STD_PERCENT = 20.0
-#: How the structure is chosen (:func:`paired_se`, :data:`DETERMINED_STD_PERCENT`).
+#: A coefficient whose sign physics fixes (an armature, a viscous, Coulomb or quadratic
+#: friction coefficient: at least zero) fitted above zero is determined at a relative
+#: standard deviation [%] of at most this (``t >= 3``; :func:`admissible`). The sign is a
+#: second check a spurious term must pass: of a true zero, a value above zero at 3
+#: standard deviations has probability 1.3e-3 (one-sided), and still 7 % if the standard
+#: deviation were half the true one, where a term so loose costs ``M(q)`` or the
+#: friction at most its own small value; leaving a real one out costs all of it. A
+#: Kinova Jaco2's wrist armatures (0.03, 0.02, 0.02 kg m^2) fitted at 30 %, 46 % and 23 %
+#: were left out at 20 %, the wrist's ``M_jj`` 53 %, 31 % and 76 % low. An offset (either
+#: sign) or a Stribeck bump (a correction of the sign's shape as often as static
+#: friction) has no sign to check and stays at :data:`DETERMINED_STD_PERCENT`.
+ADMISSIBLE_STD_PERCENT = 100.0 / 3.0
+#: How the structure is chosen (:func:`paired_se`, :data:`DETERMINED_STD_PERCENT`,
+#: :data:`ADMISSIBLE_STD_PERCENT`).
 RULE = (
     "simplest within one standard error of the lowest held-out error (each joint in units "
-    "of its own noise), paired over the folds; a coefficient determined to 20 % kept; "
+    "of its own noise), paired over the folds; a coefficient determined to 20 % kept (an "
+    "armature or friction coefficient above zero to 33 %, 3 std); "
     "friction below zero not determined to 20 % left out"
 )
 #: Held-out errors closer than this fraction of the lowest one count as equal: a model
@@ -124,6 +140,10 @@ class Candidate:
         Its friction coefficients that push the arm by themselves and that the data do
         not determine (:func:`loose_pushing`): each one's label, value in its fit on all
         data and relative standard deviation [%]; the choice leaves them out.
+    admissible : tuple of str
+        The labels of :attr:`relative_std` whose sign physics fixes and whose fit on all
+        data puts them above zero (:func:`admissible`): determined at
+        :data:`ADMISSIBLE_STD_PERCENT`.
     """
 
     structure: Structure
@@ -141,6 +161,7 @@ class Candidate:
     negative_bump: tuple[str, ...] = ()
     part_scores: tuple[float, ...] = ()
     loose_pushing: tuple[tuple[str, float, float], ...] = ()
+    admissible: tuple[str, ...] = ()
 
     @property
     def skipped(self) -> bool:
@@ -150,12 +171,18 @@ class Candidate:
 
     def determined(self) -> dict[str, float]:
         """The coefficients of :attr:`relative_std` that the data determine (at most
-        :data:`DETERMINED_STD_PERCENT`) and their relative standard deviations [%]; none
-        when the fit is exact (training error at round-off, :data:`~.structure.
-        ERROR_FLOOR_PERCENT`), where a standard deviation is round-off too."""
+        :data:`DETERMINED_STD_PERCENT`; :data:`ADMISSIBLE_STD_PERCENT` for those of
+        :attr:`admissible`) and their relative standard deviations [%]; none when the fit
+        is exact (training error at round-off, :data:`~.structure.ERROR_FLOOR_PERCENT`),
+        where a standard deviation is round-off too."""
         if self.train_error_percent <= ERROR_FLOOR_PERCENT:
             return {}
-        return {lab: r for lab, r in self.relative_std if r <= DETERMINED_STD_PERCENT}
+        signed = frozenset(self.admissible)
+        return {
+            lab: r
+            for lab, r in self.relative_std
+            if r <= (ADMISSIBLE_STD_PERCENT if lab in signed else DETERMINED_STD_PERCENT)
+        }
 
     @property
     def score(self) -> float:
@@ -337,6 +364,7 @@ def candidate_judged(
     relative: tuple[tuple[str, float], ...] = ()
     negative: tuple[str, ...] = ()
     loose: tuple[tuple[str, float, float], ...] = ()
+    signed: tuple[str, ...] = ()
     if check is not None:
         assert whole_std is not None  # asked for with the check
         x, sd = np.zeros(use.size), np.zeros(use.size)
@@ -345,6 +373,7 @@ def candidate_judged(
         relative = relative_stds(x, sd, use, labels)
         negative = negative_bumps(x, use, labels)
         loose = loose_pushing(x, sd, use, labels)
+        signed = admissible(x, use, labels)
     return Candidate(
         structure=structure,
         n_params=int(use.sum()),
@@ -359,6 +388,7 @@ def candidate_judged(
         negative_bump=negative,
         part_scores=tuple(parts),
         loose_pushing=loose,
+        admissible=signed,
     )
 
 
@@ -400,6 +430,27 @@ def loose_pushing(
         for lab, got in seen.items()
         if all(v < 0 for v, _ in got) and min(r for _, r in got) > DETERMINED_STD_PERCENT
     )
+
+
+#: A coefficient whose sign physics fixes, at least zero: a rotor's inertia (``Ia3``) or a
+#: dissipating friction coefficient (:data:`_DISSIPATING`).
+_SIGNED = re.compile(r"Ia[0-9]+|j?f[vcq][0-9]+")
+
+
+def admissible(
+    x: NDArray[np.float64], use: NDArray[np.bool_], labels: Sequence[str]
+) -> tuple[str, ...]:
+    """The labels among the columns ``use`` (``labels``: one per column, ``""`` for none)
+    whose sign physics fixes, at least zero, and whose value in ``x`` is above zero on
+    every column of theirs in use: an armature ``Ia3`` [kg m^2], a viscous, Coulomb or
+    quadratic friction coefficient ``fv3``, ``fc3``, ``fq3`` (``jfv7`` at a joint beside
+    the motors). An offset ``fo3`` may take either sign, and a Stribeck bump ``fsp3``
+    above zero may be a correction of the sign's shape as well: neither is one."""
+    seen: dict[str, bool] = {}
+    for lab, on, xi in zip(labels, use, x, strict=bool(labels)):
+        if lab and on and _SIGNED.fullmatch(lab):
+            seen[lab] = seen.get(lab, True) and float(xi) > 0.0
+    return tuple(lab for lab, ok in seen.items() if ok)
 
 
 def relative_stds(

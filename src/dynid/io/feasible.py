@@ -30,6 +30,10 @@ and was not on a torque log; the friction identified with the links in ``linear_
      "unknown_scale": {"motors": [6, 7], "joints": [...], "factor": [1.10, null],
          "finding": ...} (the motors whose torque constants the data leave unknown beside
          those judged off; the robot files written of it say so at their top),
+     "armature_left_out": ["Ia4", "Ia6"] (only when the identified structure left some
+         rotor inertias out and kept others: those left out, 0 in ``drive``, which the
+         data did not determine; the robot files written of it say so at their top,
+         :func:`armature_left_out_note`),
      "kinematics": {...}, "feasible": true, "relative_residual": ..., "seed": ...,
      "violated": [...], "heldout": {...}, "units": {...}, "conventions": {...}}
 
@@ -44,7 +48,7 @@ unless told otherwise; the robot files written of it say why at their top
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -72,6 +76,7 @@ from ..model.inertia import (
 )
 from ..model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Robot
 from ..model.stiffness import JointStiffness
+from ..regressors.terms import RotorInertia
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
 from .law_friction import law_friction, law_record
@@ -82,6 +87,9 @@ from .spring_record import SPRING_FIELD, SPRING_FORMULA, spring_from_record, spr
 __all__ = [
     "FEASIBLE",
     "FEASIBLE_SCHEMA",
+    "armature_left_out",
+    "armature_left_out_note",
+    "load_armature_left_out",
     "feasible_to_dict",
     "fit_rejection",
     "load_fit_rejection",
@@ -165,6 +173,7 @@ FEASIBLE = Format(
             "spring": SPRING_FIELD,
             "column_map": Field("object"),
             "unknown_scale": Field("object"),
+            "armature_left_out": Field("strings"),
         }
     ),
     "feasible-parameter file",
@@ -266,6 +275,8 @@ def feasible_to_dict(
         d["column_map"] = dict(column_map)
     if unknown_scale is not None:
         d["unknown_scale"] = dict(unknown_scale)
+    if left := armature_left_out(result):
+        d["armature_left_out"] = list(left)
     if result is None:
         return d if seed is None else d | {"seed": seed}
     marks = prior_marks_record(result)
@@ -535,6 +546,52 @@ def load_unknown_scale_caveat(path: str | Path) -> str | None:
     """:func:`unknown_scale_caveat` of the file ``path``'s ``unknown_scale``, or None."""
     found = load_document(path, FEASIBLE).get("unknown_scale")
     return None if not found else unknown_scale_caveat(str(found.get("finding", "")))
+
+
+def armature_left_out(result: FeasibleResult | None) -> tuple[str, ...]:
+    """The rotor inertias (``Ia4``) the structure of ``result``'s identified model left
+    out while it held others (its rotor-inertia term's ``mask``): the data did not
+    determine them, and the fit's drive holds 0 there. Empty when it held every rotor or
+    none, or ``result`` carries no identified model (a consistent fit carries it)."""
+    model = getattr(result, "identified", None)
+    terms = () if model is None else [t.term for t in model.terms.values()]
+    for term in terms:
+        if isinstance(term, RotorInertia) and any(term.mask) and not all(term.mask):
+            labels = term.drive.rotor_labels
+            return tuple(lab for lab, held in zip(labels, term.mask, strict=True) if not held)
+    return ()
+
+
+def load_armature_left_out(path: str | Path) -> tuple[str, ...]:
+    """:func:`armature_left_out` as the file ``path`` records it (``armature_left_out``;
+    empty in a file without it)."""
+    return tuple(load_document(path, FEASIBLE).get("armature_left_out") or ())
+
+
+def armature_left_out_note(
+    joint_names: Sequence[str], drive: Drive | None, left_out: Sequence[str]
+) -> str | None:
+    """The one sentence a robot export says of the rotor inertias ``left_out``
+    (:func:`armature_left_out`) of ``drive``: the joints whose armature
+    ``diag(K^T diag(I_a) K)`` [kg m^2] is 0 and that a rotor left out turns, named; None
+    when there are none (no drive, nothing left out, or every such joint holds another
+    rotor's inertia)."""
+    if drive is None or not left_out:
+        return None
+    ia = np.zeros(drive.n) if drive.rotor_inertia is None else np.asarray(drive.rotor_inertia)
+    armature = np.diagonal(drive.rotor_mass_matrix(ia))
+    gone = [k for k, lab in enumerate(drive.rotor_labels) if lab in left_out]
+    K = np.asarray(drive.transmission)
+    joints = [j for j in range(len(joint_names)) if armature[j] == 0.0 and K[gone, j].any()]
+    if not joints:
+        return None
+    holds = "that joint holds" if len(joints) == 1 else "those joints hold"
+    return (
+        f"armature (rotor inertia) 0 at {', '.join(joint_names[j] for j in joints)}: the "
+        f"identified structure left {', '.join(drive.rotor_labels[k] for k in gone)} out, "
+        f"which the data did not determine, so {holds} the links' inertia alone; the other "
+        "joints' armature is the one identified"
+    )
 
 
 def load_feasible_column_map(path: str | Path) -> dict[str, Any] | None:

@@ -6,18 +6,25 @@ feasible stage. The robots carry the friction of the fitted model
 (:func:`~dynid.io.feasible.fitted_robot`): the one a one-step fit identified with the links
 (the law of its structure, at the joints or, with a drive whose friction acts there, at the
 motors, or both), none when it fitted a torque log without friction, else the input robot's.
+Rotor inertias the identified structure left out while it kept others are 0 in the robot
+files: one note names their joints, and each file says so at its top
+(:func:`~dynid.io.feasible.armature_left_out_note`).
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from ..feasibility.result import FeasibleResult
 from ..identification.structural import combined_notes
+from ..progress import NOTE
 from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
 from .feasible import (
+    armature_left_out,
+    armature_left_out_note,
     combined_coefficients,
     fitted_robot,
     rejection_caveat,
@@ -28,6 +35,8 @@ from .feasible import (
 from .report_json import save_report_json
 
 __all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
+
+_log = logging.getLogger(__name__)
 
 #: The files :func:`save_feasible_bundle` writes, in order: feasible.json, one robot file
 #: per export format (:data:`~dynid.io.export.ROBOT_FORMATS`: robot.urdf, robot.xml,
@@ -86,12 +95,17 @@ def save_feasible_bundle(
     caveats = ([] if reason is None else [rejection_caveat(reason)]) + list(notes[:1])
     if unknown_scale is not None:
         caveats.append(unknown_scale_caveat(str(unknown_scale.get("finding", ""))))
+    robot = fitted_robot(result)
+    left = armature_left_out_note(robot.joint_names, result.drive, armature_left_out(result))
+    if left is not None:  # one note for the three robot files, and a line atop each
+        _log.log(NOTE, "robot files: %s", left)
+        caveats.append(left)
     options = ExportOptions(
         friction=friction,
         drive=result.drive,
         source=files[0].name,
         caveat="; ".join(caveats) if caveats else None,
     )
-    files += save_robot_files(folder, fitted_robot(result), options)
+    files += save_robot_files(folder, robot, options)
     files.append(save_report_json(folder / "report.json", result, **report_extra))
     return files

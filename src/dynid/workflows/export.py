@@ -20,11 +20,16 @@ command applies, so that the Python API behaves as the command does.
   (:mod:`dynid.friction.mujoco_soft`); how far ``mj_inverse``'s friction is from the
   law's near velocity reversals is said in a warning, and ``frictionloss=False`` leaves
   it out.
+* Rotor inertias a ``feasible.json``'s identified structure left out while it kept
+  others (``armature_left_out``: the data did not determine them) are written as 0: one
+  note names their joints, and the file says so at its top
+  (:func:`~dynid.io.feasible.armature_left_out_note`).
 """
 
 from __future__ import annotations
 
 import json
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -36,16 +41,25 @@ from ..friction.mujoco_soft import MOTION_STEP_S
 from ..io.drive_file import load_drive
 from ..io.excitation import load_trajectory
 from ..io.export import EXPORT_FORMATS, ROBOT_FORMATS, export_format, model_terms_of
-from ..io.feasible import load_fit_rejection, load_unknown_scale_caveat, rejection_caveat
+from ..io.feasible import (
+    armature_left_out_note,
+    load_armature_left_out,
+    load_fit_rejection,
+    load_unknown_scale_caveat,
+    rejection_caveat,
+)
 from ..io.robot.export_options import Along, ExportOptions
 from ..io.robot.urdf_patch import MERGED_POLICIES
 from ..io.robot_file import ROBOT_FILE_SUFFIXES, load_robot
 from ..model.builtin import BUILTIN_ROBOTS
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import NOTE
 from .options import check_choice
 
 __all__ = ["ExportRobotOptions", "RobotExport", "export_robot"]
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,6 +196,7 @@ def export_robot(
     linear, drive = model_terms_of(params, robot.n)
     if opt.drive is not None:
         drive = opt.drive if isinstance(opt.drive, Drive) else load_drive(opt.drive, robot.n)
+    left = None if opt.drive is not None else _armature_left_out(params, robot, drive)
     friction: Any = opt.friction
     if linear is not None and opt.friction:
         friction = linear
@@ -197,7 +212,7 @@ def export_robot(
         all_frames=opt.all_frames,
         drive=drive,
         source=_friction_source(params, linear is not None and opt.friction),
-        caveat=_caveat(params, rejected),
+        caveat="; ".join(c for c in (_caveat(params, rejected), left) if c) or None,
         frictionloss=opt.frictionloss,
         along=_along(opt.trajectory, robot.n),
     )
@@ -267,6 +282,20 @@ def _caveat(params: str | Path, rejected: str | None) -> str | None:
     if path.suffix.lower() == ".json" and path.exists():
         said += [c for c in (load_unknown_scale_caveat(path),) if c is not None]
     return "; ".join(said) or None
+
+
+def _armature_left_out(params: str | Path, robot: Robot, drive: Drive | None) -> str | None:
+    """The note of the rotor inertias a ``feasible.json``'s identified structure left out
+    while it kept others (:func:`~dynid.io.feasible.armature_left_out_note`: the joints
+    written with armature 0), said once and returned for the file's top; None for other
+    robots, or nothing left out."""
+    path = Path(params)
+    if path.suffix.lower() != ".json" or not path.exists():
+        return None
+    note = armature_left_out_note(robot.joint_names, drive, load_armature_left_out(path))
+    if note is not None:
+        _log.log(NOTE, "%s", note)
+    return note
 
 
 def _check_accepted(params: str | Path, allowed: bool) -> str | None:
