@@ -409,7 +409,7 @@ def test_held_out_gains_equal_a_plain_computation_on_the_explicit_rows(panda):
 
 def _factors_said(words: str, unit: str = "motor") -> dict[int, tuple[float, float]]:
     """The factors and uncertainties a ``torque constants:`` line reads, by motor from 1."""
-    found = re.findall(rf"{unit} (\d+)'s ([0-9.]+) \+- ([0-9.e-]+)", words)
+    found = re.findall(rf"{unit} (\d+) ([0-9.]+) \+- ([0-9.e-]+)", words)
     return {int(k): (float(f), float(u)) for k, f, u in found}
 
 
@@ -432,15 +432,15 @@ def test_the_constants_line_says_what_the_data_check_and_what_they_cannot(panda)
     assert found is not None and found.constants_words() is None  # torques: no line
     current = dataclasses.replace(found, effort="current", per="motor")
     words = current.constants_words()
-    assert words is not None and words.startswith("torque constants: the data check")
+    assert words is not None and words.startswith("torque constants: the true torque_constant over")
     read = _factors_said(words)
     assert set(read) == {1, 2, 3, 4, 5, 6}, words
     for k, (f, u) in read.items():
         assert abs(f - truth[k - 1]) <= max(5 * u, 0.02) and abs(f - truth[k - 1]) < 0.02, words
     assert abs(1 - read[2][0]) > 5 * read[2][1]  # off 1 by more than its uncertainty allows
-    assert "motor(s) 2 not named: within 10 % of 1" in words
-    assert "scaled by the description's masses, which the data do not check" in words
-    assert "the data cannot check motor(s) 7: their torques are as right as the drive" in words
+    assert "no change to the drive file for motor(s) 2: it is within 10 % of 1" in words
+    assert "on the scale of the description's masses, which the data do not check" in words
+    assert "not checked by these data: motor(s) 7, whose torques are as right as the" in words
     assert "(a known payload or a torque sensor checks them)" in words
     assert words.endswith("(docs: tutorials/motor-currents.md#what-the-data-check)")
     assert current.as_dict()["constants"] == words

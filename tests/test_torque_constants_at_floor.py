@@ -230,12 +230,12 @@ def test_the_constants_line_says_a_factor_clear_of_1_in_sample_and_why_not_named
     k = 3  # joint 4: the drive file's constant is the true one
     assert abs(gains.factor[k] - 1.0) > 5 * gains.std[k]  # clear of 1 in-sample
     assert abs(gains.factor[k] - 1.0) < 3 * gains.heldout_std[k]  # not over the folds
-    assert f"joint 4's {gains.factor[k]:.3g} +- {gains.heldout_std[k]:.2g} (over the folds" in words
-    said = re.search(r"joint\(s\) ([\d, ]+) not named: ([^;]+)", words)
+    assert f"joint 4 {gains.factor[k]:.3g} +- {gains.heldout_std[k]:.2g} (over the folds" in words
+    said = re.search(r"no change to the drive file for joint\(s\) ([\d, ]+): ([^;]+)", words)
     assert said is not None and "4" in said[1].split(", "), words
-    assert "within 10 % of 1, the least" in said[2]
-    assert "within 5 of its spreads over the folds of 1" in said[2]
-    assert "cannot check joint(s) 5, 6, 7: their torques are as right as the drive file's" in words
+    assert "it is within 10 % of 1" in said[2]
+    assert "at the noise floor it is within 5 times its spread over the folds of 1" in said[2]
+    assert "not checked by these data: joint(s) 5, 6, 7, whose torques are as right" in words
 
 
 def test_validate_and_identify_print_the_constants_line(fits, other_currents, tmp_path, capsys):
@@ -250,11 +250,11 @@ def test_validate_and_identify_print_the_constants_line(fits, other_currents, tm
     assert main([*argv, "--no-figures", "--out", str(tmp_path / "v")]) == 0
     out = capsys.readouterr().out.splitlines()
     verdict = next(i for i, line in enumerate(out) if line.startswith("verdict: "))
-    assert out[verdict + 1].startswith("torque constants: the data check the torque_constant")
+    assert out[verdict + 1].startswith("torque constants: the true torque_constant over the drive file's")
     doc = json.loads((tmp_path / "v" / "validation.json").read_text())
     assert doc["drive_gains"]["constants"] == out[verdict + 1]
     page = (tmp_path / "v" / "report.html").read_text()
-    assert "Torque constants: the data check the torque_constant of joint(s)" in page
+    assert "Torque constants: the true torque_constant over the drive file" in page
     kt = ", ".join(f"{x:.17g}" for x in KT * np.asarray(NEAR))
     drive = tmp_path / "drive.toml"
     drive.write_text(
@@ -266,8 +266,8 @@ def test_validate_and_identify_print_the_constants_line(fits, other_currents, tm
     assert main(argv) == 0
     out = capsys.readouterr().out.splitlines()
     verdict = next(i for i, line in enumerate(out) if line.startswith("held-out verdict"))
-    assert out[verdict + 1].startswith("torque constants: the data check")
+    assert out[verdict + 1].startswith("torque constants: the true torque_constant")
     doc = json.loads((tmp_path / "i" / "heldout.json").read_text())
     assert doc["drive_gains"]["constants"] == out[verdict + 1]
     page = (tmp_path / "i" / "report.html").read_text()
-    assert "Torque constants: the data check" in page
+    assert "Torque constants: the true torque_constant" in page

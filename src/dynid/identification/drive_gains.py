@@ -326,14 +326,14 @@ class DriveGains:
         said = []
         if d < OFF:
             said.append(
-                f"within {100 * OFF:g} % of 1, the least a factor is named at"
-                + (" (their common scale is the description's masses')" if self.scaled else "")
+                f"it is within {100 * OFF:g} % of 1"
+                + (" (the description's masses are rarely truer)" if self.scaled else "")
             )
         spread = np.inf if self.heldout_std is None else float(self.heldout_std[k])
         if self.floor and not d >= SIGNIFICANT * spread:
             said.append(
-                f"the fit is at the noise floor and it lies within {SIGNIFICANT:g} of its "
-                "spreads over the folds of 1"
+                f"at the noise floor it is within {SIGNIFICANT:g} times its spread over the "
+                "folds of 1"
             )
         if said:
             return ", and ".join(said)
@@ -361,20 +361,20 @@ class DriveGains:
             return None
         unit, std, spread = self.per, self.std, self.heldout_std
         checked = np.flatnonzero(self.determined)  # the uncertainty each is read with: _read
-        parts = [f"these data check no {unit}'s"]
+        parts = [f"these data check no {unit}'s constant"]
         if checked.size:
             reads = ", ".join(
-                f"{unit} {k + 1}'s " + _read(float(self.factor[k]), float(std[k]), spread, int(k))
+                f"{unit} {k + 1} " + _read(float(self.factor[k]), float(std[k]), spread, int(k))
                 for k in checked
             )
             scale = (
-                "scaled by the description's masses, which the data do not check"
+                "on the scale of the description's masses, which the data do not check"
                 if self.scaled
                 else "relative to each other, their common scale not known"
             )
             parts = [
-                f"the data check the torque_constant of {unit}(s) {_ids(checked)} (the true "
-                f"one over the drive file's): {reads}, {scale}"
+                f"the true torque_constant over the drive file's, read from the data {scale}: "
+                f"{reads}"
             ]
         if self.named:
             parts.append(f"{unit}(s) {_ids(self.named)} named above, with the fix")
@@ -383,12 +383,15 @@ class DriveGains:
         for k in checked:
             if d[k] >= SIGNIFICANT * std[k] and k not in self.named:
                 why.setdefault(self.unnamed_reason(int(k)), []).append(int(k))
-        parts += [f"{unit}(s) {_ids(ks)} not named: {reason}" for reason, ks in why.items()]
+        parts += [
+            f"no change to the drive file for {unit}(s) {_ids(ks)}: {reason}"
+            for reason, ks in why.items()
+        ]
         if self.unknown_scale:
             parts.append(
-                f"the data cannot check {unit}(s) {_ids(self.unknown_scale)}: their torques are "
-                "as right as the drive file's constants (a known payload or a torque sensor "
-                "checks them)"
+                f"not checked by these data: {unit}(s) {_ids(self.unknown_scale)}, whose "
+                "torques are as right as the drive file's constants (a known payload or a "
+                "torque sensor checks them)"
             )
         return f"torque constants: {'; '.join(parts)} ({CONSTANTS_DOC})"
 
