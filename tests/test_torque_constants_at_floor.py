@@ -250,7 +250,9 @@ def test_validate_and_identify_print_the_constants_line(fits, other_currents, tm
     assert main([*argv, "--no-figures", "--out", str(tmp_path / "v")]) == 0
     out = capsys.readouterr().out.splitlines()
     verdict = next(i for i, line in enumerate(out) if line.startswith("verdict: "))
-    assert out[verdict + 1].startswith("torque constants: the true torque_constant over the drive file's")
+    assert out[verdict + 1].startswith(
+        "torque constants: the true torque_constant over the drive file's"
+    )
     doc = json.loads((tmp_path / "v" / "validation.json").read_text())
     assert doc["drive_gains"]["constants"] == out[verdict + 1]
     page = (tmp_path / "v" / "report.html").read_text()
