@@ -131,3 +131,27 @@ def test_a_log_with_some_other_family_keeps_the_naming_hint(tmp_path, capsys):
     line = _error(argv, capsys)
     assert "present but unused: sig1..sig7" in line and "name the columns" in line, line
     assert "holds no joint torques" not in line, line
+
+
+def test_units_without_columns_get_the_whole_map_with_the_units_given(tmp_path, capsys):
+    """Regression (a Kortex trial: ``--units 't=us,q=deg,dq=deg/s,tau=-1'`` without
+    ``--columns`` on ``timestamp_us, joint_0_position_deg, ...`` got only "map them with
+    --columns"): the hint is the ready-made map with the user's --units kept, and pasted it
+    reads the file (positions from degrees, torques negated, times from microseconds)."""
+    signals = ("position_deg", "velocity_degps", "torque_Nm")
+    header = ["timestamp_us", *(f"joint_{j}_{s}" for s in signals for j in range(N))]
+    rng = np.random.default_rng(5)
+    t_us = np.arange(300) * 1000.0
+    body = np.column_stack([t_us, rng.normal(0.0, 20.0, (300, 3 * N))])
+    path = tmp_path / "rec.csv"
+    np.savetxt(path, body, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+    units = "t=us,q=deg,dq=deg/s,tau=-1"
+    argv = ["identify", "--robot", "panda", "--data", str(path), "--units", units]
+    line = _error([*argv, "--out", str(tmp_path / "o")], capsys)
+    pasted = _pasted(line)
+    assert pasted[0] == "--columns" and pasted[2:] == ["--units", units], line
+    log = load_mapped_torque_log(path, parse_column_map(pasted[1], pasted[3])).log
+    np.testing.assert_allclose(log.t, t_us * 1e-6, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(log.q, np.deg2rad(body[:, 1 : 1 + N]), rtol=1e-15)
+    np.testing.assert_allclose(log.dq, np.deg2rad(body[:, 1 + N : 1 + 2 * N]), rtol=1e-15)
+    np.testing.assert_array_equal(log.tau, -body[:, 1 + 2 * N :])

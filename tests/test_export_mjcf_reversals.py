@@ -20,9 +20,11 @@ from dynid.cli.__main__ import main
 from dynid.exceptions import DynidWarning
 from dynid.friction.laws import law_named
 from dynid.friction.mujoco_soft import SoftFrictionLoss, frictionloss_slope, mujoco_dry_friction
+from dynid.identification.log import TorqueLog
 from dynid.io.excitation import load_trajectory
 from dynid.io.robot.export_options import Along
 from dynid.io.robot.mjcf import mjcf_from_robot
+from dynid.io.torque_log import save_torque_log
 
 from conftest import mujoco_inverse
 
@@ -182,3 +184,24 @@ def test_trajectory_is_an_mjcf_option(tmp_path, capsys):
     assert "mj_inverse's friction (frictionloss is " in capsys.readouterr().err
     assert main([*argv, "--out", str(tmp_path / "p.urdf")]) == 2
     assert "--trajectory applies to an MJCF export only" in capsys.readouterr().err
+
+
+def test_a_torque_log_given_as_trajectory_is_told_what_the_option_takes(tmp_path, capsys):
+    """Regression (an xArm7 trial: `export --trajectory log_val.csv` said only "missing
+    column(s) ddq1..." with no word of the file it expects): a torque log is named as one
+    and the hint names excite's trajectory.csv (t, q, dq, ddq) or .json; the motion
+    written in that format is then read and measured along."""
+    robot = dynid.panda()
+    traj = tmp_path / "trajectory.csv"
+    t, q, dq, ddq = _trajectory_csv(traj, robot)
+    log = tmp_path / "log_val.csv"
+    save_torque_log(log, TorqueLog(t, q, dq, np.zeros_like(q)))
+    argv = ["export", "--params", "panda", "--out", str(tmp_path / "p.xml")]
+    assert main([*argv, "--trajectory", str(log)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert "missing column(s) ddq1, ddq2" in line, line
+    assert "it is a torque log (tau1..tau7), not a trajectory" in line, line
+    assert "hint: --trajectory takes the trajectory.csv (t, q1..q7, dq1..dq7, ddq1..ddq7)" in line
+    assert "or trajectory.json that dynid excite writes" in line, line
+    assert main([*argv, "--trajectory", str(traj)]) == 0
+    assert "along trajectory.csv (2400 samples)" in capsys.readouterr().err

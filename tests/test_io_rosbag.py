@@ -404,6 +404,57 @@ def test_a_ros1_bag_given_to_data_names_the_import_that_converts_it(tmp_path, ca
     np.testing.assert_allclose(back.t, log.t, atol=1e-9)
 
 
+_TWO_LEAVES = """<robot name="two">
+  <link name="world"/>
+  <link name="upper"><inertial><origin xyz="0 0 0.15"/><mass value="2.0"/>
+    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.004"/></inertial></link>
+  <link name="lower"><inertial><origin xyz="0.1 0 0"/><mass value="1.0"/>
+    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <link name="camera"><inertial><mass value="0.3"/>
+    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>
+  <joint name="shoulder" type="revolute"><parent link="world"/><child link="upper"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="50" velocity="3"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="lower"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>
+    <limit lower="-2" upper="2" effort="30" velocity="3"/></joint>
+  <joint name="pan" type="revolute"><parent link="world"/><child link="camera"/>
+    <origin xyz="0.2 0 0.05"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="5" velocity="3"/></joint>
+</robot>
+"""
+
+
+@pytest.mark.parametrize("folder", [False, True], ids=["bag", "folder-of-bags"])
+def test_the_suggested_import_keeps_the_robot_options_given(tmp_path, capsys, folder):
+    """Regression (a Baxter trial: identify --robot baxter.urdf --base ... --tip ... --data
+    train1.bag suggested 'dynid import train1.bag --robot ROBOT', which on that URDF of
+    many leaves failed with "several leaf links"): the suggestion carries the --robot,
+    --base and --tip typed, and the bag as given, and run as given it writes the log the
+    bag holds (joints matched by the chain's names)."""
+    urdf = tmp_path / "two.urdf"
+    urdf.write_text(_TWO_LEAVES)
+    names = ["shoulder", "elbow"]
+    rng = np.random.default_rng(4)
+    t = np.arange(40) * 1e-2
+    q, dq, tau = (rng.normal(size=(40, 2)) for _ in range(3))
+    stamps = [T0_NS + int(round(x * 1e9)) for x in t]
+    msgs = [(s + 1000, s, names, q[k], dq[k], tau[k]) for k, s in enumerate(stamps)]
+    (tmp_path / "logs").mkdir()
+    bag = write_bag(tmp_path / "logs" / "train1.bag", "ros1", msgs)
+    robot = ["--robot", str(urdf), "--base", "world", "--tip", "lower"]
+    data = str(bag.parent if folder else bag)
+    argv = ["identify", *robot, "--data", data, "--out", str(tmp_path / "o")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    command = err.split("'dynid ")[1].split("'")[0]
+    out = tmp_path / "train1.csv"
+    assert command == f"import {bag} {' '.join(robot)} --out train1.csv", err
+    assert main([*command.split()[:-1], str(out), "-q"]) == 0
+    back = load_torque_log(out)
+    np.testing.assert_array_equal(back.tau, tau)
+    np.testing.assert_array_equal(back.q, q)
+
+
 def test_import_labels_the_effort_with_the_drives_unit(tmp_path, capsys):
     """Regression: dynid import wrote 'tau [N m]' on the units line of motor currents; with
     a --drive whose effort is current it writes 'tau [A]' (which identify refuses to read

@@ -345,8 +345,10 @@ def _main(argv: Sequence[str] | None) -> int:
     say = f"dynid {args.command}"
     record = RunRecord()
     console = Console(args.command, quiet=args.quiet, verbose=args.verbose, record=record)
+    given: frozenset[str] = frozenset()
     try:
-        check_applies(args, given_options(parser, argv), args._applies)
+        given = given_options(parser, argv)
+        check_applies(args, given, args._applies)
         with (
             record,
             _signals_and_warnings(console),
@@ -380,7 +382,8 @@ def _main(argv: Sequence[str] | None) -> int:
     except (DynidError, OSError) as exc:
         if args.debug:
             raise
-        print(f"{say}: error: {one_line(_message(exc, args), ERROR_LINE_LIMIT)}", file=_stderr())
+        said = one_line(_message(exc, args, given), ERROR_LINE_LIMIT)
+        print(f"{say}: error: {said}", file=_stderr())
         return 2
     except MemoryError as exc:
         if args.debug:
@@ -398,19 +401,24 @@ def _main(argv: Sequence[str] | None) -> int:
         return 2
 
 
-def _message(exc: BaseException, args: argparse.Namespace | None = None) -> str:
+def _message(
+    exc: BaseException, args: argparse.Namespace | None = None, given: frozenset[str] = frozenset()
+) -> str:
     """An error's line: an option named by its flag (:func:`dynid.cli.common.flag`); a
-    missing input file named with its option (:func:`dynid.cli.common.missing_input`)."""
+    missing input file named with its option (:func:`dynid.cli.common.missing_input`); a
+    suggested ``dynid import`` given the robot options typed (``given``:
+    :func:`dynid.cli.common.import_robot`)."""
     if isinstance(exc, OptionError):
         from .common import option_message
 
         return option_message(exc)
-    from .common import cli_text, missing_input
+    from .common import cli_text, import_robot, missing_input
 
     if isinstance(exc, FileNotFoundError) and exc.filename is not None:
         said = None if args is None else missing_input(args, exc.filename)
         return said or f"{Path(exc.filename).name}: {exc.filename} does not exist"
-    return cli_text(str(exc))
+    text = cli_text(str(exc))
+    return text if args is None else import_robot(text, args, given)
 
 
 #: What makes each command's memory smaller, for the out-of-memory hint (the commands that

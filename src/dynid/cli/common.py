@@ -87,6 +87,28 @@ def missing_input(args: argparse.Namespace, filename: str | Path) -> str | None:
     return None
 
 
+#: The options of a run that ``dynid import`` takes too: its robot's and drive's.
+IMPORT_ROBOT_OPTIONS = ("robot", "base", "tip", "snap_angles", "drive")
+
+
+def import_robot(message: str, args: argparse.Namespace, given: frozenset[str]) -> str:
+    """``message`` with each ``dynid import`` it suggests given the robot options the run
+    was typed with (:data:`IMPORT_ROBOT_OPTIONS` among ``given``, their values ``args``'):
+    ``dynid import train1.bag --robot arm.urdf --base b --tip t --out train1.csv``, the
+    chain the run reads (:func:`dynid.workflows.data_files.with_import_robot`)."""
+    if "dynid import" not in message:
+        return message
+    from ..workflows.data_files import with_import_robot
+
+    options: list[str] = []
+    for name in IMPORT_ROBOT_OPTIONS:
+        value = getattr(args, name, None)
+        if name not in given or value is None or value is False:
+            continue
+        options += [flag(name)] if value is True else [flag(name), str(value)]
+    return with_import_robot(message, options)
+
+
 def cli_text(message: str) -> str:
     """A library message as the command line says it: a Python option in a hint,
     ``(drop_invalid=True)``, becomes its flag, and a flag the message already names is

@@ -49,6 +49,7 @@ __all__ = [
     "BINS",
     "acceleration_led",
     "at_standstill",
+    "cannot_hold_note",
     "Dependence",
     "dependence_hint",
     "friction_left_out",
@@ -347,16 +348,19 @@ _INERTIA_REMEDY = (
 )
 
 
-def _constant(d: Dependence, head: str, offset: tuple[str, bool] | None) -> str:
+def _constant(
+    d: Dependence, head: str, offset: tuple[str, bool] | None, lacks: str | None = None
+) -> str:
     """Joint ``d``'s residual that is a constant over the samples judged, in words, told
     with the model's own offset (``offset``: its label and whether the model holds it,
     :func:`offsets_of`): an offset the structure chosen on held-out data left out, or one
     the model holds, is no offset the fit missed but a level that changes along the motion
     (the Panda's last 1.1 s of a 5 s log: 0.21 N m on joint 4, whose true friction has no
-    offset)."""
+    offset); ``lacks``: the robot file the model was read from, which holds no offset
+    (``"a URDF"``)."""
     said = f"{head}{abs(d.mean):.2g} of {d.rms:.2g} N m RMS residual is a constant"
     if offset is None:
-        return f"{said} (an offset)"
+        return f"{said} (an offset{'' if lacks is None else f', which {lacks} cannot hold'})"
     label, held = offset
     why = (
         f"beyond the model's offset {label}"
@@ -379,6 +383,7 @@ def _sentence(
     left_out: Mapping[int, tuple[str, ...]] | None = None,
     inertia: str | None = None,
     still_as: str | None = None,
+    lacks: str | None = None,
 ) -> str:
     """One joint's diagnosis in words (a residual that concentrates at standstill first:
     the holding torque at rest, its why said once, ``still_as`` the joint it was said
@@ -393,7 +398,10 @@ def _sentence(
     ``left_out`` its friction coefficients left out per joint (:func:`friction_left_out`):
     a residual that follows the velocity there is that friction, not one the law misses
     (a model fitted to two FR3 recordings of opposite signs on joint 7 had dropped fv7 and
-    fc7, and its validation had suggested comparing the laws)."""
+    fc7, and its validation had suggested comparing the laws); ``lacks``: the robot file
+    the model was read from, which holds no offset and no friction beyond viscous and
+    Coulomb (``"a URDF"``), named with a constant residual and one that follows the
+    velocity (:func:`cannot_hold_note`)."""
     head = f"{name}: "
     if still_led(d):
         said = (
@@ -455,11 +463,12 @@ def _sentence(
     if d.velocity >= FOLLOWS * d.systematic:
         return (
             f"{head}{d.velocity:.2g} of {d.rms:.2g} N m RMS residual follows its velocity "
-            "(friction the law misses; dynid friction compares the laws on held-out data, "
-            "and --terms of dynid identify takes the one it chooses)"
+            f"(friction the law misses{'' if lacks is None else f' or {lacks} cannot hold'}; "
+            "dynid friction compares the laws on held-out data, and --terms of dynid "
+            "identify takes the one it chooses)"
         )
     if abs(d.mean) >= FOLLOWS * d.systematic:
-        return _constant(d, head, (offsets or {}).get(d.joint))
+        return _constant(d, head, (offsets or {}).get(d.joint), lacks)
     return (
         f"{head}of {d.rms:.2g} N m RMS residual, {d.position:.2g} follows its position and "
         f"{d.velocity:.2g} its velocity: the rest depends on other joints' motion"
@@ -544,6 +553,7 @@ def dependence_hint(
     left_out: Mapping[int, tuple[str, ...]] | None = None,
     ddq: Sequence[NDArray[np.float64]] | None = None,
     inertia: str | None = None,
+    lacks: str | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -564,7 +574,10 @@ def dependence_hint(
     per joint (:func:`friction_left_out`), named where the residual follows the velocity;
     ``ddq``: the accelerations [rad/s^2] at the samples (pieces as ``q``), with which a
     residual that follows them is said to be an inertia the model lacks (a rotor's),
-    ``inertia`` the remedy said where the caller knows it (a URDF holds no armature)."""
+    ``inertia`` the remedy said where the caller knows it (a URDF holds no armature);
+    ``lacks``: the robot file the model was read from (``"a URDF"``), whose missing
+    offsets and friction are named with the joints and said once after them
+    (:func:`cannot_hold_note`)."""
     if tilt is not None and tilt.named and tilt.rows.size == 0:
         return tilt.sentence()  # judged on other samples (a block's whole log): said alone
     if tilt is not None and tilt.named:
@@ -576,6 +589,7 @@ def dependence_hint(
         rest = dependence_hint(
             kept(q), kept(dq), [tilt.rest], noise_rms, joint_names, terms, offsets=offsets,
             left_out=left_out, ddq=None if ddq is None else kept(ddq), inertia=inertia,
+            lacks=lacks,
         )  # fmt: skip
         return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
     found = residual_dependence(q, dq, error, noise_rms, ratios, ddq)
@@ -586,14 +600,33 @@ def dependence_hint(
     for d in worst[:NAMED]:
         remedy = inertia if first is None else f"as for {first}"
         name = joint_names[d.joint]
-        clauses.append(_sentence(d, name, terms, springs, offsets, left_out, remedy, still))
+        clauses.append(_sentence(d, name, terms, springs, offsets, left_out, remedy, still, lacks))
         if first is None and acceleration_led(d) and not still_led(d):
             first = name
         if still is None and still_led(d):
             still = name
     said = "; ".join(clauses)
     more = len(worst) - NAMED
-    return said + (f" ({more} more joint(s) above their noise)" if more > 0 else "")
+    said += f" ({more} more joint(s) above their noise)" if more > 0 else ""
+    return said + ("" if lacks is None else cannot_hold_note(said, lacks))
+
+
+def cannot_hold_note(said: str, lacks: str) -> str:
+    """``; a URDF holds no torque offsets: validate ...``: what the robot file ``lacks``
+    (``"a URDF"``) cannot hold of what the joints' diagnoses ``said`` name (an offset, a
+    friction beyond viscous and Coulomb: :func:`dependence_hint`), and the model that
+    holds it; empty when they name neither."""
+    held = (
+        ("no torque offsets", f"an offset, which {lacks} cannot hold"),
+        ("no friction beyond viscous and Coulomb", f"misses or {lacks} cannot hold"),
+    )
+    what = [words for words, mark in held if mark in said]
+    if not what:
+        return ""
+    return (
+        f"; {lacks} holds {' and '.join(what)}: validate the identification's feasible.json "
+        "(--params) or identification.json (--model) for the full model"
+    )
 
 
 def round_off(
@@ -639,6 +672,7 @@ def with_dependence_hint(
     left_out: Mapping[int, tuple[str, ...]] | None = None,
     ddq: Sequence[NDArray[np.float64]] | None = None,
     inertia: str | None = None,
+    lacks: str | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself; with the
@@ -650,15 +684,15 @@ def with_dependence_hint(
     with the model, said for a spring's joint; ``offsets``: the model's offset per joint
     (:func:`offsets_of`), with which a constant residual is told; ``left_out``: its
     friction coefficients left out per joint (:func:`friction_left_out`); ``ddq`` and
-    ``inertia``: the accelerations and the remedy of a residual that follows them
-    (:func:`dependence_hint`)."""
+    ``inertia``: the accelerations and the remedy of a residual that follows them;
+    ``lacks``: the robot file the model was read from (:func:`dependence_hint`)."""
     if verdict.level == "good":
         return verdict
     if (exact := round_off(error, torques)) is not None:
         return with_hint(verdict, round_off_note(exact))
     said = dependence_hint(
         q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets, left_out,
-        ddq, inertia,
+        ddq, inertia, lacks,
     )  # fmt: skip
     return with_hint(verdict, said)
 

@@ -482,7 +482,11 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
                 f"no column the map names (templates "
                 f"{[cmap.template(k) for k in quantities]}); the file has {names[:12]}"
                 f"{'...' if len(names) > 12 else ''}"
-                + (import_hint(names, path.name) or "; hint: map them with --columns"),
+                + (
+                    import_hint(names, path.name)
+                    or _guessed_hint(names, path.name, cmap)
+                    or "; hint: map them with --columns"
+                ),
                 file=path.name,
                 at=f"line {line}",
             )
@@ -686,9 +690,35 @@ def _map_hint(table: _Table, cmap: ColumnMap, otherwise: str) -> str:
     templates given kept, :func:`~dynid.io.column_hint.guessed_map`), else ``otherwise``."""
     if hint := import_hint(table.header, table.name):
         return hint
-    guess = guessed_map(table.header, cmap.columns) if table.name.lower().endswith(".csv") else ""
-    units = " and the --units given" if cmap.names else ""
-    return f"; hint: {guess}{units} reads the file" if guess else otherwise
+    return _guessed_hint(table.header, table.name, cmap) or otherwise
+
+
+def _guessed_hint(header: Sequence[str], name: str, cmap: ColumnMap) -> str:
+    """``; hint: --columns '...' --units '...' reads the file``: the map guessed from a
+    CSV's header (:func:`~dynid.io.column_hint.guessed_map`, the templates given kept) with
+    the ``--units`` given kept and the units the names say added for the quantities
+    without one given; empty when nothing is guessed."""
+    guess = guessed_map(header, cmap.columns) if name.lower().endswith(".csv") else ""
+    if not guess:
+        return ""
+    spec, _, said = guess.partition(" --units ")
+    units = dict(e.split("=", 1) for e in said.strip("'").split(",") if "=" in e)
+    units.update(_given_units(cmap))
+    text = ",".join(f"{k}={v}" for k, v in units.items())
+    return f"; hint: {spec}" + (f" --units '{text}'" if text else "") + " reads the file"
+
+
+def _given_units(cmap: ColumnMap) -> dict[str, str]:
+    """The ``--units`` entries ``cmap`` was made from, key -> value as typed again
+    (``{"t": "us", "tau": "-1", "tau2": "-1", "rec2.csv:tau": "-1"}``): each quantity's
+    unit, each joint's and each file's sign flip; an entry that changed nothing
+    (``tau2=1``) is left out."""
+    out = dict(cmap.names)
+    out |= {f"{k}{j + 1}": "-1" for k, joints in cmap.flips.items() for j in joints}
+    for f, own in cmap.file_flips.items():
+        out |= {f"{f}:{k}{j + 1}": "-1" for k, joints in own.items() for j in joints}
+    out |= {f"{f}:{k}": "-1" for f, signs in cmap.file_signs.items() for k in signs}
+    return out
 
 
 @dataclass(frozen=True, slots=True)

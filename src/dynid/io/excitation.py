@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -409,7 +409,10 @@ def _trajectory_csv(path: Path, n: int) -> Trajectory:
         missing = [c for c in want if c not in names]
         if missing:
             raise DataError(
-                f"missing column(s) {_checks.names(missing)} for {n} joints", file=path.name, at=at
+                f"missing column(s) {_checks.names(missing)} for {n} joints"
+                + _not_a_trajectory(names, n),
+                file=path.name,
+                at=at,
             )
         unknown = [c for c in names if c not in want]
         if unknown:
@@ -432,6 +435,19 @@ def _trajectory_csv(path: Path, n: int) -> Trajectory:
         )
     except DynidError as exc:
         raise DataError(str(exc), file=path.name) from None
+
+
+def _not_a_trajectory(names: Sequence[str], n: int) -> str:
+    """``; ...`` for a trajectory CSV of header ``names`` that lacks columns: what a
+    trajectory file is (``dynid excite``'s ``trajectory.csv``, ``t, q, dq, ddq``, or its
+    ``trajectory.json``), said of a torque log (``tau`` columns) as such."""
+    log = any(re.fullmatch(r"tau[1-9]\d*", c) for c in names)
+    return (
+        f"; {f'it is a torque log (tau1..tau{n}), not a trajectory; ' if log else ''}hint: "
+        f"--trajectory takes the trajectory.csv (t, q1..q{n}, dq1..dq{n}, ddq1..ddq{n}) or "
+        "trajectory.json that dynid excite writes"
+        + (" (the one the log was recorded along)" if log else "")
+    )
 
 
 def _check_derived(tr: dict[str, Any], traj: ExcitingTrajectory, name: str) -> None:

@@ -19,6 +19,7 @@ import dataclasses
 import hashlib
 import logging
 import re
+import shlex
 import warnings
 import zipfile
 from collections.abc import Callable, Mapping, Sequence
@@ -60,6 +61,7 @@ __all__ = [
     "read_static_file",
     "read_torque_log",
     "recorded_columns",
+    "with_import_robot",
 ]
 
 _log = logging.getLogger(__name__)
@@ -235,8 +237,27 @@ def _bag_file_hint(path: Path) -> str:
         return ""
     name = bag.name or str(bag)
     return (
-        f"; it is {what}: convert it into a torque log with 'dynid import {name} --robot "
-        f"ROBOT --out {Path(name).stem}.csv' and give that file to --data"
+        f"; it is {what}: convert it into a torque log with 'dynid import {bag} {ROBOT} "
+        f"--out {Path(name).stem}.csv' and give that file to --data"
+    )
+
+
+#: The robot of a suggested ``dynid import`` in a message, for the caller to fill in
+#: (:func:`with_import_robot`).
+ROBOT = "--robot ROBOT"
+
+
+def with_import_robot(message: str, options: Sequence[str]) -> str:
+    """``message`` with the robot of each ``dynid import`` it suggests (:data:`ROBOT`)
+    given as ``options``: the run's own robot options as typed (``["--robot", "arm.urdf",
+    "--base", "b", "--tip", "t"]``), so that the import reads the same chain (a URDF of
+    several leaves needs its ``--tip``); unchanged without ``--robot`` among them."""
+    if "--robot" not in options:
+        return message
+    return re.sub(
+        r"(dynid import \S+ )" + re.escape(ROBOT),
+        lambda m: m.group(1) + shlex.join(options),
+        message,
     )
 
 
@@ -610,7 +631,7 @@ def _bag_hint(folder: Path) -> str:
         held = ", ".join(["metadata.yaml"] * (folder / "metadata.yaml").exists() + stores[:3])
         return (
             f": it is a ROS 2 bag ({held}); convert it into a torque log with "
-            f"'dynid import {folder.name} --robot ROBOT --out {folder.name}.csv' and give "
+            f"'dynid import {folder} {ROBOT} --out {folder.name}.csv' and give "
             "that file to --data"
         )
     bags = sorted(
@@ -622,7 +643,7 @@ def _bag_hint(folder: Path) -> str:
         return ""
     return (
         f": it holds ROS bag(s) {_checks.names(bags[:5])}; convert each into a torque log "
-        f"with 'dynid import {folder.name}/{bags[0]} --robot ROBOT --out {Path(bags[0]).stem}.csv' "
+        f"with 'dynid import {folder / bags[0]} {ROBOT} --out {Path(bags[0]).stem}.csv' "
         "and give those files to --data"
     )
 

@@ -77,18 +77,25 @@ class ResidualHints:
     load: ResidualLoad | None = None
 
 
-def terms_held(
-    model: IdentifiedModel | Robot, drive: Drive | None, label: str | None
-) -> tuple[frozenset[str], str | None]:
+#: The model's terms, the remedy of a residual that follows a joint's acceleration, and
+#: the robot file that holds no offsets (:func:`terms_held`).
+Held = tuple[frozenset[str], str | None, str | None]
+
+
+def terms_held(model: IdentifiedModel | Robot, drive: Drive | None, label: str | None) -> Held:
     """The terms ``model`` holds beside the rigid bodies
     (:func:`~dynid.identification.residual_dependence.held_terms`; ``armature`` too where
-    the ``drive`` placed has rotor inertias), and the remedy of a residual that follows
+    the ``drive`` placed has rotor inertias), the remedy of a residual that follows
     a joint's acceleration: :data:`URDF_INERTIA` for a robot read from a URDF (``label``
-    naming it) without an armature, else None (the remedy by the terms)."""
+    naming it) without an armature, else None (the remedy by the terms), and ``"a URDF"``
+    for such a robot, which holds no torque offsets and no friction beyond viscous and
+    Coulomb (:func:`~dynid.identification.residual_dependence.cannot_hold_note`), else
+    None."""
     rotors = drive is not None and drive.rotor_inertia is not None
     terms = held_terms(model) | ({"armature"} if rotors else frozenset())
     urdf = isinstance(model, Robot) and (label or "").lower().endswith(".urdf")
-    return terms, URDF_INERTIA if urdf and "armature" not in terms else None
+    inertia = URDF_INERTIA if urdf and "armature" not in terms else None
+    return terms, inertia, "a URDF" if urdf else None
 
 
 def residual_hints(
@@ -100,7 +107,7 @@ def residual_hints(
     names: Sequence[str],
     *,
     dependence: bool = True,
-    held: tuple[frozenset[str], str | None] = (frozenset(), None),
+    held: Held = (frozenset(), None, None),
     gains_too: bool = False,
     payload: str = "`dynid payload`",
 ) -> ResidualHints:
@@ -165,13 +172,13 @@ def _dependence_said(
     whole: Validation | None,
     noise: JudgedNoise,
     names: Sequence[str],
-    held: tuple[frozenset[str], str | None],
+    held: Held,
     payload: str,
 ) -> ResidualHints:
     """``verdict`` with the tilt of the gravity vector, the springs and the flange load
     fitted on the recordings joined (``whole``; None: at the noise floor, none), and what
     each joint's residual follows (on what the load leaves, where one is named)."""
-    terms, inertia = held
+    terms, inertia, lacks = held
     offsets, left_out = offsets_of(model), friction_left_out(model)
     q = [v.log.q for v in val.parts]
     dq = [v.log.dq for v in val.parts]
@@ -186,14 +193,14 @@ def _dependence_said(
         verdict = with_hint(verdict, load_hint(load, payload))
         rest = dependence_hint(
             q, dq, load.residual, noise.total, names, terms, offsets=offsets,
-            left_out=left_out, ddq=ddq, inertia=inertia,
+            left_out=left_out, ddq=ddq, inertia=inertia, lacks=lacks,
         )  # fmt: skip
         verdict = with_hint(verdict, None if rest is None else f"what it leaves: {rest}")
         return ResidualHints(verdict, None, None, tilt, load)  # the load, not a spring
     tau = [v.log.tau for v in val.parts]
     verdict = with_dependence_hint(
         verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
-        tau, offsets, left_out, ddq, inertia,
+        tau, offsets, left_out, ddq, inertia, lacks,
     )  # fmt: skip
     return ResidualHints(verdict, springs, None, tilt, load)
 
