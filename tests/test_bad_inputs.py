@@ -1022,7 +1022,7 @@ CASES = [
     C("trajectory-json-duration-edited", trajectory_json_edited, f"simulate --trajectory {{d}}/longer.json --out {OUT}/x.csv", 2, "longer.json: key 'trajectory.total_duration_s': expected 21 (from the coefficients; the file was edited: regenerate it with dynid excite); got 3"),
     C("toml-inertia-triangle", toml_inertia_triangle, "fk --robot {d}/tri.toml --q 0.1,0.2", 0, "the inertial is physically inconsistent: principal moments 0.01, 0.01, 0.05 kg m^2 violate the triangle inequality (0.01 + 0.01 < 0.05)"),
     # feasible.json read back by export: strict keys and types, sane masses and CoMs
-    C("feasible-unknown-key", feasible_edited, "export --params {d}/extra.json --out {d}/out.urdf", 2, "extra.json: key 'note': unknown key; allowed: column_map, combined, conventions, drive, dynid_version"),
+    C("feasible-unknown-key", feasible_edited, "export --params {d}/extra.json --out {d}/out.urdf", 2, "extra.json: key 'note': unknown key; allowed: armature_left_out, column_map, combined, conventions, drive"),
     C("feasible-kinematics-unknown-key", feasible_edited, "export --params {d}/kin.json --out {d}/out.urdf", 2, "kin.json: key 'kinematics.note': unknown key; allowed: T_parent_joint, axes"),
     C("feasible-flag-string", feasible_edited, "export --params {d}/yes.json --out {d}/out.urdf", 2, "yes.json: key 'feasible': expected true or false; got 'yes'"),
     C("feasible-mass-1e12", feasible_edited, "export --params {d}/heavy.json --out {d}/out.urdf", 2, "heavy.json: key 'links[0].mass': expected a number in [-1e+06, 1e+06] [kg]; got 1000000000000.0"),

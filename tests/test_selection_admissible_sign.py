@@ -71,18 +71,19 @@ def _candidate(relative: dict[str, float], signed: tuple[str, ...]) -> Candidate
     return replace(c, relative_std=tuple(relative.items()), admissible=signed)
 
 
-def test_only_a_signed_coefficient_above_zero_is_determined_at_three_std():
-    """At 25 % std (|t| = 4): an armature or a friction coefficient above zero is
-    determined; the same below zero, an offset (either sign) and a Stribeck bump are
-    not; at 40 % (|t| = 2.5) none is."""
+def test_only_an_armature_above_zero_is_determined_at_three_std():
+    """At 25 % std (|t| = 4): an armature above zero is determined; the same below zero,
+    a friction coefficient (whose standard deviation a low-passed log understates: see
+    the viscous-only Panda of test_smooth_stribeck_widths.py), an offset (either sign)
+    and a Stribeck bump are not; at 40 % (|t| = 2.5) none is."""
     labels = ("Ia5", "fv2", "jfc7", "fq3", "fo1", "fsp4")
     x = np.array([0.01, 0.2, 0.3, 0.05, 0.4, 0.1])
     use = np.ones(x.size, dtype=bool)
     signed = admissible(x, use, labels)
-    assert signed == ("Ia5", "fv2", "jfc7", "fq3")
+    assert signed == ("Ia5",)
     assert admissible(-x, use, labels) == ()
     at_four = _candidate(dict.fromkeys(labels, 25.0), signed)
-    assert set(at_four.determined()) == {"Ia5", "fv2", "jfc7", "fq3"}
+    assert set(at_four.determined()) == {"Ia5"}
     assert not _candidate(dict.fromkeys(labels, 25.0), ()).determined()
     assert not _candidate(dict.fromkeys(labels, 40.0), signed).determined()
     assert set(_candidate(dict.fromkeys(labels, 15.0), ()).determined()) == set(labels)

@@ -31,7 +31,7 @@ was not fitted to (one recording left out at a time when there are several, else
 contiguous time blocks, or --validate-on), with every joint's torques in units of its own
 noise, and the simplest within one standard error of the lowest held-out error (of the
 difference, paired over the folds) is kept, never without a coefficient the fit
-determines to 20 % (an armature or friction coefficient above zero to 33 %, 3 std: a wrist
+determines to 20 % (an armature above zero to 33 %, 3 std: a wrist
 armature whose torque the held-out error hardly sees, named under the choice). The
 summary prints the table of candidates
 (each smooth or Stribeck law at its best shape) and the choice, and the terms'

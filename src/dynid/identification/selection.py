@@ -24,9 +24,9 @@ that holds for the filtered log's coloured residual) is never left out that way:
 leaves when held-out data do not miss it **and** the fit cannot tell it from zero (a wrist
 armature whose torque stays within the noise at the training's accelerations, yet
 determined to 3 %, kept ``M(q)`` of the wrist right;
-:attr:`~.candidates.Selection.determined` names what was kept so). A coefficient whose
-sign physics fixes (an armature, a viscous, Coulomb or quadratic friction coefficient)
-fitted above zero is determined at three standard deviations,
+:attr:`~.candidates.Selection.determined` names what was kept so). An armature (a
+rotor's inertia, at least zero) fitted above zero is determined at three standard
+deviations,
 :data:`~dynid.identification.candidates.ADMISSIBLE_STD_PERCENT` (a Kinova Jaco2's wrist
 armatures at 31 % and 23 % had been left out, its ``M44`` and ``M66`` 53 % and 76 % low).
 A smooth Coulomb's width is then chosen per joint (:mod:`dynid.identification.widths`),
