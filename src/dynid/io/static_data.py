@@ -45,6 +45,7 @@ from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
 from ..model.robot import Robot
 from ..regressors.static import static_labels
 from .atomic import open_atomic
+from .column_hint import holdings, static_map
 from .input_files import regular_file
 from .json_files import dumps, loads
 from .npz_files import check_npz
@@ -258,6 +259,16 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
         raise DataError(
             f"duplicated columns {_checks.names(dup)}", file=path.name, at=f"line {line}"
         )
+    if robot is not None and (guess := static_map(header, robot.n)):
+        expected = static_columns(robot.n)
+        if any(c not in header for c in expected):  # another tool's names: the map that reads them
+            raise DataError(
+                f"the columns {holdings(header)} are not dynid's static format "
+                f"({_expected_hint(robot)}); hint: {guess} reads them ({{i0}}: joints from 0; "
+                "{k0}: M as one flat column-major array, k = i + n j from 0, as libfranka's)",
+                file=path.name,
+                at=f"line {line}",
+            )
     qcols = [c for c in header if re.fullmatch(r"q[1-9]\d*", c)]
     if not qcols:
         raise DataError(
