@@ -1028,20 +1028,26 @@ class MappedStatic:
 
 
 def load_mapped_static_data(
-    path: str | Path, columns: ColumnMap, robot: Robot | None = None, *, require_M: bool = True
+    path: str | Path,
+    columns: ColumnMap,
+    robot: Robot | None = None,
+    *,
+    require_M: bool = True,
+    drop_invalid: bool = False,
 ) -> MappedStatic:
     """Read static data ``q, M, g`` (CSV or NPZ) through a column map; SI out.
 
     ``M`` is read from the lower triangle ``i >= j`` (a column named by ``(i, j)`` or, when
     absent, by ``(j, i)``) and mirrored; NPZ arrays are taken whole. With
     ``require_M=False`` a file without ``M`` (gravity torques only) is read with ``M`` set
-    to zero, said in the notes.
+    to zero, said in the notes. With ``drop_invalid`` the rows holding NaN or inf are
+    dropped, said in the notes with their lines.
 
     Raises
     ------
     DataError
         Missing columns (named), a column named by two quantities' templates, a joint
-        count other than the robot's, NaN rows.
+        count other than the robot's, NaN rows (without ``drop_invalid``).
     """
     path = Path(path)
     table = _read_table(path, columns, ("q", "g", "M"))
@@ -1079,7 +1085,16 @@ def load_mapped_static_data(
     bad = ~(np.all(np.isfinite(q), 1) & np.all(np.isfinite(g), 1))
     bad |= ~np.all(np.isfinite(M.reshape(len(M), -1)), 1)
     if bad.any():
-        raise DataError(f"row {int(np.argmax(bad))} holds NaN or inf", file=path.name)
+        rows = np.flatnonzero(bad)
+        where = _where(rows, table.lines)
+        if not drop_invalid or rows.size == len(bad):
+            raise DataError(
+                f"{rows.size} row(s) hold NaN or inf ({where}); hint: fix the file or pass "
+                "--drop-invalid (drop_invalid=True) to drop such rows",
+                file=path.name,
+            )
+        q, M, g = q[~bad], M[~bad], g[~bad]
+        extra += (f"dropped {rows.size} row(s) holding NaN or inf of {len(bad)}: {where}",)
     said = conversion_notes(columns, list(columns.factors))
     try:  # a full matrix's triangles checked for symmetry, the file named
         data = StaticDataset(q, M, g, {"file": path.name})

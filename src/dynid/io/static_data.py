@@ -51,6 +51,7 @@ from .json_files import dumps, loads
 from .npz_files import check_npz
 
 __all__ = [
+    "data_row_lines",
     "static_columns",
     "save_static_data",
     "load_static_data",
@@ -432,8 +433,8 @@ def load_static_npz(
     if bad and not drop_invalid:
         first = min(bad, key=lambda b: int(b.split(":")[0].split()[1]))
         raise DataError(
-            f"{first} ({len(bad)} bad row(s) in all); hint: fix the file or load "
-            "with drop_invalid=True",
+            f"{first} ({len(bad)} bad row(s) in all); hint: fix the file or pass "
+            "--drop-invalid (drop_invalid=True) to drop such rows",
             file=path.name,
         )
     table = np.concatenate([q, M[:, i, j], g], axis=1)[ok]
@@ -473,3 +474,24 @@ def _npz_rows(path: Path, z: Any) -> int:
     if a.shape != () or not np.issubdtype(a.dtype, np.integer) or int(a) < 0:
         raise DataError(f"array 'n_rows' must be one integer >= 0; got {a!r}", file=path.name)
     return int(a)
+
+
+def data_row_lines(path: str | Path, n_rows: int) -> tuple[int, ...] | None:
+    """The line (from 1) of each data row of a CSV file of static data, dynid's or another
+    tool's: the lines after the header that are neither empty nor comments; None for an
+    NPZ file, or when the file holds another number of rows than ``n_rows`` (rows were
+    dropped as they were read: which ones, the lines cannot tell)."""
+    path = Path(path)
+    if path.suffix.lower() != ".csv":
+        return None
+    lines: list[int] = []
+    header = False
+    with path.open(encoding="utf-8-sig", errors="replace") as fh:
+        for k, raw in enumerate(fh, start=1):
+            s = raw.strip()
+            if not s or s.startswith("#"):
+                continue
+            if header:
+                lines.append(k)
+            header = True
+    return tuple(lines) if len(lines) == n_rows else None
