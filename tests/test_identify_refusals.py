@@ -60,7 +60,6 @@ def test_identify_refuses_what_does_not_apply_to_logs(logs, tmp_path, capsys, ex
     [
         (["--cutoff", "5"], "--cutoff"),
         (["--max-gap", "0.1"], "--max-gap"),
-        (["--keep-outlying"], "--keep-outlying"),
     ],
 )
 def test_identify_refuses_log_options_with_static_data(static, tmp_path, capsys, extra, flag):

@@ -307,7 +307,10 @@ def _add_heldout_options(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="several recordings: fit those found outlying too (default: a recording whose "
         "held-out error is far above the others', a payload or contacts the model lacks, is "
-        "left out of the structure's choice and of the final fit, and named in a warning)",
+        "left out of the structure's choice and of the final fit, and named in a warning); "
+        "static data: fit the configurations whose residual, predicted by the fit of the "
+        "others, stands far above the others' (a wrong q; default: left out, named with "
+        "their lines in a warning)",
     )
 
 

@@ -57,6 +57,7 @@ from ..workflows.retrieve import RetrieveOptions, retrieve_files
 from .applies import Applies, urdf_chain
 from .common import (
     add_consistency_options,
+    add_drop_invalid,
     add_robot_options,
     add_seed_option,
     add_subcommand,
@@ -79,6 +80,7 @@ _SEEDED = tuple(name for name, m in METHODS.items() if m.parallel)
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
 APPLIES = (
     Applies(("robot",), lambda a: a.static is not None, "--static", "--model holds its robot"),
+    Applies(("drop_invalid",), lambda a: a.static is not None, "--static", "--model holds no rows"),
     urdf_chain(),
     urdf_chain("prior", ("prior_base", "prior_tip")),
     Applies(
@@ -134,6 +136,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "capped, with a note)",
     )
     add_seed_option(p)
+    add_drop_invalid(p)
     p.add_argument(
         "--friction", type=Path, default=None, help="friction.json (sigmoid) to put on the robot"
     )

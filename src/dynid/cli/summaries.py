@@ -629,7 +629,7 @@ def format_retrieval(result: RetrievalResult) -> str:
         m = " ".join(f"{x:.3e}" for x in lam[i])
         mass = f"{r.mass[i]:.4f}{mk_m[i]}"
         lines.append(f"{name:<{w}}  {mass:>10}  {c:^29}  {m:^30}  {tri[i + 1]:>9.2e}")
-    lines += _prior_mark_line(r)
+    lines += _prior_mark_line(r, prior=False)
     status = "FEASIBLE" if r.feasible else "INFEASIBLE (least-violating solution)"
     lines += [
         f"total mass {float(np.sum(r.mass)):.4f} kg"
@@ -781,11 +781,20 @@ def _prior_marks(r: FeasibleResult) -> tuple[list[str], NDArray[np.str_]]:
     return [PRIOR_MARK if x else " " for x in mass], np.where(com, PRIOR_MARK, " ")
 
 
-def _prior_mark_line(r: FeasibleResult) -> list[str]:
-    """The line under the links' table saying what the mark means (none unmarked)."""
+def _prior_mark_line(r: FeasibleResult, *, prior: bool = True) -> list[str]:
+    """The line under the links' table saying what the mark means (none unmarked); of a
+    method without a prior (``prior=False``: the penalty method), that the value marked is
+    where its best run landed among the many that fit."""
     det = r.determined
     if det is None or det.n != r.robot.n or not any(det.by_prior[: 10 * det.n]):
         return []
+    if not prior:
+        return [
+            f"{PRIOR_MARK} not measured: the data give only combinations holding it (the base "
+            "parameters), and the penalty method uses no prior: its value is one of many that "
+            "fit them, where the best run landed (another --seed may land elsewhere); "
+            "unmarked: the data determine it"
+        ]
     share = (
         ""
         if det.prior_share is None

@@ -33,6 +33,7 @@ __all__ = [
     "missing_joints",
     "no_torques",
     "position_count",
+    "static_map",
     "time_column",
 ]
 
@@ -242,6 +243,60 @@ def _found(families: Sequence[str], signals: Sequence[str]) -> dict[str, str]:
                 found[signal] = fits[0]
                 break
     return found
+
+
+#: Names of static data's families (lower case, without separators), by dynid's name.
+STATIC_ALIASES: dict[str, tuple[str, ...]] = {
+    "q": ALIASES["q"],
+    "g": ("g", "gravity", "grav", "gravitytorque", "gravitytorques"),
+    "M": ("m", "mass", "massmatrix", "inertia", "inertiamatrix"),
+}
+
+
+def static_map(names: Sequence[str], n: int, given: Mapping[str, str] | None = None) -> str:
+    """The ``--columns`` map that reads static data of header ``names`` for an arm of
+    ``n`` joints: ``--columns 'q=q{i0},M=M{k0},g=g{i0}'`` for libfranka's dump (``q0..q6``,
+    the mass matrix as one flat column-major array ``M0..M48``, ``g0..g6``); the
+    templates ``given`` that name columns of the file kept; empty when ``q``, ``M`` or
+    ``g`` cannot be told (none, or several candidates) or the file needs no map.
+
+    ``q`` and ``g`` are families of ``n`` columns numbered ``1..n`` or ``0..n-1``; ``M`` a
+    family of ``n * n`` columns numbered ``0..n^2-1`` (``{k0}``) or ``1..n^2`` (``{k}``),
+    each of a name of :data:`STATIC_ALIASES` (case and separators aside).
+    """
+    have = set(names)
+    default = {"q": "q{i}", "M": "M{i}_{j}", "g": "g{i}"}
+
+    def present(key: str, tpl: str) -> bool:  # every column of the template there
+        if "{" not in tpl:
+            return tpl in have
+        pairs = [(i, j) for i in range(n) for j in range(i + 1)] if key == "M" else []
+        try:
+            if key != "M":
+                return all(tpl.format(i=i + 1, i0=i) in have for i in range(n))
+            return all(
+                any(
+                    tpl.format(i=a + 1, i0=a, j=b + 1, j0=b, k=a + n * b + 1, k0=a + n * b) in have
+                    for a, b in ((i, j), (j, i))
+                )
+                for i, j in pairs
+            )
+        except (KeyError, IndexError, ValueError):
+            return False
+
+    found = {k: v for k, v in (given or {}).items() if k in default and present(k, v)}
+    families = list(joint_families(names, n))
+    flat = [t.replace("{i0}", "{k0}").replace("{i}", "{k}") for t in joint_families(names, n * n)]
+    for key, candidates in (("q", families), ("g", families), ("M", flat)):
+        if key in found or present(key, default[key]):
+            continue
+        fits = [t for t in candidates if _root(t.replace("{k", "{i")) in STATIC_ALIASES[key]]
+        if len(fits) != 1:
+            return ""
+        found[key] = fits[0]
+    if not found or found == dict(given or {}):
+        return ""
+    return "--columns '" + ",".join(f"{k}={found[k]}" for k in default if k in found) + "'"
 
 
 def time_column(names: Sequence[str]) -> str | None:

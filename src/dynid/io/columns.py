@@ -6,7 +6,11 @@ A :class:`ColumnMap` names, per quantity, the column template of a file and its 
 * templates: ``{i}`` is the joint number from 1, ``{i0}`` from 0 (``position_{i0}``
   reads ``position_0 .. position_{n-1}``); ``M`` needs a row and a column index,
   ``{i}``/``{j}`` or ``{i0}``/``{j0}`` (either triangle, or both: a full matrix is
-  checked for symmetry by the data set). A quantity not mapped keeps dynid's name
+  checked for symmetry by the data set), or one flat index of the whole matrix, ``{k0}``
+  from 0 or ``{k}`` from 1, column-major (``k0 = i0 + n j0``, as libfranka's
+  ``std::array<double, 49>`` and Eigen store it: ``M=M{k0}`` reads ``M0 .. M48``; every
+  entry read, so symmetry is checked); a template of ``M`` with one index alone is
+  refused (it would read one column per row). A quantity not mapped keeps dynid's name
   (``q{i}``, ``tau{i}``, ``M{i}_{j}``, ...). In an NPZ file a template names an array;
 * units (converted to SI on reading): ``t`` in ``s, ms, us, ns``; ``q`` in ``rad, deg``
   (``m, mm`` for prismatic arms); ``dq`` in ``rad/s, deg/s``; ``ddq`` in ``rad/s^2,
@@ -59,7 +63,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
-from .column_hint import guessed_map, joint_families, no_torques
+from .column_hint import guessed_map, joint_families, no_torques, static_map
 from .csv_tables import csv_table
 from .input_files import file_text, regular_file
 from .joint_state_csv import import_hint
@@ -178,6 +182,8 @@ class ColumnMap:
         for key in list(self.columns) + list(self.factors):
             if key not in _DEFAULT:
                 raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
+        if "M" in self.columns:
+            _check_matrix_template(str(self.columns["M"]))
         for key, tpl in self.columns.items():
             if str(tpl).strip().lower() == IGNORED and key not in _IGNORABLE:
                 raise DataError(
@@ -325,6 +331,45 @@ class ColumnMap:
 
 #: The quantities whose single joints' columns ``--units`` can flip (``tau2=-1``).
 _FLIPPABLE = ("q", "dq", "ddq", "tau")
+#: The index fields of a template of ``M``: row, column, flat (column-major).
+_ROW, _COL, _FLAT = ("i", "i0"), ("j", "j0"), ("k", "k0")
+
+
+def _check_matrix_template(tpl: str) -> None:
+    """Refuse a template of ``M`` that names a column without both a row and a column
+    index, or a flat one (``M{i0}``: one column read for a whole row of M).
+
+    Raises
+    ------
+    DataError
+        A row index alone, a column index alone, a flat index beside a row or column one.
+    """
+    fields = set(re.findall(r"\{(\w*)\}", tpl))
+    if not fields:  # an NPZ array's name
+        return
+    row, col, flat = (bool(fields & set(f)) for f in (_ROW, _COL, _FLAT))
+    if (row and col and not flat) or (flat and not row and not col):
+        return
+    raise DataError(
+        f"M={tpl}: a template of M needs a row and a column index (M{{i0}}_{{j0}}, "
+        "M{i}_{j}), or one flat index of the n*n matrix, column-major as libfranka and "
+        "Eigen store it (M{k0}: M0..M48 for 7 joints, from 0; M{k} from 1); "
+        f"got {'no column index' if row else 'no row index'}; hint: --columns M=M{{k0}} "
+        "reads libfranka's flat array"
+    )
+
+
+def _fill_matrix(template: str, i: int, j: int, n: int) -> str:
+    """The column of ``M[i, j]`` (from 0) of an ``n``-joint arm: ``{i}``/``{j}`` (from
+    1), ``{i0}``/``{j0}`` (from 0), or the flat column-major index ``{k0} = i + n j``
+    (``{k}`` from 1)."""
+    try:
+        return template.format(i=i + 1, i0=i, j=j + 1, j0=j, k=i + n * j + 1, k0=i + n * j)
+    except (KeyError, IndexError, ValueError) as exc:
+        raise DataError(
+            f"column template {template!r} of M: use {{i}}/{{j}} (from 1), {{i0}}/{{j0}} "
+            "(from 0) or a flat {k0}/{k}"
+        ) from exc
 
 
 def _joint_key(key: str) -> tuple[str, int] | None:
@@ -544,11 +589,12 @@ def _grouped(
 
 def _referenced(names: list[str], cmap: ColumnMap, quantities: tuple[str, ...]) -> set[str]:
     """The column names a map's templates of ``quantities`` can name (every column when a
-    template is more than ``{i}``, ``{i0}``, ``{j}``, ``{j0}`` in text)."""
+    template is more than ``{i}``, ``{i0}``, ``{j}``, ``{j0}``, ``{k}``, ``{k0}`` in
+    text)."""
     patterns = []
     for quantity in quantities:
         tpl = cmap.template(quantity)
-        parts = re.split(r"(\{i0?\}|\{j0?\})", tpl)
+        parts = re.split(r"(\{i0?\}|\{j0?\}|\{k0?\})", tpl)
         text = "".join(parts[::2])  # the template without its joint fields
         if "{" in text or "}" in text:  # another format field: read every column
             return set(names)
@@ -646,8 +692,8 @@ def _check_distinct(table: _Table, cmap: ColumnMap, quantities: tuple[str, ...],
         tpl = cmap.template(quantity)
         if "{" not in tpl:
             names = [tpl]
-        elif "{j" in tpl:
-            names = [_fill(tpl, i, j) for i in range(n) for j in range(n)]
+        elif quantity == "M":
+            names = [_fill_matrix(tpl, i, j, n) for i in range(n) for j in range(n)]
         else:
             names = [_fill(tpl, i) for i in range(n)]
         for c in names:
@@ -1012,20 +1058,26 @@ class MappedStatic:
 
 
 def load_mapped_static_data(
-    path: str | Path, columns: ColumnMap, robot: Robot | None = None, *, require_M: bool = True
+    path: str | Path,
+    columns: ColumnMap,
+    robot: Robot | None = None,
+    *,
+    require_M: bool = True,
+    drop_invalid: bool = False,
 ) -> MappedStatic:
     """Read static data ``q, M, g`` (CSV or NPZ) through a column map; SI out.
 
     ``M`` is read from the lower triangle ``i >= j`` (a column named by ``(i, j)`` or, when
     absent, by ``(j, i)``) and mirrored; NPZ arrays are taken whole. With
     ``require_M=False`` a file without ``M`` (gravity torques only) is read with ``M`` set
-    to zero, said in the notes.
+    to zero, said in the notes. With ``drop_invalid`` the rows holding NaN or inf are
+    dropped, said in the notes with their lines.
 
     Raises
     ------
     DataError
         Missing columns (named), a column named by two quantities' templates, a joint
-        count other than the robot's, NaN rows.
+        count other than the robot's, NaN rows (without ``drop_invalid``).
     """
     path = Path(path)
     table = _read_table(path, columns, ("q", "g", "M"))
@@ -1035,19 +1087,23 @@ def load_mapped_static_data(
         k = robot.n  # more joints than the robot's: their columns were ignored silently
         while _fill(tpl_q, k) in table.columns:
             k += 1
+        guess = static_map(table.header, robot.n, columns.columns)
         raise DataError(
             f"data for {k} joints (columns {_fill(tpl_q, 0)}..{_fill(tpl_q, k - 1)}); "
-            f"robot {robot.name!r} has {robot.n}; hint: pass the robot the data were recorded with",
+            f"robot {robot.name!r} has {robot.n}; hint: "
+            + (
+                f"{guess} reads the file" if guess else "pass the robot the data were recorded with"
+            ),
             file=path.name,
         )
-    q = _need(table, columns, "q", n)
+    q = _static_vector(table, columns, "q", n)
     n = q.shape[1]
-    g = _need(table, columns, "g", n)
+    g = _static_vector(table, columns, "g", n)
     _check_distinct(table, columns, ("q", "g", "M"), n)
     tpl = columns.template("M")
     extra: tuple[str, ...] = ()
-    has_M = (tpl in table.columns) if "{" not in tpl else (_fill(tpl, 0, 0) in table.columns)
-    if not require_M and not has_M:
+    first = tpl if "{" not in tpl else _fill_matrix(tpl, 0, 0, n)
+    if not require_M and first not in table.columns:
         M = np.zeros((q.shape[0], n, n))
         extra = ("no M columns: M set to zero (gravity torques only)",)
     elif "{" not in tpl:
@@ -1055,20 +1111,71 @@ def load_mapped_static_data(
             raise DataError(f"no array {tpl!r} for 'M'", file=path.name)
         M = table.columns[tpl] * columns.factor("M")
     else:
-        M = np.zeros((q.shape[0], n, n))
-        for i in range(n):
-            for j in range(i + 1):
-                name = _fill(tpl, i, j)
-                if name not in table.columns:
-                    name = _fill(tpl, j, i)
-                if name not in table.columns:
-                    raise DataError(
-                        f"no column {_fill(tpl, i, j)!r} for M (template {tpl!r})", file=path.name
-                    )
-                M[:, i, j] = M[:, j, i] = table.columns[name] * columns.factor("M")
+        M = _matrix(table, columns, n, q.shape[0])
     bad = ~(np.all(np.isfinite(q), 1) & np.all(np.isfinite(g), 1))
     bad |= ~np.all(np.isfinite(M.reshape(len(M), -1)), 1)
     if bad.any():
-        raise DataError(f"row {int(np.argmax(bad))} holds NaN or inf", file=path.name)
+        rows = np.flatnonzero(bad)
+        where = _where(rows, table.lines)
+        if not drop_invalid or rows.size == len(bad):
+            raise DataError(
+                f"{rows.size} row(s) hold NaN or inf ({where}); hint: fix the file or pass "
+                "--drop-invalid (drop_invalid=True) to drop such rows",
+                file=path.name,
+            )
+        q, M, g = q[~bad], M[~bad], g[~bad]
+        extra += (f"dropped {rows.size} row(s) holding NaN or inf of {len(bad)}: {where}",)
     said = conversion_notes(columns, list(columns.factors))
-    return MappedStatic(StaticDataset(q, M, g, {"file": path.name}), extra, said)
+    try:  # a full matrix's triangles checked for symmetry, the file named
+        data = StaticDataset(q, M, g, {"file": path.name})
+    except DataError as exc:
+        raise DataError(str(exc), file=path.name) from None
+    return MappedStatic(data, extra, said)
+
+
+def _matrix(table: _Table, cmap: ColumnMap, n: int, rows: int) -> NDArray[np.float64]:
+    """``M`` (rows, n, n) [SI] from the columns of its template: each entry ``(i, j)`` from
+    its own column, or from ``(j, i)``'s where only one triangle is there (both present:
+    read as they are, the data set checks their symmetry).
+
+    Raises
+    ------
+    DataError
+        Neither ``(i, j)`` nor ``(j, i)`` is there (named, with the map that reads the
+        file when its header tells one).
+    """
+    tpl = cmap.template("M")
+    M = np.zeros((rows, n, n))
+    for i in range(n):
+        for j in range(i + 1):
+            have = [
+                c
+                for c in (_fill_matrix(tpl, i, j, n), _fill_matrix(tpl, j, i, n))
+                if c in table.columns
+            ]
+            if not have:
+                hint = static_map(table.header, n, cmap.columns) if table.header else ""
+                raise DataError(
+                    f"no column {_fill_matrix(tpl, i, j, n)!r} for M (template {tpl!r}); "
+                    f"{table.has()}" + (f"; hint: {hint} reads the file" if hint else ""),
+                    file=table.name,
+                )
+            M[:, i, j] = table.columns[have[0]]
+            M[:, j, i] = table.columns[have[-1]]
+    return M * cmap.factor("M")
+
+
+def _static_vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDArray:
+    """:func:`_need` for static data, its error's hint the map that reads the file when its
+    header tells one (:func:`~dynid.io.column_hint.static_map`: libfranka's ``q0..q6``)."""
+    try:
+        return _need(table, cmap, quantity, n)
+    except DataError as exc:
+        guess = static_map(table.header, n, cmap.columns) if n and table.header else ""
+        if not guess:
+            raise
+        raise DataError(
+            f"{str(exc).removeprefix(table.name + ': ').partition('; hint:')[0]}; hint: {guess} "
+            "reads the file",
+            file=table.name,
+        ) from None

@@ -45,11 +45,13 @@ from ..identification.data import DEFAULT_SYMMETRY_RTOL, StaticDataset
 from ..model.robot import Robot
 from ..regressors.static import static_labels
 from .atomic import open_atomic
+from .column_hint import holdings, static_map
 from .input_files import regular_file
 from .json_files import dumps, loads
 from .npz_files import check_npz
 
 __all__ = [
+    "data_row_lines",
     "static_columns",
     "save_static_data",
     "load_static_data",
@@ -258,6 +260,16 @@ def _check_columns(path: Path, header: list[str], line: int, robot: Robot | None
         raise DataError(
             f"duplicated columns {_checks.names(dup)}", file=path.name, at=f"line {line}"
         )
+    if robot is not None and (guess := static_map(header, robot.n)):
+        expected = static_columns(robot.n)
+        if any(c not in header for c in expected):  # another tool's names: the map that reads them
+            raise DataError(
+                f"the columns {holdings(header)} are not dynid's static format "
+                f"({_expected_hint(robot)}); hint: {guess} reads them ({{i0}}: joints from 0; "
+                "{k0}: M as one flat column-major array, k = i + n j from 0, as libfranka's)",
+                file=path.name,
+                at=f"line {line}",
+            )
     qcols = [c for c in header if re.fullmatch(r"q[1-9]\d*", c)]
     if not qcols:
         raise DataError(
@@ -421,8 +433,8 @@ def load_static_npz(
     if bad and not drop_invalid:
         first = min(bad, key=lambda b: int(b.split(":")[0].split()[1]))
         raise DataError(
-            f"{first} ({len(bad)} bad row(s) in all); hint: fix the file or load "
-            "with drop_invalid=True",
+            f"{first} ({len(bad)} bad row(s) in all); hint: fix the file or pass "
+            "--drop-invalid (drop_invalid=True) to drop such rows",
             file=path.name,
         )
     table = np.concatenate([q, M[:, i, j], g], axis=1)[ok]
@@ -462,3 +474,24 @@ def _npz_rows(path: Path, z: Any) -> int:
     if a.shape != () or not np.issubdtype(a.dtype, np.integer) or int(a) < 0:
         raise DataError(f"array 'n_rows' must be one integer >= 0; got {a!r}", file=path.name)
     return int(a)
+
+
+def data_row_lines(path: str | Path, n_rows: int) -> tuple[int, ...] | None:
+    """The line (from 1) of each data row of a CSV file of static data, dynid's or another
+    tool's: the lines after the header that are neither empty nor comments; None for an
+    NPZ file, or when the file holds another number of rows than ``n_rows`` (rows were
+    dropped as they were read: which ones, the lines cannot tell)."""
+    path = Path(path)
+    if path.suffix.lower() != ".csv":
+        return None
+    lines: list[int] = []
+    header = False
+    with path.open(encoding="utf-8-sig", errors="replace") as fh:
+        for k, raw in enumerate(fh, start=1):
+            s = raw.strip()
+            if not s or s.startswith("#"):
+                continue
+            if header:
+                lines.append(k)
+            header = True
+    return tuple(lines) if len(lines) == n_rows else None

@@ -497,7 +497,9 @@ def read_static_file(
     """
     path = Path(path)
     if columns is not None or not require_M:
-        mapped = load_mapped_static_data(path, columns or ColumnMap(), robot, require_M=require_M)
+        mapped = load_mapped_static_data(
+            path, columns or ColumnMap(), robot, require_M=require_M, drop_invalid=drop_invalid
+        )
         for note in mapped.conversions:  # as asked: a note
             _log.log(NOTE, "%s: %s", path.name, note)
         for note in mapped.notes:

@@ -120,6 +120,7 @@ from .recordings import (
     unwrapped_recorded,
     usable_recorded,
 )
+from .static_outliers import without_outlying
 
 __all__ = [
     "ColumnSpec",
@@ -286,7 +287,9 @@ class IdentifyOptions:
     keep_outlying : bool
         Torque logs: fit the recordings found outlying too (default: the structure is
         chosen without them and the final fit leaves them out,
-        :func:`~dynid.identification.selection.identify_recordings`).
+        :func:`~dynid.identification.selection.identify_recordings`). Static data: fit
+        the configurations found outlying too (default: left out,
+        :func:`~dynid.workflows.static_outliers.without_outlying`).
     consistent : bool
         Also identify physically consistent link parameters in one step (convex).
     prior : str, Path or Robot, optional
@@ -469,6 +472,7 @@ def identify_files(
     if kind != "torque_log":
         _one_static_file(paths, opt)
         static = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
+        static = without_outlying(robot, path, static, keep=opt.keep_outlying, drive=opt.drive)
         if not opt.consistent:
             return IdentifyResult(_static(robot, path, static, opt), None, tuple(paths))
         consistent, unconstrained = _consistent_static(robot, path, static, opt, prior)
@@ -914,7 +918,7 @@ def _one_static_file(paths: list[Path], opt: IdentifyOptions) -> None:
             f"applies to torque logs, not static data ({paths[0].name})", field="terms"
         )
     given = {n: getattr(opt, n) is not None for n in ("cutoff_hz", "max_gap_s", "torque_delay_s")}
-    given |= {"q_start": opt.q_start is not None, "keep_outlying": opt.keep_outlying}
+    given |= {"q_start": opt.q_start is not None}
     for name in (n for n, said in given.items() if said):
         raise OptionError(f"applies to torque logs, not static data ({paths[0].name})", field=name)
 

@@ -33,6 +33,7 @@ from ..model.robot import Robot
 from .data_files import read_static_file
 from .options import check_band, check_choice, check_count, check_number
 from .prior import load_prior
+from .static_outliers import without_outlying
 
 __all__ = [
     "Retrieval",
@@ -160,6 +161,9 @@ class RetrieveOptions:
         Penalty method: worker processes (capped at the cores and the runs, with a note).
     seed : int or None
         Penalty method: the seed of the runs.
+    drop_invalid : bool
+        Static data: drop the rows holding NaN or inf (said in a warning) instead of
+        refusing the file.
 
     Raises
     ------
@@ -184,6 +188,7 @@ class RetrieveOptions:
     stages: int | None = None
     workers: int | None = None
     seed: int | None = 0
+    drop_invalid: bool = False
 
     def __post_init__(self) -> None:
         check_choice(self, "method", METHODS, optional=False)
@@ -307,7 +312,8 @@ def retrieve_files(
         raise DynidError("retrieving from static data needs the robot that recorded them")
     else:
         robot = _with_friction(robot, opt.friction)
-        data = read_static_file(source, robot)
+        data = read_static_file(source, robot, drop_invalid=opt.drop_invalid)
+        data = without_outlying(robot, Path(source), data, keep_flag="")
     prior = opt.prior
     if not isinstance(prior, Robot):
         prior = load_prior(prior, robot, base=opt.prior_base, tip=opt.prior_tip)
