@@ -63,6 +63,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from ..model.robot import Robot
+from .bag_hint import bag_hint
 from .column_hint import guessed_map, joint_families, no_torques, static_map
 from .csv_tables import csv_table
 from .input_files import file_text, regular_file
@@ -513,7 +514,7 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
             raise DataError(f"array {complex_[0]!r} holds complex numbers", file=path.name)
         return _Table(path.name, arrays, header=list(raw))
     if suffix != ".csv":
-        raise DataError("expected a .csv or .npz file", file=path.name)
+        raise DataError(f"expected a .csv or .npz file{bag_hint(path)}", file=path.name)
 
     def layout(names: list[str], line: int) -> dict[str, list[int]]:
         dup = sorted({c for c in names if names.count(c) > 1})

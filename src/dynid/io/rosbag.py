@@ -18,7 +18,7 @@ from ..identification.log import DEFAULT_CUTOFF_HZ
 from .input_files import regular_file
 from .joint_states import JointStateImport, JointStateMessages, assemble
 
-__all__ = ["JOINT_STATE_TYPES", "load_joint_state_bag"]
+__all__ = ["JOINT_STATE_TYPES", "joint_state_topics", "load_joint_state_bag"]
 
 JOINT_STATE_TYPES = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 
@@ -41,6 +41,44 @@ def _open(path: Path):  # noqa: ANN202 (a rosbags reader)
         raise DataError("give a ROS 1 .bag file or a ROS 2 bag folder", file=path.name)
     store = Stores.ROS1_NOETIC if path.suffix == ".bag" else Stores.ROS2_HUMBLE
     return AnyReader([path], default_typestore=get_typestore(store))
+
+
+def joint_state_topics(path: str | Path) -> list[str] | None:
+    """The ``sensor_msgs/JointState`` topics of the bag ``path`` (a ROS 1 ``.bag`` or a
+    ROS 2 bag folder), sorted; None when it cannot be opened (``rosbags`` missing, not a
+    bag, unreadable). Opening reads the bag's index or metadata only, never its messages:
+    cheap for a bag of any length, so that a message may name them."""
+    try:
+        reader = _open(Path(path))
+        reader.open()
+    except Exception:  # noqa: BLE001 (rosbags' own error classes): not known, nothing said
+        return None
+    try:
+        return _joint_state_topics(reader.connections)
+    finally:
+        reader.close()
+
+
+def _joint_state_topics(connections: Sequence[object]) -> list[str]:
+    """The topics of ``connections`` (a rosbags reader's) that hold JointState, sorted."""
+    return sorted(
+        {
+            str(getattr(c, "topic", ""))
+            for c in connections
+            if getattr(c, "msgtype", None) in JOINT_STATE_TYPES
+        }
+    )
+
+
+def _topic_hint(connections: Sequence[object]) -> str:
+    """``; hint: ...``: the ``--topic`` of the bag's JointState topic (one), or its
+    JointState topics to choose from (several); a bag without one is told so."""
+    found = _joint_state_topics(connections)
+    if len(found) == 1:
+        return f"; hint: its JointState topic is {found[0]}: pass --topic {found[0]}"
+    if found:
+        return f"; hint: pass --topic with one of its JointState topics {_checks.names(found)}"
+    return "; it holds no sensor_msgs/JointState topic"
 
 
 def load_joint_state_bag(
@@ -95,7 +133,9 @@ def load_joint_state_bag(
         if not conns:
             topics = sorted({c.topic for c in reader.connections})
             raise DataError(
-                f"no topic {topic!r}; the bag has {_checks.short(topics)}", file=path.name
+                f"no topic {topic!r}; the bag has {_checks.short(topics)}"
+                + _topic_hint(reader.connections),
+                file=path.name,
             )
         bad = [c.msgtype for c in conns if c.msgtype not in JOINT_STATE_TYPES]
         if bad:

@@ -54,6 +54,7 @@ from ..identification.log import (
     with_derived_velocities,
 )
 from .atomic import open_atomic
+from .bag_hint import bag_hint
 from .column_hint import column_hint, no_torques, position_count, time_column
 from .csv_tables import ROWS_PREFIX, csv_table
 from .joint_state_csv import import_hint
@@ -287,7 +288,7 @@ def load_torque_log(
     elif suffix == ".csv":
         arrays, lines = _read_csv(path)
     else:
-        raise DataError(f"torque log must be a .csv or .npz file; got {path.name!r}")
+        raise DataError(f"torque log must be a .csv or .npz file{bag_hint(path)}", file=path.name)
     _check_rows(path, arrays, lines, drop_invalid)
     derive = "dq" not in arrays
     if derive:

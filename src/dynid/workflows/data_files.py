@@ -28,12 +28,12 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
-from .. import _checks
 from ..exceptions import DataError, DynidError, DynidWarning, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import MILLISECONDS_HINT, TorqueLog
 from ..identification.unit_mix import unit_findings
+from ..io.bag_hint import ROBOT, bag_hint
 from ..io.column_hint import commanded_torques, missing_joints
 from ..io.columns import (
     ColumnMap,
@@ -221,34 +221,12 @@ def data_kind(path: str | Path, columns: ColumnMap | None = None) -> DataKind:
         except (AttributeError, TypeError):  # a single .npy array: np.load gives an array
             raise DataError("a single array, not an NPZ archive", file=path.name) from None
         return "torque_log" if "t" in keys or "tau" in keys else "static"
-    raise DataError(f"a data file must be .csv or .npz{_bag_file_hint(path)}", file=path.name)
-
-
-def _bag_file_hint(path: Path) -> str:
-    """``: ...``: the ``dynid import`` that converts a ROS bag file (a ROS 1 ``.bag``, or
-    the ``.db3``/``.mcap`` store of a ROS 2 bag, whose folder is the bag) into a torque
-    log; empty for any other file."""
-    suffix = path.suffix.lower()
-    if suffix == ".bag":
-        bag, what = path, "a ROS 1 bag"
-    elif suffix in (".db3", ".mcap"):
-        bag, what = path.parent, f"the {suffix} store of a ROS 2 bag, its folder"
-    else:
-        return ""
-    name = bag.name or str(bag)
-    return (
-        f"; it is {what}: convert it into a torque log with 'dynid import {bag} {ROBOT} "
-        f"--out {Path(name).stem}.csv' and give that file to --data"
-    )
-
-
-#: The robot of a suggested ``dynid import`` in a message, for the caller to fill in
-#: (:func:`with_import_robot`).
-ROBOT = "--robot ROBOT"
+    raise DataError(f"a data file must be .csv or .npz{bag_hint(path)}", file=path.name)
 
 
 def with_import_robot(message: str, options: Sequence[str]) -> str:
-    """``message`` with the robot of each ``dynid import`` it suggests (:data:`ROBOT`)
+    """``message`` with the robot of each ``dynid import`` it suggests
+    (:data:`~dynid.io.bag_hint.ROBOT`)
     given as ``options``: the run's own robot options as typed (``["--robot", "arm.urdf",
     "--base", "b", "--tip", "t"]``), so that the import reads the same chain (a URDF of
     several leaves needs its ``--tip``); unchanged without ``--robot`` among them."""
@@ -625,31 +603,6 @@ def _read_with(columns: str | None, units: str | None) -> str:
     return ", ".join(given) or "the default column names and units"
 
 
-def _bag_hint(folder: Path) -> str:
-    """``; ...``: the ROS bag a folder is or holds, and the ``dynid import`` that converts
-    it into a torque log; empty when there is none."""
-    stores = sorted(f.name for f in folder.iterdir() if f.suffix.lower() in (".db3", ".mcap"))
-    if (folder / "metadata.yaml").exists() or stores:
-        held = ", ".join(["metadata.yaml"] * (folder / "metadata.yaml").exists() + stores[:3])
-        return (
-            f": it is a ROS 2 bag ({held}); convert it into a torque log with "
-            f"'dynid import {folder} {ROBOT} --out {folder.name}.csv' and give "
-            "that file to --data"
-        )
-    bags = sorted(
-        f.name
-        for f in folder.iterdir()
-        if f.suffix.lower() == ".bag" or (f.is_dir() and (f / "metadata.yaml").exists())
-    )
-    if not bags:
-        return ""
-    return (
-        f": it holds ROS bag(s) {_checks.names(bags[:5])}; convert each into a torque log "
-        f"with 'dynid import {folder / bags[0]} {ROBOT} --out {Path(bags[0]).stem}.csv' "
-        "and give those files to --data"
-    )
-
-
 def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
     """The data files of ``--data``: the paths given, a folder standing for its ``.csv``
     and ``.npz`` files in name order (its other files, hidden ones and folders apart,
@@ -668,7 +621,7 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
             found = sorted(f for f in p.iterdir() if f.suffix.lower() in (".csv", ".npz"))
             if not found:
                 raise DataError(
-                    f"{p.name}: the folder holds no .csv or .npz data file{_bag_hint(p)}"
+                    f"{p.name}: the folder holds no .csv or .npz data file{bag_hint(p, ': ')}"
                 )
             other = sorted(
                 f.name
