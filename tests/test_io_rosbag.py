@@ -47,8 +47,10 @@ def _message(ts, ros1, k, stamp_ns, names, q, dq, tau):
     )
 
 
-def write_bag(path, kind, messages, *, extra_topic=0):
-    """Write ``messages`` (receive_ns, stamp_ns, names, q, dq, tau) to a bag of ``kind``."""
+def write_bag(path, kind, messages, *, extra_topic=0, topic="/joint_states", more_js=()):
+    """Write ``messages`` (receive_ns, stamp_ns, names, q, dq, tau) to a bag of ``kind`` on
+    the JointState ``topic``; the first message again on each JointState topic of
+    ``more_js``."""
     ros1 = kind == "ros1"
     ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
     if ros1:
@@ -58,10 +60,14 @@ def write_bag(path, kind, messages, *, extra_topic=0):
         writer = Writer2(path, version=9, storage_plugin=plugin)
     ser = ts.serialize_ros1 if ros1 else ts.serialize_cdr
     with writer as w:
-        conn = w.add_connection("/joint_states", JS, typestore=ts)
+        conn = w.add_connection(topic, JS, typestore=ts)
         other = w.add_connection("/chatter", "std_msgs/msg/String", typestore=ts)
         for k, (recv, stamp, names, q, dq, tau) in enumerate(messages):
             w.write(conn, recv, ser(_message(ts, ros1, k, stamp, names, q, dq, tau), JS))
+        for name in more_js:
+            recv, stamp, names, q, dq, tau = messages[0]
+            js = w.add_connection(name, JS, typestore=ts)
+            w.write(js, recv, ser(_message(ts, ros1, 0, stamp, names, q, dq, tau), JS))
         String = ts.types["std_msgs/msg/String"]
         for k in range(extra_topic):
             w.write(other, T0_NS + k, ser(String(data="hello"), "std_msgs/msg/String"))
@@ -453,6 +459,81 @@ def test_the_suggested_import_keeps_the_robot_options_given(tmp_path, capsys, fo
     back = load_torque_log(out)
     np.testing.assert_array_equal(back.tau, tau)
     np.testing.assert_array_equal(back.q, q)
+
+
+@pytest.mark.parametrize(
+    ("command", "kind"),
+    [
+        (["validate", "--robot", "panda"], "ros1"),
+        (["friction", "--robot", "panda"], "ros1"),
+        (["observe", "--params", "panda", "--calibrate"], "ros1"),
+        (["validate", "--robot", "panda", "--columns", "tau=effort_{i}"], "ros1"),
+        (["friction", "--robot", "panda"], "sqlite3"),
+    ],
+    ids=["validate", "friction", "observe", "validate-columns", "friction-db3"],
+)
+def test_every_log_reader_names_the_import_of_a_bag_with_its_topic(
+    tmp_path, capsys, monkeypatch, command, kind
+):
+    """Regression (a Baxter trial): validate, friction and observe given a bag said only
+    "torque log must be a .csv or .npz file" (a mapped read "expected a .csv or .npz
+    file"), and identify's suggested import lacked the --topic of a bag whose JointState
+    topic is not /joint_states (Baxter's /robot/joint_states), so that following it ended
+    in "no topic '/joint_states'". Every reader names the import, with the bag's topic,
+    and that command, run as given, writes the log the bag holds."""
+    robot = dynid.panda()
+    log = _small(robot, N=40, seed=14)
+    ros1 = kind == "ros1"
+    bag = write_bag(
+        tmp_path / ("train1.bag" if ros1 else "train1"),
+        kind,
+        _shuffled(log, robot, 15),
+        extra_topic=2,
+        topic="/robot/joint_states",
+    )
+    data = bag if ros1 else next(bag.glob("*.db3"))
+    monkeypatch.chdir(tmp_path)
+    assert main([*command, "--data", str(data.relative_to(tmp_path)), "--out", "o"]) == 2
+    err = capsys.readouterr().err
+    assert err.split(": error: ")[1].startswith(f"{data.name}: "), err
+    command = err.split("'dynid ")[1].split("'")[0].replace("ROBOT", "panda")
+    given = "train1.bag" if ros1 else "train1"  # a ROS 2 bag's store: its folder
+    topic = "--topic /robot/joint_states"
+    assert command == f"import {given} --robot panda {topic} --out train1.csv", err
+    assert main([*command.split(), "-q"]) == 0
+    back = load_torque_log(tmp_path / "train1.csv")
+    np.testing.assert_array_equal(back.tau, log.tau)
+    np.testing.assert_allclose(back.t, log.t, atol=1e-9)
+
+
+def test_the_suggested_import_lists_several_joint_state_topics(tmp_path, capsys):
+    """A bag of several JointState topics (or none): the suggestion leaves --topic to the
+    user and lists the JointState topics written; a bag without one says so; the import
+    on a missing topic names the bag's one JointState topic."""
+    robot = dynid.panda()
+    msgs = _shuffled(_small(robot, N=10, seed=16), robot, 17)
+    bag = write_bag(tmp_path / "two.bag", "ros1", msgs, more_js=["/left/joint_states"])
+    assert main(["validate", "--robot", "panda", "--data", str(bag), "--out", "o"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        f"'dynid import {bag} --robot panda --topic TOPIC --out two.csv' (TOPIC: one of its "
+        "JointState topics /joint_states, /left/joint_states)" in err
+    ), err
+    none = tmp_path / "none.bag"
+    with Writer1(none) as w:
+        ts = get_typestore(Stores.ROS1_NOETIC)
+        conn = w.add_connection("/chatter", "std_msgs/msg/String", typestore=ts)
+        w.write(
+            conn,
+            T0_NS,
+            ts.serialize_ros1(ts.types["std_msgs/msg/String"](data="x"), "std_msgs/msg/String"),
+        )
+    assert main(["validate", "--robot", "panda", "--data", str(none), "--out", "o"]) == 2
+    assert "--out none.csv' (it holds no sensor_msgs/JointState topic" in capsys.readouterr().err
+    one = write_bag(tmp_path / "one.bag", "ros1", msgs, topic="/robot/joint_states")
+    said = r"hint: its JointState topic is /robot/joint_states: pass --topic /robot/joint_states$"
+    with pytest.raises(DataError, match=said):
+        load_joint_state_bag(one, robot.joint_names)
 
 
 def test_import_labels_the_effort_with_the_drives_unit(tmp_path, capsys):

@@ -42,6 +42,8 @@ def _hint(path: Path) -> str:
     try:
         if path.is_dir():
             return _folder_hint(path)
+        if not path.exists():  # a missing file is said as missing, not as a bag
+            return ""
     except OSError:  # unreadable: its reader says so
         return ""
     suffix = path.suffix.lower()
