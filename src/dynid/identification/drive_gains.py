@@ -353,10 +353,11 @@ class DriveGains:
         """One line for a log of motor currents: which motors' torque constants the data
         check (:attr:`determined`: the true over the drive file's, at the description's
         masses' scale where :attr:`scaled`, which the data do not check, else relative),
-        why factors :data:`SIGNIFICANT` in-sample standard deviations clear of 1 are not
-        named (:meth:`unnamed_reason`, the motors of one reason together), and which the
-        data cannot check (:attr:`unknown_scale`: those motors' torques are as right as the
-        drive file's constants); None for a log of torques."""
+        why each that is not named needs no change to the drive file
+        (:meth:`unnamed_reason`, the motors of one reason together: a factor read 0.92 +-
+        0.02 of a constant that is right is within the description's masses' error), and
+        which the data cannot check (:attr:`unknown_scale` not determined: those motors'
+        torques are as right as the drive file's constants); None for a log of torques."""
         if self.effort != "current":
             return None
         unit, std, spread = self.per, self.std, self.heldout_std
@@ -378,18 +379,18 @@ class DriveGains:
             ]
         if self.named:
             parts.append(f"{unit}(s) {_ids(self.named)} named above, with the fix")
-        d = np.abs(np.nan_to_num(self.factor, nan=1.0) - 1.0)
         why: dict[str, list[int]] = {}
         for k in checked:
-            if d[k] >= SIGNIFICANT * std[k] and k not in self.named:
+            if k not in self.named:
                 why.setdefault(self.unnamed_reason(int(k)), []).append(int(k))
         parts += [
             f"no change to the drive file for {unit}(s) {_ids(ks)}: {reason}"
             for reason, ks in why.items()
         ]
-        if self.unknown_scale:
+        unchecked = [k for k in self.unknown_scale if not self.determined[k]]
+        if unchecked:
             parts.append(
-                f"not checked by these data: {unit}(s) {_ids(self.unknown_scale)}, whose "
+                f"not checked by these data: {unit}(s) {_ids(unchecked)}, whose "
                 "torques are as right as the drive file's constants (a known payload or a "
                 "torque sensor checks them)"
             )
