@@ -26,6 +26,7 @@ from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
 from ..friction.model import FrictionModel, combined, through_drive
 from ..identification.model import IdentifiedModel
+from ..identification.static_flange import data_flange_note, model_flange_note
 from ..io.bounds_file import load_bounds
 from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
@@ -335,8 +336,23 @@ def retrieve_files(
         "seed": opt.seed,
         "progress": progress,
     }
+    given = prior if opt.prior is not None else None
     if kind == "model":
         result = with_model_friction(m.from_coefficients(model, **common), model)
         result = replace(result, determined=result.determined or determined_by_data(model))
-        return Retrieval(result, tuple(notes))
-    return Retrieval(m.from_data(robot, data, **common), tuple(notes))
+        hand = model_flange_note(model, given) if _static_route(model) else None
+        return Retrieval(_noted(result, hand), tuple(notes))
+    hand = data_flange_note(robot, data.q, data.g, given)
+    return Retrieval(_noted(m.from_data(robot, data, **common), hand), tuple(notes))
+
+
+def _static_route(model: IdentifiedModel) -> bool:
+    """Whether ``model`` was identified from static data (its gravity torques a
+    controller's model's)."""
+    return model.info.route == "static"
+
+
+def _noted(result: FeasibleResult, said: str | None) -> FeasibleResult:
+    """``result`` with ``said`` (a mass at the flange the description lacks,
+    :mod:`dynid.identification.static_flange`) first in its notes; ``result`` for None."""
+    return result if said is None else replace(result, notes=(said, *result.notes))
