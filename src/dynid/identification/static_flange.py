@@ -102,7 +102,7 @@ def flange_words(reference: Robot, found: FlangeMass, against: str, source: str)
     """The note of the mass ``found``: ``source``'s gravity torques (``"the data's"``)
     are ``against``'s (``"the robot description's"``, ``"the prior's"``) plus its,
     naming it, what it may be and what to do."""
-    at = ", ".join(f"{v:+.3f}" for v in found.com)
+    at = ", ".join(f"{v if abs(v) >= 5e-4 else 0.0:+.3f}" for v in found.com)  # no -0.000
     return (
         f"{source} gravity torques are {against} plus those of a mass of about "
         f"{found.mass:.3g} kg at ({at}) m in {reference.link_names[-1]}'s frame (the "
