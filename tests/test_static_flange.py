@@ -115,3 +115,16 @@ def test_retrieve_model_refuses_columns_in_one_line(tmp_path, capsys):
     assert main([*argv, "--columns", "q=q{i0},M=M{k0},g=g{i0}"]) == 2
     err = [ln for ln in capsys.readouterr().err.splitlines() if "error" in ln]
     assert len(err) == 1 and "--columns applies to --static only" in err[0]
+
+
+def test_validate_refuses_static_data_in_one_line_naming_predict(tmp_path, capsys):
+    """validate on static data: one line saying the file holds static data and what gives a
+    model's M and g at a held-out configuration (not the torque log's header error), exit
+    code 2, nothing written."""
+    q, M, g, _ = _truth(3, False)
+    path = save_static_data(tmp_path / "heldout.csv", StaticDataset(q, M, g))
+    out = tmp_path / "v"
+    assert main(["validate", "--robot", "panda", "--data", str(path), "--out", str(out)]) == 2
+    err = [ln for ln in capsys.readouterr().err.splitlines() if "error" in ln]
+    assert len(err) == 1 and "heldout.csv holds static data (q, M, g)" in err[0], err
+    assert "dynid predict" in err[0] and "header" not in err[0] and not out.exists()
