@@ -21,7 +21,13 @@ reproducible whatever the number of workers.
 
 Input: --model DIR/identification.json (from `dynid identify`; pruned coefficients are
 ignored), or --static FILE (static data, single-step variant: the objective is taken
-directly on [tril M; g], no identification step) with --robot.
+directly on [tril M; g], no identification step) with --robot; a file of another tool is
+read with --columns/--units as identify reads it (libfranka's flat M: --columns
+'q=q{i0},M=M{k0},g=g{i0}').
+
+Static data whose gravity torques are the prior's (or the description's) plus a mass at
+the flange (a hand the controller's model holds and the description lacks) get a note
+naming the mass: the retrieval puts it on the last links; `dynid payload` weighs it.
 
 --total-mass MIN,MAX sets the band on the total mass [kg] (--no-total-mass drops the
 default one); --friction friction.json (sigmoid) puts a friction model on the exported
@@ -56,6 +62,7 @@ from ..io.feasible_bundle import save_feasible_bundle
 from ..workflows.retrieve import RetrieveOptions, retrieve_files
 from .applies import Applies, urdf_chain
 from .common import (
+    add_column_options,
     add_consistency_options,
     add_drop_invalid,
     add_robot_options,
@@ -80,7 +87,12 @@ _SEEDED = tuple(name for name, m in METHODS.items() if m.parallel)
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
 APPLIES = (
     Applies(("robot",), lambda a: a.static is not None, "--static", "--model holds its robot"),
-    Applies(("drop_invalid",), lambda a: a.static is not None, "--static", "--model holds no rows"),
+    Applies(
+        ("drop_invalid", "columns", "units"),
+        lambda a: a.static is not None,
+        "--static",
+        "--model holds no rows",
+    ),
     urdf_chain(),
     urdf_chain("prior", ("prior_base", "prior_tip")),
     Applies(
@@ -137,6 +149,7 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     add_seed_option(p)
     add_drop_invalid(p)
+    add_column_options(p)
     p.add_argument(
         "--friction", type=Path, default=None, help="friction.json (sigmoid) to put on the robot"
     )
@@ -154,6 +167,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         RetrieveOptions,
         total_mass_band=not args.no_total_mass,
         total_mass=parse_mass_band(args.total_mass),
+        columns=(args.columns, args.units),
     )
     retrieval = retrieve_files(
         source,
@@ -165,7 +179,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
     for field, what in retrieval.notes:
         console.notice(f"note: {flag(field)} {what}")
     result = retrieval.result
-    files = save_feasible_bundle(args.out, result, source=str(source))
+    files = save_feasible_bundle(
+        args.out, result, column_map=retrieval.column_map, source=str(source)
+    )
     files += [] if args.no_figures else save_retrieval_figure(args.out, result)
     summary = format_retrieval if isinstance(result, RetrievalResult) else format_consistent
     console.print(summary(result))  # type: ignore[arg-type]

@@ -50,6 +50,7 @@ __all__ = [
     "at_the_motors",
     "gravity_masses_words",
     "flange_mass",
+    "flange_mass_of",
     "gravity_ratio_covariance",
     "gravity_ratios",
     "gravity_scale_factor",
@@ -152,15 +153,25 @@ def flange_mass(
 ) -> tuple[float, NDArray[np.float64]] | None:
     """The point mass [kg] and its position (3,) [m, last link's frame] at the last link
     whose gravity torques make up the model's less the description's at the
-    configurations ``q`` (N, n) [rad] (least squares of the last link's mass and first
-    moment columns over the joints gravity loads), or None: a mass not positive, or one
-    that leaves over a tenth of that difference's energy. A hand or a tool the description
-    lacks reads so (a Panda carrying its 0.73 kg hand, which the built-in description
-    holds not), and so do its last links heavier than described (its links 5-7 16 % so:
-    0.63 kg near link 7's origin leaves 0.2 % of the difference), which gravity torques
-    alone cannot tell apart."""
+    configurations ``q`` (N, n) [rad] (:func:`flange_mass_of` the model's gravity
+    torques), or None. A hand or a tool the description lacks reads so (a Panda carrying
+    its 0.73 kg hand, which the built-in description holds not), and so do its last links
+    heavier than described (its links 5-7 16 % so: 0.63 kg near link 7's origin leaves 0.2
+    % of the difference), which gravity torques alone cannot tell apart."""
+    return flange_mass_of(robot, q, model.gravity_torques(q))
+
+
+def flange_mass_of(
+    robot: Robot, q: NDArray[np.float64], g: NDArray[np.float64]
+) -> tuple[float, NDArray[np.float64]] | None:
+    """The point mass [kg] and its position (3,) [m, last link's frame] at the last link
+    whose gravity torques make up ``g`` (N, n) [N m] (a model's, or a controller's static
+    data) less ``robot``'s description's at the configurations ``q`` (N, n) [rad] (least
+    squares of the last link's mass and first moment columns over the joints gravity
+    loads), or None: a mass not positive, or one that leaves over a tenth of that
+    difference's energy."""
     loaded = gravity_loaded(robot, q)
-    diff = (model.gravity_torques(q) - gravity_torques(robot, q))[:, loaded].ravel()
+    diff = (np.asarray(g, dtype=np.float64) - gravity_torques(robot, q))[:, loaded].ravel()
     last = 10 * (robot.n - 1)
     zero = np.zeros_like(q)
     Y = torque_regressor(robot, q, zero, zero)[:, loaded, last : last + 4].reshape(-1, 4)

@@ -68,6 +68,7 @@ from ..identification.motor_constants import shared_gear_ratio
 from ..identification.residual_dependence import outside_model_note, round_off_note
 from ..identification.selection import fitted_logs, identify_recordings
 from ..identification.static import identify_static
+from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
 from ..identification.torque_delay import TorqueDelay
 from ..model.drive import Drive
@@ -473,9 +474,13 @@ def identify_files(
         _one_static_file(paths, opt)
         static = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         static = without_outlying(robot, path, static, keep=opt.keep_outlying, drive=opt.drive)
+        hand = _flange_note(robot, path, static, prior)
         if not opt.consistent:
-            return IdentifyResult(_static(robot, path, static, opt), None, tuple(paths))
+            model = _noted(_static(robot, path, static, opt), hand)
+            return IdentifyResult(model, None, tuple(paths))
         consistent, unconstrained = _consistent_static(robot, path, static, opt, prior)
+        unconstrained = _noted(unconstrained, hand)
+        consistent = dataclasses.replace(consistent, identified=unconstrained)
         return IdentifyResult(unconstrained, consistent, tuple(paths))
     separate = heldout.get("validate_on")
     logs = _read_logs(robot, paths, cmap, opt, separate)
@@ -753,6 +758,25 @@ def _say_gravity_scale(
         extra={**model.info.extra, GRAVITY_SCALE: {"factor": factor.factor, "finding": found}},
     )
     return dataclasses.replace(model, info=info)
+
+
+def _flange_note(robot: Robot, path: Path, data: Any, prior: Robot | None) -> str | None:
+    """The note of a mass at the flange that static data ``data`` (read from ``path``)
+    hold and the description (``prior``'s inertials where one is given) lacks
+    (:func:`~dynid.identification.static_flange.data_flange_note`), said; or None."""
+    said = data_flange_note(robot, data.q, data.g, prior)
+    if said is not None:
+        _log.log(NOTE, "%s: %s", path.name, said)
+    return said
+
+
+def _noted(model: IdentifiedModel, said: str | None) -> IdentifiedModel:
+    """``model`` with ``said`` in its notes (``model`` itself for None)."""
+    if said is None:
+        return model
+    return dataclasses.replace(
+        model, info=dataclasses.replace(model.info, notes=(*model.info.notes, said))
+    )
 
 
 def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> IdentifiedModel:

@@ -10,7 +10,7 @@ must be the robot's, a friction file on the robot must be sigmoid friction.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -26,11 +26,12 @@ from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
 from ..friction.model import FrictionModel, combined, through_drive
 from ..identification.model import IdentifiedModel
+from ..identification.static_flange import data_flange_note, model_flange_note
 from ..io.bounds_file import load_bounds
 from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
-from .data_files import read_static_file
+from .data_files import ColumnSpec, check_file_entries, column_map, read_static_file
 from .options import check_band, check_choice, check_count, check_number
 from .prior import load_prior
 from .static_outliers import without_outlying
@@ -164,6 +165,11 @@ class RetrieveOptions:
     drop_invalid : bool
         Static data: drop the rows holding NaN or inf (said in a warning) instead of
         refusing the file.
+    columns : (str or None, str or None), optional
+        Static data: the column names and units of a file of another tool (``--columns``,
+        ``--units``), read as ``identify`` reads them
+        (:func:`~dynid.workflows.data_files.column_map`); recorded with the result
+        (:attr:`Retrieval.column_map`).
 
     Raises
     ------
@@ -189,6 +195,7 @@ class RetrieveOptions:
     workers: int | None = None
     seed: int | None = 0
     drop_invalid: bool = False
+    columns: ColumnSpec | None = None
 
     def __post_init__(self) -> None:
         check_choice(self, "method", METHODS, optional=False)
@@ -259,10 +266,15 @@ class Retrieval:
     notes : tuple of (str, str)
         What was adjusted, as (field, what): the worker processes capped at the cores
         and the runs (``("workers", "64: using 2 (2 cores, 10 runs)")``).
+    column_map : mapping, optional
+        How the data were read (``{"columns": ..., "units": ...}``): the static data's
+        ``columns`` given, or the identified model's record (``info.column_map``); for
+        ``feasible.json``.
     """
 
     result: FeasibleResult
     notes: tuple[tuple[str, str], ...] = ()
+    column_map: Mapping[str, str | None] | None = None
 
 
 def retrieve_files(
@@ -303,7 +315,14 @@ def retrieve_files(
     opt = options or RetrieveOptions()
     m = consistent_method(opt.method)
     method_options = opt.method_options()
+    spec = None if opt.columns in (None, (None, None)) else opt.columns
     if kind == "model":
+        if spec is not None:
+            raise OptionError(
+                "applies to static data (a file of another tool); an identified model holds "
+                "no rows: leave it out",
+                field="columns",
+            )
         model = load_model_with_friction(source, opt.friction)
         if opt.prior is None:  # the description's inertials, as in the fit's own run
             model = replace(model, robot=model.description, description_phi=None)
@@ -312,7 +331,9 @@ def retrieve_files(
         raise DynidError("retrieving from static data needs the robot that recorded them")
     else:
         robot = _with_friction(robot, opt.friction)
-        data = read_static_file(source, robot, drop_invalid=opt.drop_invalid)
+        cmap = None if spec is None else column_map(*spec)
+        check_file_entries(cmap, [source])
+        data = read_static_file(source, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         data = without_outlying(robot, Path(source), data, keep_flag="")
     prior = opt.prior
     if not isinstance(prior, Robot):
@@ -335,8 +356,24 @@ def retrieve_files(
         "seed": opt.seed,
         "progress": progress,
     }
+    given = prior if opt.prior is not None else None
     if kind == "model":
         result = with_model_friction(m.from_coefficients(model, **common), model)
         result = replace(result, determined=result.determined or determined_by_data(model))
-        return Retrieval(result, tuple(notes))
-    return Retrieval(m.from_data(robot, data, **common), tuple(notes))
+        hand = model_flange_note(model, given) if _static_route(model) else None
+        return Retrieval(_noted(result, hand), tuple(notes), model.info.column_map)
+    hand = data_flange_note(robot, data.q, data.g, given)
+    read = None if spec is None else {"columns": spec[0], "units": spec[1]}
+    return Retrieval(_noted(m.from_data(robot, data, **common), hand), tuple(notes), read)
+
+
+def _static_route(model: IdentifiedModel) -> bool:
+    """Whether ``model`` was identified from static data (its gravity torques a
+    controller's model's)."""
+    return model.info.route == "static"
+
+
+def _noted(result: FeasibleResult, said: str | None) -> FeasibleResult:
+    """``result`` with ``said`` (a mass at the flange the description lacks,
+    :mod:`dynid.identification.static_flange`) first in its notes; ``result`` for None."""
+    return result if said is None else replace(result, notes=(said, *result.notes))

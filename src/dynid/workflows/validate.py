@@ -86,7 +86,7 @@ from ..observer.friction import banded_if_narrow, banding_note, noise_bands
 from ..observer.residual_load import ResidualLoad
 from ..progress import NOTE
 from .as_identified import identification_beside, read_as_identified
-from .data_files import ColumnSpec, in_file
+from .data_files import ColumnSpec, data_files, data_kind, in_file
 from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
 from .recordings import (
     Recorded,
@@ -349,6 +349,32 @@ class ValidateResult:
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
 
+def _torque_logs(
+    data: str | Path | Sequence[str | Path],
+) -> str | Path | Sequence[str | Path]:
+    """``data``, torque logs: static data (``q, M, g``) among them refused, saying what
+    judges a model there.
+
+    Raises
+    ------
+    DataError
+        Naming the file and ``dynid predict``.
+    """
+    for path in data_files(data):
+        try:
+            static = data_kind(path) == "static"
+        except (DataError, OSError):  # the torque log's reader names it in its own words
+            continue
+        if static:
+            raise DataError(
+                f"{path.name} holds static data (q, M, g): validate judges a model's torques "
+                "on torque logs (t, q, dq, tau); hint: a model's M and g at a held-out "
+                "configuration are `dynid predict --model DIR/identification.json --q=... "
+                "--json` (or --params feasible.json), to set against that row of the file"
+            )
+    return data
+
+
 def validate_files(
     model: IdentifiedModel | Robot,
     data: str | Path | Sequence[str | Path],
@@ -392,8 +418,8 @@ def validate_files(
     Raises
     ------
     DataError
-        A bad file, another joint count, invalid rows without ``drop_invalid``, other
-        units, no piece long enough to filter, another drive, errors that overflow (named).
+        A bad file, static data, another joint count, invalid rows without ``drop_invalid``,
+        other units, no piece long enough to filter, another drive, overflowing errors (named).
     ShapeError
         A friction model of another joint count.
     """
@@ -402,10 +428,10 @@ def validate_files(
     opt = _as_identified(options or ValidateOptions(), own)  # as identify read its logs
     drive, placed = _drives(model, opt.drive, feasible)
     rec = recorded or read_recordings(
-        data, robot, recorded=None if own is None else own.info.column_map, columns=opt.columns,
-        drop_invalid=opt.drop_invalid, cutoff_hz=velocity_cutoff(opt.cutoff_hz),
-        owner=f"the model ({label or robot.name})", drive=placed, q_start=opt.q_start,
-        max_gap_s=opt.max_gap_s, reference=_reference(model),
+        _torque_logs(data), robot, recorded=None if own is None else own.info.column_map,
+        columns=opt.columns, drop_invalid=opt.drop_invalid, q_start=opt.q_start,
+        cutoff_hz=velocity_cutoff(opt.cutoff_hz), owner=f"the model ({label or robot.name})",
+        drive=placed, max_gap_s=opt.max_gap_s, reference=_reference(model),
     )  # fmt: skip
     checked = unwrapped_recorded(rec, robot, opt.max_gap_s)  # as the preparation reads them
     sign_map, opposite = _said_signs(checked, model, opt, own)  # before the verdict
