@@ -213,14 +213,15 @@ def milliseconds_findings(log: TorqueLog) -> list[str]:
 _TIME_UNITS = (("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9))
 
 
-def velocity_rate_factor(log: TorqueLog) -> float:
+def velocity_rate_factor(log: TorqueLog, skip: Sequence[int] = ()) -> float:
     """``k`` of ``d q / dt ~ k dq`` [1]: 1 when ``t``, ``q`` and ``dq`` share their units.
 
     The positions' differences over their time steps against the mean of the two samples'
     recorded velocities, pooled over every joint by least squares; a step where a position
     jumps by more than half a turn (a wrap) or the time by more than 1.5 median steps (a
-    gap) is left out. NaN for velocities derived from the positions, fewer than 5 samples
-    or a log that does not move.
+    gap) is left out; the joints ``skip`` (from 0) are left out too (a prismatic joint's
+    velocities in mm/s, another finding). NaN for velocities derived from the positions,
+    fewer than 5 samples or a log that does not move.
     """
     if log.dq_derived or log.n_samples < 5:
         return float("nan")
@@ -228,6 +229,8 @@ def velocity_rate_factor(log: TorqueLog) -> float:
     ok = dt <= 1.5 * float(np.median(dt))
     num = den = 0.0
     for j in range(log.n):  # one joint at a time: temporaries of one column (long logs)
+        if j in skip:
+            continue
         dqj = np.diff(log.q[:, j])
         v = 0.5 * (log.dq[1:, j] + log.dq[:-1, j])
         keep = ok & (np.abs(dqj) <= np.pi)
@@ -236,15 +239,17 @@ def velocity_rate_factor(log: TorqueLog) -> float:
     return num / den if den > 0 else float("nan")
 
 
-def time_unit(log: TorqueLog, given: float = 1.0) -> tuple[str, float] | None:
+def time_unit(
+    log: TorqueLog, given: float = 1.0, skip: Sequence[int] = ()
+) -> tuple[str, float] | None:
     """The unit of ``log``'s time column when it is not the one it was read in: its
     recorded velocities a power of ten (within 25 %) times the rate of change of its
     positions per second as read, so that the column's unit is ``given`` [s] (the factor
     it was read with: 1e-3 for ``--units t=ms``) times that factor, one of s, ms, us, ns:
     its ``--units t=`` spelling and its length [s] (``("ms", 1e-3)``; ``("us", 1e-6)`` for
     stamps in microseconds read as ms); None otherwise, or when it is ``given``
-    (:func:`velocity_rate_factor`)."""
-    k = velocity_rate_factor(log)
+    (:func:`velocity_rate_factor`, without the joints ``skip``)."""
+    k = velocity_rate_factor(log, skip)
     if not np.isfinite(k) or k <= 0:
         return None
     for unit, size in (("s", 1.0), *_TIME_UNITS):
@@ -281,13 +286,14 @@ def time_unit_finding(name: str, log: TorqueLog, given: float = 1.0) -> str | No
     return None if said is None else f"{name}: {said}"
 
 
-def time_unit_said(log: TorqueLog, given: float = 1.0) -> str | None:
-    """:func:`time_unit_finding` without the file's name."""
-    found = time_unit(log, given)
+def time_unit_said(log: TorqueLog, given: float = 1.0, skip: Sequence[int] = ()) -> str | None:
+    """:func:`time_unit_finding` without the file's name (judged without the joints
+    ``skip``)."""
+    found = time_unit(log, given, skip)
     if found is None:
         return None
     unit, size = found
-    k = velocity_rate_factor(log)
+    k = velocity_rate_factor(log, skip)
     read = unit_name("t", given)
     if math.isclose(given, 1.0, rel_tol=1e-9):
         per, said = "per unit of its time column", f"{unit}, not seconds (t x {1 / size:g})"

@@ -59,7 +59,7 @@ from .angle_time_units import (
     time_unit_said,
 )
 from .log import TorqueLog, joint_side_log
-from .velocity_scale import velocity_scale_finding
+from .velocity_scale import prismatic_scale_finding, velocity_scale_finding
 
 __all__ = [
     "DEGREE_TOLERANCE",
@@ -318,8 +318,12 @@ def unit_findings(
     """
     found = []
     given = given or GivenUnits()
-    if time is None and (time := time_unit(log, given.factor("t"))) is not None:
-        time_said = time_unit_said(log, given.factor("t"))
+    rail = prismatic_scale_finding(robot, log, given)  # mm/s: not a time unit
+    skip = () if rail is None else rail[1]
+    if rail is not None:
+        found.append(rail[0])
+    if time is None and (time := time_unit(log, given.factor("t"), skip)) is not None:
+        time_said = time_unit_said(log, given.factor("t"), skip)
     mapped = drive is not None and drive.n == log.n
     if side is None:
         side = joint_side_log(log, drive) if mapped else log
@@ -332,6 +336,6 @@ def unit_findings(
     joints, said = joints_in_degrees(robot, side, LIMIT_MARGIN, log if motor else None)
     if joints:
         found.append(said)
-    if (scaled := velocity_scale_finding(robot, side, given, joints)) is not None:
+    if (scaled := velocity_scale_finding(robot, side, given, [*joints, *skip])) is not None:
         found.append(scaled)
     return joined_unit_findings(found, given.text) if found else None

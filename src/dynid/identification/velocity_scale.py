@@ -19,6 +19,12 @@ times theirs, or ``2 pi`` rad/s without one; both or neither: the velocities whe
 too fast, ``dq=deg/s``, the positions when too slow, ``q=deg``); acceleration columns read
 in the velocities' unit are named with them (``ddq=deg/s^2``).
 
+On a robot with prismatic and revolute joints, velocity columns of the prismatic joints
+``1000`` times (or ``1 / 1000`` of) the derivative of their positions while the revolute
+joints' agree are a length unit forgotten (``dq=mm/s`` beside ``q=mm``), not a time column
+in ms, which would scale every joint alike (:func:`prismatic_scale_finding`, judged before
+the time column).
+
 A scale is not a lag: :mod:`~dynid.identification.derivative_columns` reads the lag of
 columns of the positions' scale only.
 """
@@ -41,6 +47,7 @@ __all__ = [
     "SHAPE_CORRELATION",
     "WINDOW_S",
     "joint_rate_factors",
+    "prismatic_scale_finding",
     "velocity_scale_finding",
 ]
 
@@ -204,6 +211,73 @@ def velocity_scale_finding(
     return _with_hint(
         said, entries, robot, joints, judged & ~scaled, "velocity" if blame == "dq" else "position"
     )
+
+
+#: The ``--units`` spellings of a prismatic joint's velocities and accelerations [to SI].
+_LENGTH_RATES = {
+    "dq": {"m/s": 1.0, "mm/s": 1e-3},
+    "ddq": {"m/s^2": 1.0, "mm/s^2": 1e-3},
+}
+
+
+def _length_rate(quantity: str, factor: float) -> str | None:
+    """The ``--units`` spelling of ``factor`` for a prismatic joint's ``quantity``, or
+    None when it is no length unit's."""
+    for name, f in _LENGTH_RATES[quantity].items():
+        if math.isclose(factor, f, rel_tol=1e-6):
+            return name
+    return None
+
+
+def prismatic_scale_finding(
+    robot: Robot, log: TorqueLog, given: GivenUnits | None = None
+) -> tuple[str, tuple[int, ...]] | None:
+    """One line saying the velocity columns of ``robot``'s prismatic joints are in
+    another length unit than their positions (``1000`` times the derivative of the
+    positions while the revolute joints' agree with theirs: ``dq=mm/s`` forgotten beside
+    ``q=mm``), with its ``--units`` hint, and the joints it names (from 0); None
+    otherwise, and for a robot of one kind of joint (where a time column in ms reads
+    alike).
+
+    Parameters
+    ----------
+    robot : Robot
+        The model's robot (joint kinds and names).
+    log : TorqueLog
+        The log as read with ``given`` [s, m or rad, m/s or rad/s].
+    given : GivenUnits, optional
+        The units it was read with: the factor of ``dq`` applies to the prismatic joints
+        when it is a length unit's (1 or 1e-3), else they were read in m/s.
+    """
+    given = given or GivenUnits()
+    pri = np.asarray(robot.prismatic, dtype=bool)
+    k = joint_rate_factors(log)
+    judged = np.isfinite(k) & (k > 0)
+    rev = judged & ~pri
+    if not rev.any() or not (judged & pri).any():
+        return None
+    ratio = np.where(judged & pri, k / float(np.median(k[rev])), np.nan)
+    read = given.factor("dq") if _length_rate("dq", given.factor("dq")) else 1.0
+    for c in (1e-3, 1e3):
+        joints = np.flatnonzero(np.abs(ratio / c - 1.0) < RATE_AGREES)
+        unit = _length_rate("dq", read * c)
+        if joints.size == 0 or unit is None:
+            continue
+        entries = {"dq": unit}
+        if log.ddq is not None and math.isclose(given.factor("ddq"), given.factor("dq")):
+            entries["ddq"] = _length_rate("ddq", read * c) or f"{read * c:.10g}"
+        names = ", ".join(robot.joint_names[j] for j in joints)
+        s = "s" if joints.size > 1 else ""
+        times = 1.0 / float(np.median(ratio[joints]))
+        said = (
+            f"the velocity columns of the prismatic joint{s} {names} are {times:.4g} times "
+            "the derivative of their positions while the revolute joints' agree with theirs: "
+            f"velocities in {unit} read as {_length_rate('dq', read)}, a unit, not a time "
+            "column in ms (which would scale every joint alike) nor a lag; hint: --units "
+            + ",".join(f"{q}={u}" for q, u in entries.items())
+        )
+        return said, tuple(int(j) for j in joints)
+    return None
 
 
 def _acceleration_finding(robot: Robot, log: TorqueLog, given: GivenUnits) -> str | None:

@@ -40,6 +40,7 @@ cutoff ``velocity_cutoff_hz``), after cleaning; the returned notes say so.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import warnings
@@ -110,6 +111,10 @@ LEFT_OUT = "velocity columns left out (--columns dq=none)"
 _IGNORABLE = ("dq", "ddq")
 _TIME = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3}
+#: The units of ``q`` that are lengths (a prismatic joint's); the others are angles.
+_LENGTH = ("m", "mm")
+#: The joint quantities whose named unit applies to the joints of its kind alone.
+_JOINT_QUANTITIES = ("q", "dq", "ddq")
 _TORQUE = {"Nm": 1.0, "N m": 1.0, "N": 1.0, "mNm": 1e-3, "mN m": 1e-3}
 #: Motor currents for ``tau`` [A]: a drive of effort = "current" makes them torques.
 CURRENT_UNITS = {"A": 1.0, "mA": 1e-3}
@@ -169,6 +174,11 @@ class ColumnMap:
         A file's name -> the quantities read with the opposite sign on every joint of
         that file alone, its factor negated when that file is read (``--units
         rec2.csv:tau=-1``: ``{"rec2.csv": ("tau",)}``, :meth:`for_file`).
+    prismatic : tuple of bool, optional
+        The kind of each joint of the robot the files are read for (:meth:`for_robot`):
+        a length unit of ``q``, ``dq``, ``ddq`` (``mm``, ``mm/s``) then scales the
+        prismatic joints' columns alone, an angle unit (``deg``, ``deg/s``) the revolute
+        joints' alone; None (not known): a unit scales every joint's.
     """
 
     columns: Mapping[str, str] = field(default_factory=dict)
@@ -178,6 +188,7 @@ class ColumnMap:
     flips: Mapping[str, tuple[int, ...]] = field(default_factory=dict)
     file_flips: Mapping[str, Mapping[str, tuple[int, ...]]] = field(default_factory=dict)
     file_signs: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    prismatic: tuple[bool, ...] | None = None
 
     def __post_init__(self) -> None:
         for key in list(self.columns) + list(self.factors):
@@ -277,6 +288,7 @@ class ColumnMap:
             flips=flips,
             file_flips={name: own} if own else {},
             file_signs={name: negated} if negated else {},
+            prismatic=self.prismatic,
         )
 
     def unknown_files(self, names: Sequence[str]) -> tuple[str, ...]:
@@ -318,6 +330,80 @@ class ColumnMap:
     def factor(self, quantity: str) -> float:
         """The factor to SI of a quantity."""
         return float(self.factors.get(quantity, 1.0))
+
+    def unit_kind(self, quantity: str) -> str | None:
+        """``"length"`` or ``"angle"``: the kind of the unit named for ``q``, ``dq`` or
+        ``ddq`` (``mm/s`` a length's, ``deg/s`` an angle's); None for another quantity,
+        none named, or a number (a factor scales every joint)."""
+        name = str(self.names.get(quantity, "")).strip()
+        if quantity not in _JOINT_QUANTITIES or name not in _UNITS[quantity]:
+            return None
+        return "length" if name.partition("/")[0] in _LENGTH else "angle"
+
+    def for_robot(self, prismatic: Sequence[bool], joint_names: Sequence[str] = ()) -> ColumnMap:
+        """The map that reads the files of a robot whose joints are ``prismatic`` (n,):
+        each named unit of ``q``, ``dq``, ``ddq`` scales the joints of its kind alone
+        (:attr:`prismatic`, :meth:`joint_factors`).
+
+        Raises
+        ------
+        DataError
+            A unit whose kind matches none of the joints (``q=mm`` for an arm of revolute
+            joints alone), naming the entry and the joints' kind.
+        """
+        kinds = tuple(bool(p) for p in prismatic)
+        for quantity in _JOINT_QUANTITIES:
+            kind = self.unit_kind(quantity)
+            wanted = kind == "length"
+            if kind is None or any(p == wanted for p in kinds):
+                continue
+            said = f"--units {quantity}={self.names[quantity]}"
+            other = "revolute (rad, deg)" if wanted else "prismatic (m, mm)"
+            raise DataError(
+                f"{said}: a {kind} unit reads the {'prismatic' if wanted else 'revolute'} "
+                f"joints' columns; the robot's {len(kinds)} joint(s) are all {other}; hint: "
+                f"leave out {quantity}={self.names[quantity]}, or pass the robot the data were "
+                "recorded with"
+            )
+        if kinds == self.prismatic:
+            return self
+        return dataclasses.replace(self, prismatic=kinds)
+
+    def joint_factors(self, quantity: str, count: int) -> float | NDArray[np.float64]:
+        """The factor to SI of ``quantity``: one number for every joint, or per joint
+        (``count``,) where a named unit applies to the joints of its kind alone
+        (:meth:`for_robot`; the others read in SI, their sign kept; joints beyond the
+        robot's, which no reader keeps, at the unit's factor)."""
+        f = self.factor(quantity)
+        kind = self.unit_kind(quantity)
+        if self.prismatic is None or kind is None or f in (1.0, -1.0):
+            return f
+        match = np.array([p == (kind == "length") for p in self.prismatic], dtype=bool)
+        match = np.concatenate([match, np.ones(max(0, count - match.size), dtype=bool)])
+        return np.where(match[:count], f, math.copysign(1.0, f))
+
+    def kind_notes(self, joint_names: Sequence[str]) -> tuple[str, ...]:
+        """One line per named unit of ``q``, ``dq``, ``ddq`` that applies to some joints
+        alone (:meth:`for_robot`): ``q=mm applied to the prismatic joint rail; the revolute
+        joints read in rad``; nothing for a robot of one kind of joint or a map without
+        the robot's kinds."""
+        if self.prismatic is None or len(set(self.prismatic)) < 2:
+            return ()
+        out = []
+        for quantity in _JOINT_QUANTITIES:
+            if (kind := self.unit_kind(quantity)) is None:
+                continue
+            wanted = kind == "length"
+            which = [n for n, p in zip(joint_names, self.prismatic, strict=False) if p == wanted]
+            si = {"q": ("rad", "m"), "dq": ("rad/s", "m/s"), "ddq": ("rad/s^2", "m/s^2")}
+            kinds = ("prismatic", "revolute") if wanted else ("revolute", "prismatic")
+            s = "s" if len(which) > 1 else ""
+            out.append(
+                f"{quantity}={self.names[quantity]} applied to the {kinds[0]} joint{s} "
+                f"{', '.join(which)}; the {kinds[1]} joints read in "
+                f"{si[quantity][0 if wanted else 1]}"
+            )
+        return tuple(out)
 
     def mapped(self, quantity: str) -> bool:
         """Whether the quantity was given a template."""
@@ -402,9 +488,17 @@ def _sign_flip(key: str, value: Any) -> bool:
         f = math.nan
     if f in (1.0, -1.0):
         return f == -1.0
+    quantity = key.strip().rstrip("0123456789")
+    unit = str(value).strip()
+    kind = ""
+    if quantity in _JOINT_QUANTITIES and unit in _UNITS[quantity]:
+        kind = (
+            f"; hint: --units {quantity}={unit} (a length unit scales the prismatic joints' "
+            "columns alone, an angle unit the revolute joints')"
+        )
     raise DataError(
         f"{key}={value}: a single joint's entry flips its sign ({key}=-1); its unit is its "
-        "quantity's (a joint's scale: a drive's torque_constant or gear_ratio)"
+        f"quantity's (a joint's scale: a drive's torque_constant or gear_ratio){kind}"
     )
 
 
@@ -553,7 +647,7 @@ def _read_table(path: Path, cmap: ColumnMap, quantities: tuple[str, ...]) -> _Ta
         if key.startswith(_GROUP):
             names, quantity = groups_of[key], key[len(_GROUP) :]
             if cmap.factor(quantity) != 1.0:
-                a *= cmap.factor(quantity)
+                a *= cmap.joint_factors(quantity, len(names))
                 table.scaled.add(quantity)
             a = _checks.frozen(a)
             table.groups[quantity] = (names, a)
@@ -614,7 +708,7 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
         a = a[:, None] if a.ndim == 1 else a
         if n is not None and a.shape[1] != n:
             raise DataError(f"{tpl!r} has {a.shape[1]} joints; expected {n}", file=table.name)
-        return _flipped(a * cmap.factor(quantity), cmap, quantity, table.name)
+        return _flipped(a * cmap.joint_factors(quantity, a.shape[1]), cmap, quantity, table.name)
     if n is None:
         n = 0
         while _fill(tpl, n) in table.columns:
@@ -633,9 +727,9 @@ def _vector(table: _Table, cmap: ColumnMap, quantity: str, n: int | None) -> NDA
         )
     group = table.groups.get(quantity)
     # the columns of a group scaled as read are in SI (the first n of the group: names)
-    f = 1.0 if quantity in table.scaled else cmap.factor(quantity)
+    f = 1.0 if quantity in table.scaled else cmap.joint_factors(quantity, n)
     if group is not None and group[0] == names:  # read side by side: no copy when in SI
-        a = group[1] if f == 1.0 else _checks.frozen(group[1] * f)
+        a = group[1] if np.all(f == 1.0) else _checks.frozen(group[1] * f)
     else:
         a = np.stack([table.columns[c] for c in names], axis=1) * f
     return _flipped(a, cmap, quantity, table.name)
@@ -1081,6 +1175,8 @@ def load_mapped_static_data(
         count other than the robot's, NaN rows (without ``drop_invalid``).
     """
     path = Path(path)
+    if robot is not None:  # a unit of q for the joints of its kind
+        columns = columns.for_robot(robot.prismatic)
     table = _read_table(path, columns, ("q", "g", "M"))
     n = robot.n if robot is not None else None
     tpl_q = columns.template("q")

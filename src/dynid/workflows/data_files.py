@@ -98,6 +98,7 @@ def column_map(
     *,
     cutoff_hz: float | None = None,
     drive: Drive | None = None,
+    robot: Robot | None = None,
 ) -> ColumnMap | None:
     """The column map of ``--columns`` (text or a ``.toml`` file) and ``--units``, or None;
     the units declared logged once as a note (:meth:`~dynid.io.columns.ColumnMap.unit_note`),
@@ -115,11 +116,17 @@ def column_map(
     drive : Drive, optional
         The drive the logs are read through: ``tau`` in ``A`` or ``mA`` needs one whose
         effort is current.
+    robot : Robot, optional
+        The robot the logs are read for: a unit of ``q``, ``dq``, ``ddq`` scales the
+        joints of its kind alone (a length's the prismatic joints, an angle's the
+        revolute ones: :meth:`~dynid.io.columns.ColumnMap.for_robot`), said in a note
+        when the robot has both kinds.
 
     Raises
     ------
     DataError
-        A malformed map or unit (named).
+        A malformed map or unit (named); a unit whose kind matches none of ``robot``'s
+        joints (``q=mm`` for an arm of revolute joints alone).
     OptionError
         ``tau`` in a current's unit without a drive of effort = "current", or in a
         torque's unit with one.
@@ -145,6 +152,10 @@ def column_map(
     check_current_unit(cmap, drive)
     if (note := cmap.unit_note()) is not None:
         _log.info(note)
+    if robot is not None:
+        cmap = cmap.for_robot(robot.prismatic)
+        for said in cmap.kind_notes(robot.joint_names):
+            _log.log(NOTE, "%s", said)
     return cmap
 
 
@@ -330,6 +341,8 @@ def _units_in_ms(
     if columns is not None and columns.factor("t") != 1.0:
         return None
     cm = columns if columns is not None else ColumnMap()
+    if robot.n == n or n is None:
+        cm = cm.for_robot(robot.prismatic)
     ms = dataclasses.replace(cm, factors={**cm.factors, "t": 1e-3}, names={**cm.names, "t": "ms"})
     try:
         log = load_mapped_torque_log(path, ms, n=n).log
@@ -354,6 +367,8 @@ def _read_torque_log(
     if columns is None:
         log = load_torque_log(path, drop_invalid=drop_invalid)
     else:
+        if robot is not None and n in (None, robot.n):  # each unit for its joints' kind
+            columns = columns.for_robot(robot.prismatic)
         mapped = load_mapped_torque_log(path, columns, n=n)
         said_of = commanded_torques(columns.template("tau"), header_names(path), mapped.log.n)
         if said_of is not None:  # a controller's torque read as measured: once per run

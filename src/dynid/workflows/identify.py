@@ -136,9 +136,9 @@ __all__ = [
 _log = logging.getLogger(__name__)
 
 
-def _columns(spec: ColumnSpec | None, cutoff_hz: Cutoff, drive: Drive | None) -> Any:
+def _columns(spec: ColumnSpec | None, cutoff_hz: Cutoff, drive: Drive | None, robot: Robot) -> Any:
     cut = velocity_cutoff(cutoff_hz)
-    return None if spec is None else column_map(*spec, cutoff_hz=cut, drive=drive)
+    return None if spec is None else column_map(*spec, cutoff_hz=cut, drive=drive, robot=robot)
 
 
 def _heldout(
@@ -466,7 +466,7 @@ def identify_files(
     paths = data_files(data)
     prior = _prior(robot, opt)
     path = paths[0]
-    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive)
+    cmap = _columns(opt.columns, opt.cutoff_hz, opt.drive, robot)
     check_file_entries(cmap, [*paths, *([] if opt.validate_on is None else [opt.validate_on])])
     kind = data_kind(path, cmap)
     heldout = _heldout(paths, kind, opt.folds, opt.validate_on, robot, cmap, opt.drop_invalid)

@@ -551,7 +551,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     wants_margin = opts.standstill if given is None else given.standstill
     files = data_files(opts.data)
     columns = recorded_columns(recorded, *opts.columns, files)  # (names, units), said once
-    cmap = column_map(*columns, drive=model.drive)
+    cmap = column_map(*columns, drive=model.drive, robot=model.robot)
     read = _read_logs(files, model, cmap, opts, recorded, columns[1])
     read, _ = despiked_recordings(
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ

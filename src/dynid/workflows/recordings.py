@@ -262,7 +262,7 @@ def read_recordings(
     """
     paths = data_files(data)
     names, units = recorded_columns(recorded, *(columns or (None, None)), paths)
-    cmap = column_map(names, units, cutoff_hz=cutoff_hz, drive=drive)
+    cmap = column_map(names, units, cutoff_hz=cutoff_hz, drive=drive, robot=robot)
     mine, toml = columns or (None, None), str((columns or (None,))[0] or "").lower()
     if mine[1] is not None or toml.endswith(".toml"):  # the user's units, not the model's
         check_file_entries(cmap, paths)  # recorded map (it names its own files)

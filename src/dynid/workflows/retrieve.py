@@ -331,7 +331,7 @@ def retrieve_files(
         raise DynidError("retrieving from static data needs the robot that recorded them")
     else:
         robot = _with_friction(robot, opt.friction)
-        cmap = None if spec is None else column_map(*spec)
+        cmap = None if spec is None else column_map(*spec, robot=robot)
         check_file_entries(cmap, [source])
         data = read_static_file(source, robot, columns=cmap, drop_invalid=opt.drop_invalid)
         data = without_outlying(robot, Path(source), data, keep_flag="")
