@@ -340,7 +340,7 @@ class ColumnMap:
             return None
         return "length" if name.partition("/")[0] in _LENGTH else "angle"
 
-    def for_robot(self, prismatic: Sequence[bool], joint_names: Sequence[str] = ()) -> ColumnMap:
+    def for_robot(self, prismatic: Sequence[bool] | NDArray[np.bool_]) -> ColumnMap:
         """The map that reads the files of a robot whose joints are ``prismatic`` (n,):
         each named unit of ``q``, ``dq``, ``ddq`` scales the joints of its kind alone
         (:attr:`prismatic`, :meth:`joint_factors`).

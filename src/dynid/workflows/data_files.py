@@ -138,14 +138,13 @@ def column_map(
         cmap = load_column_map(columns, **kw)
         if units is not None:
             extra = parse_column_map(None, units)
-            cmap = type(cmap)(
-                cmap.columns,
-                {**cmap.factors, **extra.factors},
+            cmap = dataclasses.replace(
+                cmap,
+                factors={**cmap.factors, **extra.factors},
                 names={**cmap.names, **extra.names},
                 flips={**cmap.flips, **extra.flips},
                 file_flips={**cmap.file_flips, **extra.file_flips},
                 file_signs={**cmap.file_signs, **extra.file_signs},
-                **kw,
             )
     else:
         cmap = parse_column_map(columns, units, **kw)
