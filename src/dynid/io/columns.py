@@ -13,11 +13,14 @@ A :class:`ColumnMap` names, per quantity, the column template of a file and its 
   refused (it would read one column per row). A quantity not mapped keeps dynid's name
   (``q{i}``, ``tau{i}``, ``M{i}_{j}``, ...). In an NPZ file a template names an array;
 * units (converted to SI on reading): ``t`` in ``s, ms, us, ns``; ``q`` in ``rad, deg``
-  (``m, mm`` for prismatic arms); ``dq`` in ``rad/s, deg/s``; ``ddq`` in ``rad/s^2,
-  deg/s^2``; ``tau`` and ``g`` in ``Nm, N m, mNm, mN m``, ``tau`` also in ``A, mA`` (motor
-  currents, read through a drive whose effort is current); ``M`` in ``kg m^2, g m^2``; or
-  a number, the factor to SI. A unit given is the user's word, not a finding: the map
-  says it once (:meth:`ColumnMap.unit_note`), not each file;
+  (``m, mm`` for prismatic joints); ``dq`` in ``rad/s, deg/s`` (``m/s, mm/s``); ``ddq``
+  in ``rad/s^2, deg/s^2`` (``m/s^2, mm/s^2``): once the robot is known
+  (:meth:`ColumnMap.for_robot`) a length unit scales the prismatic joints' columns alone,
+  an angle unit the revolute joints' alone; ``tau`` and ``g`` in ``Nm, N m, N, mNm,
+  mN m``, ``tau`` also in ``A, mA`` (motor currents, read through a drive whose effort
+  is current); ``M`` in ``kg m^2, g m^2``; or a number, the factor to SI. A unit given
+  is the user's word, not a finding: the map says it once (:meth:`ColumnMap.unit_note`),
+  not each file;
 * sign flips of single joints: ``tau2=-1`` (also ``q3``, ``dq3``, ``ddq3``; joints from 1)
   flips that joint's column as it is read, after its quantity's unit (a controller whose
   convention differs on some joints; ``tau=-1`` flips every joint); prefixed by a file's
