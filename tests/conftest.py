@@ -168,6 +168,29 @@ def pinocchio_panda_model(arm=None, load=None):
     return model
 
 
+def pinocchio_panda_static(seed, N, margin=0.95, load=None):
+    """Pinocchio's exact ``(q, M, g)`` of :func:`pinocchio_panda_model` (``load`` on link
+    7) at ``N`` configurations drawn uniformly within ``margin`` times dynid's Panda's
+    joint limits (seed ``seed``): what a controller's model gives at static
+    configurations. Skips the test without Pinocchio."""
+    import pytest
+
+    pin = pytest.importorskip("pinocchio")
+    import dynid
+
+    model = pinocchio_panda_model(None, load)
+    data = model.createData()
+    robot = dynid.panda()
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(np.asarray(robot.q_min) * margin, np.asarray(robot.q_max) * margin, (N, 7))
+    M, g = np.empty((N, 7, 7)), np.empty((N, 7))
+    for s in range(N):
+        A = pin.crba(model, data, q[s]).copy()
+        M[s] = np.triu(A) + np.triu(A, 1).T
+        g[s] = pin.computeGeneralizedGravity(model, data, q[s])
+    return q, M, g
+
+
 def mujoco_inverse(model, q, dq, ddq):
     """MuJoCo's inverse dynamics ``qfrc_inverse`` (N, nv) of ``model`` (an ``MjModel``) at
     each state (N, nv)."""

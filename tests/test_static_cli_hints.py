@@ -10,31 +10,18 @@ Panda inertials; the row made NaN is known by construction.
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import dynid
 from dynid.cli.__main__ import main
 from dynid.io.model_json import load_model_json
 from dynid.io.static_data import static_columns
 
-from conftest import pinocchio_panda_model
+from conftest import pinocchio_panda_static
 
 
 def _truth(seed: int, N: int):
     """Pinocchio's exact ``(q, M, g)`` at ``N`` random configurations within the limits."""
-    pin = pytest.importorskip("pinocchio")
-    model = pinocchio_panda_model()
-    data = model.createData()
-    robot = dynid.panda()
-    rng = np.random.default_rng(seed)
-    q = rng.uniform(np.asarray(robot.q_min) * 0.95, np.asarray(robot.q_max) * 0.95, (N, 7))
-    M = np.empty((N, 7, 7))
-    g = np.empty((N, 7))
-    for s in range(N):
-        A = pin.crba(model, data, q[s]).copy()
-        M[s] = np.triu(A) + np.triu(A, 1).T
-        g[s] = pin.computeGeneralizedGravity(model, data, q[s])
-    return q, M, g
+    return pinocchio_panda_static(seed, N)
 
 
 def _err_lines(capsys) -> list[str]:

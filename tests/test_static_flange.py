@@ -21,7 +21,7 @@ from dynid.identification.static_flange import data_flange_note, model_flange_no
 from dynid.io.static_data import save_static_data
 from dynid.workflows.identify import identify_files
 
-from conftest import pinocchio_panda_model
+from conftest import pinocchio_panda_model, pinocchio_panda_static
 
 HAND_MASS = 0.73
 HAND_COM = np.array([-0.01, 0.0, 0.137])  # [m] in link 7's frame
@@ -34,16 +34,8 @@ def _truth(N: int, hand: bool, seed: int = 3):
     load = None
     if hand:
         load = pin.Inertia(HAND_MASS, HAND_COM, np.diag([0.001, 0.0025, 0.0017]))
-    model = pinocchio_panda_model(None, load)
-    data = model.createData()
-    robot = dynid.panda()
-    q = np.random.default_rng(seed).uniform(robot.q_min * 0.9, robot.q_max * 0.9, (N, 7))
-    M, g = np.empty((N, 7, 7)), np.empty((N, 7))
-    for s in range(N):
-        A = pin.crba(model, data, q[s]).copy()
-        M[s] = np.triu(A) + np.triu(A, 1).T
-        g[s] = pin.computeGeneralizedGravity(model, data, q[s])
-    return q, M, g, model
+    q, M, g = pinocchio_panda_static(seed, N, margin=0.9, load=load)
+    return q, M, g, pinocchio_panda_model(None, load)
 
 
 def _said(notes, what="a mass of about"):

@@ -16,25 +16,14 @@ from dynid.exceptions import DataError
 from dynid.io.columns import load_mapped_static_data, parse_column_map
 from dynid.io.static_data import load_static_data
 
-from conftest import pinocchio_panda_model
+from conftest import pinocchio_panda_static
 
 
 def _libfranka_csv(path, seed: int, N: int = 6, first: int = 0):
     """A libfranka-style dump of Pinocchio's M and g at ``N`` random configurations:
     ``q{first}..``, ``M{first}..M{first + 48}`` column-major, ``g{first}..``; returns the
     truth ``(q, M, g)``."""
-    pin = pytest.importorskip("pinocchio")
-    model = pinocchio_panda_model()
-    data = model.createData()
-    rng = np.random.default_rng(seed)
-    robot = dynid.panda()
-    q = rng.uniform(np.asarray(robot.q_min) * 0.9, np.asarray(robot.q_max) * 0.9, (N, 7))
-    M = np.empty((N, 7, 7))
-    g = np.empty((N, 7))
-    for s in range(N):
-        A = pin.crba(model, data, q[s]).copy()
-        M[s] = np.triu(A) + np.triu(A, 1).T
-        g[s] = pin.computeGeneralizedGravity(model, data, q[s])
+    q, M, g = pinocchio_panda_static(seed, N, margin=0.9)
     names = (
         [f"q{i + first}" for i in range(7)]
         + [f"M{k + first}" for k in range(49)]

@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 
 import numpy as np
-import pytest
 
 import dynid
 from dynid.cli.__main__ import main
@@ -20,24 +19,12 @@ from dynid.identification.static_outliers import outlying_configurations
 from dynid.io.model_json import load_model_json
 from dynid.io.static_data import save_static_csv
 
-from conftest import pinocchio_panda_model
+from conftest import pinocchio_panda_static
 
 
 def _truth(seed: int, N: int):
     """Pinocchio's exact ``(q, M, g)`` at ``N`` random configurations within the limits."""
-    pin = pytest.importorskip("pinocchio")
-    model = pinocchio_panda_model()
-    data = model.createData()
-    robot = dynid.panda()
-    rng = np.random.default_rng(seed)
-    q = rng.uniform(np.asarray(robot.q_min) * 0.95, np.asarray(robot.q_max) * 0.95, (N, 7))
-    M = np.empty((N, 7, 7))
-    g = np.empty((N, 7))
-    for s in range(N):
-        A = pin.crba(model, data, q[s]).copy()
-        M[s] = np.triu(A) + np.triu(A, 1).T
-        g[s] = pin.computeGeneralizedGravity(model, data, q[s])
-    return q, M, g
+    return pinocchio_panda_static(seed, N)
 
 
 def _controller(seed: int, N: int, out_of_step: int | None) -> StaticDataset:
