@@ -15,6 +15,8 @@ import pytest
 from dynid.cli.__main__ import main
 from dynid.io.observer_files import load_thresholds
 
+from conftest import TWO_LEAVES
+
 
 @pytest.fixture(scope="module")
 def logs(tmp_path_factory):
@@ -171,26 +173,6 @@ def test_observe_refuses_thresholds_of_another_joint_count(logs, calibrated, cap
     args = ["observe", "--params", "panda", "--thresholds", str(d / "six.json")]
     assert main([*args, "--data", str(d / "hit.csv"), "--out", str(d / "bad")]) == 2
     assert "thresholds for 6 joints" in capsys.readouterr().err
-
-
-TWO_LEAVES = """<robot name="two_leaves">
-  <link name="world"/>
-  <link name="upper"><inertial><origin xyz="0 0 0.15"/><mass value="2.0"/>
-    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.004"/></inertial></link>
-  <link name="lower"><inertial><origin xyz="0.1 0 0"/><mass value="1.0"/>
-    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
-  <link name="camera"><inertial><mass value="0.3"/>
-    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>
-  <joint name="shoulder" type="revolute"><parent link="world"/><child link="upper"/>
-    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="50" velocity="3"/></joint>
-  <joint name="elbow" type="revolute"><parent link="upper"/><child link="lower"/>
-    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>
-    <limit lower="-2" upper="2" effort="30" velocity="3"/></joint>
-  <joint name="pan" type="revolute"><parent link="world"/><child link="camera"/>
-    <origin xyz="0.2 0 0.05"/><axis xyz="0 0 1"/>
-    <limit lower="-3" upper="3" effort="5" velocity="3"/></joint>
-</robot>
-"""
 
 
 def test_observe_params_urdf_with_two_leaves_takes_the_chain_of_tip(tmp_path, capsys):

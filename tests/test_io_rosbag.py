@@ -23,6 +23,8 @@ from rosbags.rosbag2 import StoragePlugin  # noqa: E402
 from rosbags.rosbag2 import Writer as Writer2  # noqa: E402
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
 
+from conftest import TWO_LEAVES  # noqa: E402
+
 JS = "sensor_msgs/msg/JointState"
 T0_NS = 1_700_000_000_123_456_789  # an epoch stamp: float64 seconds would lose the ns
 
@@ -410,26 +412,6 @@ def test_a_ros1_bag_given_to_data_names_the_import_that_converts_it(tmp_path, ca
     np.testing.assert_allclose(back.t, log.t, atol=1e-9)
 
 
-_TWO_LEAVES = """<robot name="two">
-  <link name="world"/>
-  <link name="upper"><inertial><origin xyz="0 0 0.15"/><mass value="2.0"/>
-    <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.004"/></inertial></link>
-  <link name="lower"><inertial><origin xyz="0.1 0 0"/><mass value="1.0"/>
-    <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
-  <link name="camera"><inertial><mass value="0.3"/>
-    <inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial></link>
-  <joint name="shoulder" type="revolute"><parent link="world"/><child link="upper"/>
-    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="50" velocity="3"/></joint>
-  <joint name="elbow" type="revolute"><parent link="upper"/><child link="lower"/>
-    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>
-    <limit lower="-2" upper="2" effort="30" velocity="3"/></joint>
-  <joint name="pan" type="revolute"><parent link="world"/><child link="camera"/>
-    <origin xyz="0.2 0 0.05"/><axis xyz="0 0 1"/>
-    <limit lower="-3" upper="3" effort="5" velocity="3"/></joint>
-</robot>
-"""
-
-
 @pytest.mark.parametrize("folder", [False, True], ids=["bag", "folder-of-bags"])
 def test_the_suggested_import_keeps_the_robot_options_given(tmp_path, capsys, folder):
     """Regression (a Baxter trial: identify --robot baxter.urdf --base ... --tip ... --data
@@ -438,7 +420,7 @@ def test_the_suggested_import_keeps_the_robot_options_given(tmp_path, capsys, fo
     --base and --tip typed, and the bag as given, and run as given it writes the log the
     bag holds (joints matched by the chain's names)."""
     urdf = tmp_path / "two.urdf"
-    urdf.write_text(_TWO_LEAVES)
+    urdf.write_text(TWO_LEAVES)
     names = ["shoulder", "elbow"]
     rng = np.random.default_rng(4)
     t = np.arange(40) * 1e-2
