@@ -548,17 +548,19 @@ def _checked_units(units: str) -> bool:
     named units of :data:`_CHECKED_QUANTITIES` (``t=us,q=deg,dq=deg/s``): a new file they
     do not fit is refused with its own hint, so reusing them is a note (a column map of
     other names fails on the first missing column just as plainly)."""
-    entries = [e.split("=", 1) for e in units.split(",") if e.strip()]
-    if not entries or any(len(e) != 2 for e in entries):
+    try:
+        parsed = parse_column_map(None, units)
+    except DataError:
         return False
-    for key, value in entries:
-        quantity = key.strip().rsplit(":", 1)[-1].rstrip("0123456789")
-        v = value.strip()
-        if v in ("-1", "1", "+1"):
-            continue
-        if quantity not in _CHECKED_QUANTITIES or not v or v[0].isdigit() or v[0] in "+-.":
-            return False
-    return True
+    said = dict(parsed.names)
+    signs = (parsed.flips, parsed.file_flips, parsed.file_signs)
+    if not said and not any(signs):
+        return False
+    return all(
+        unit in ("-1", "1", "+1")
+        or (quantity in _CHECKED_QUANTITIES and not unit[:1].isdigit() and unit[:1] not in "+-.")
+        for quantity, unit in said.items()
+    )
 
 
 def _reads_alike(
