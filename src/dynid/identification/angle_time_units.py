@@ -34,6 +34,7 @@ from .log import TorqueLog
 __all__ = [
     "RATE_AGREES",
     "GivenUnits",
+    "named_unit",
     "unit_name",
     "units_with",
     "degrees_findings",
@@ -60,6 +61,12 @@ _UNIT_NAMES: dict[str, dict[str, float]] = {
     "q": {"rad": 1.0, "deg": math.pi / 180},
     "dq": {"rad/s": 1.0, "deg/s": math.pi / 180},
     "ddq": {"rad/s^2": 1.0, "deg/s^2": math.pi / 180},
+}
+#: The ``--units`` spellings of a prismatic joint's quantities [to SI].
+_LENGTH_NAMES: dict[str, dict[str, float]] = {
+    "q": {"m": 1.0, "mm": 1e-3},
+    "dq": {"m/s": 1.0, "mm/s": 1e-3},
+    "ddq": {"m/s^2": 1.0, "mm/s^2": 1e-3},
 }
 #: The quantities in the order ``--units`` entries are written (a new one goes after its
 #: neighbour: ``q=deg,dq=deg/s``).
@@ -91,10 +98,19 @@ class GivenUnits:
 def unit_name(quantity: str, factor: float) -> str:
     """The ``--units`` spelling of ``factor`` [1, to SI] for ``quantity``: ``deg/s`` for
     ``dq`` at ``pi / 180``, ``us`` for ``t`` at ``1e-6``; the number otherwise."""
-    for name, f in _UNIT_NAMES.get(quantity, {}).items():
-        if math.isclose(factor, f, rel_tol=1e-9):
+    return named_unit(quantity, factor) or f"{factor:.10g}"
+
+
+def named_unit(
+    quantity: str, factor: float, length: bool = False, rel_tol: float = 1e-9
+) -> str | None:
+    """The ``--units`` unit name of ``factor`` [1, to SI] for ``quantity`` (of a
+    prismatic joint's with ``length``: ``mm/s`` for ``dq`` at ``1e-3``), or None when no
+    name has it (within ``rel_tol``)."""
+    for name, f in (_LENGTH_NAMES if length else _UNIT_NAMES).get(quantity, {}).items():
+        if math.isclose(factor, f, rel_tol=rel_tol):
             return name
-    return f"{factor:.10g}"
+    return None
 
 
 def units_with(text: str | None, entries: Mapping[str, str]) -> str:

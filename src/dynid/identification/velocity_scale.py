@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
-from .angle_time_units import RATE_AGREES, GivenUnits, unit_name
+from .angle_time_units import RATE_AGREES, GivenUnits, named_unit, unit_name
 from .log import TorqueLog
 
 __all__ = [
@@ -213,20 +213,10 @@ def velocity_scale_finding(
     )
 
 
-#: The ``--units`` spellings of a prismatic joint's velocities and accelerations [to SI].
-_LENGTH_RATES = {
-    "dq": {"m/s": 1.0, "mm/s": 1e-3},
-    "ddq": {"m/s^2": 1.0, "mm/s^2": 1e-3},
-}
-
-
 def _length_rate(quantity: str, factor: float) -> str | None:
     """The ``--units`` spelling of ``factor`` for a prismatic joint's ``quantity``, or
     None when it is no length unit's."""
-    for name, f in _LENGTH_RATES[quantity].items():
-        if math.isclose(factor, f, rel_tol=1e-6):
-            return name
-    return None
+    return named_unit(quantity, factor, length=True, rel_tol=1e-6)
 
 
 def prismatic_scale_finding(
