@@ -6,6 +6,8 @@ give that CSV's log back (times to 1e-9 s, values exactly), and count what it dr
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -540,3 +542,32 @@ def test_import_labels_the_effort_with_the_drives_unit(tmp_path, capsys):
     assert declared_tau_unit(tmp_path / "t.csv") == "N m"
     np.testing.assert_array_equal(load_torque_log(tmp_path / "a.csv").tau, log.tau)
     assert "tau in A: motor currents" in capsys.readouterr().out
+
+
+def test_the_suggested_import_of_a_model_run_takes_the_model(tmp_path, capsys, monkeypatch):
+    """Regression (a Baxter trial): validate --model id.json given a bag suggested
+    'dynid import train1.bag --robot ROBOT', a robot the user never typed. The suggestion
+    names the model, and ``dynid import --model`` reads the model's robot and drive: run as
+    given, it writes the bag's log with the drive's effort unit (a geared arm logged in
+    motor currents: tau [A])."""
+    from dynid.io.model_json import save_model_json
+
+    from conftest import exact_model, geared_drive
+
+    robot = dynid.panda()
+    model = dataclasses.replace(exact_model(robot, robot), drive=geared_drive())
+    save_model_json(tmp_path / "id.json", model)
+    log = _small(robot, N=40, seed=21)
+    write_bag(tmp_path / "train1.bag", "ros1", _shuffled(log, robot, 22))
+    monkeypatch.chdir(tmp_path)
+    argv = ["validate", "--model", "id.json", "--data", "train1.bag", "--out", "o"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    command = err.split("'dynid ")[1].split("'")[0]
+    assert command == "import train1.bag --model id.json --out train1.csv", err
+    assert main([*command.split(), "-q"]) == 0
+    assert "tau [A]" in (tmp_path / "train1.csv").read_text().splitlines()[0]
+    back = load_torque_log(tmp_path / "train1.csv")
+    np.testing.assert_array_equal(back.tau, log.tau)
+    assert main([*command.split(), "--robot", "panda"]) == 2
+    assert "--robot applies to a run without --model only" in capsys.readouterr().err

@@ -87,8 +87,9 @@ def missing_input(args: argparse.Namespace, filename: str | Path) -> str | None:
     return None
 
 
-#: The options of a run that ``dynid import`` takes too: its robot's and drive's.
-IMPORT_ROBOT_OPTIONS = ("robot", "base", "tip", "snap_angles", "drive")
+#: The options of a run that ``dynid import`` takes too: its robot's and drive's, or the
+#: identified model that holds both.
+IMPORT_ROBOT_OPTIONS = ("model", "robot", "base", "tip", "snap_angles", "drive")
 
 
 def import_robot(message: str, args: argparse.Namespace, given: frozenset[str]) -> str:

@@ -17,13 +17,15 @@ counted. Without velocities in the recording the log holds positions and torques
 and none takes them for measured ones. A JointState's effort is whatever its driver puts
 there: with a --drive whose effort is "current" the log's units line gives the tau columns
 as motor currents (tau [A]), which identify and validate then read through that drive;
-without one, as joint torques (tau [N m]).
+without one, as joint torques (tau [N m]). --model identification.json takes the robot
+and drive of an identified model instead of --robot and --drive.
 
 Writes the torque log (--out .csv or .npz) that identify, friction and validate read.
 
 examples:
   dynid import recording/ --out log.csv --robot panda --topic /joint_states
   dynid import joint_states.csv --out log.csv --robot arm.urdf   (rostopic echo -p)
+  dynid import recording/ --out log.csv --model id/identification.json
 """
 
 from __future__ import annotations
@@ -34,9 +36,10 @@ from pathlib import Path
 from typing import Any
 
 from ..io.joint_states import JointStateImport
+from ..io.model_json import load_model_json
 from ..io.ros_recordings import load_joint_state_recording
 from ..io.torque_log import save_torque_log
-from .applies import urdf_chain
+from .applies import Applies, urdf_chain
 from .common import (
     add_drive_option,
     add_robot_options,
@@ -51,7 +54,15 @@ NAME = "import"
 #: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
 OUTPUT = "file"
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
-APPLIES = (urdf_chain(),)
+APPLIES = (
+    urdf_chain(),
+    Applies(
+        ("robot", "drive"),
+        lambda a: a.model is None,
+        "a run without --model",
+        "--model carries the identified robot and drive",
+    ),
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -79,6 +90,13 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_robot_options(p)
     add_drive_option(p)
     p.add_argument(
+        "--model",
+        type=Path,
+        default=None,
+        help="identification.json of an identified model: its robot and drive, instead of "
+        "--robot and --drive",
+    )
+    p.add_argument(
         "--joints",
         default=None,
         help="the recording's joint names in the robot's order, comma-separated",
@@ -89,10 +107,16 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace, console: Console) -> int:
     """Read the recording, write the log, print what was found; returns the exit code."""
-    robot = load_robot(args)
+    if args.model is not None:
+        model = load_model_json(args.model)
+        robot, drive = model.robot, model.drive
+    else:
+        robot = load_robot(args)
+        drive = None
     joints = None if args.joints is None else [s.strip() for s in args.joints.split(",")]
     res = load_joint_state_recording(args.bag, robot.joint_names, topic=args.topic, joints=joints)
-    drive = load_drive_arg(args, robot.n)
+    if args.model is None:
+        drive = load_drive_arg(args, robot.n)
     unit = "N m" if drive is None else drive.effort_unit
     path = save_torque_log(args.out, res.log, tau_unit=unit)
     if args.json:

@@ -239,8 +239,9 @@ def with_import_robot(message: str, options: Sequence[str]) -> str:
     (:data:`~dynid.io.bag_hint.ROBOT`)
     given as ``options``: the run's own robot options as typed (``["--robot", "arm.urdf",
     "--base", "b", "--tip", "t"]``), so that the import reads the same chain (a URDF of
-    several leaves needs its ``--tip``); unchanged without ``--robot`` among them."""
-    if "--robot" not in options:
+    several leaves needs its ``--tip``), or ``["--model", "id/identification.json"]``;
+    unchanged without ``--robot`` or ``--model`` among them."""
+    if "--robot" not in options and "--model" not in options:
         return message
     return re.sub(
         r"(dynid import \S+ )" + re.escape(ROBOT),
