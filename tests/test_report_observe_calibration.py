@@ -9,6 +9,7 @@ those thresholds on the same log, and the log's own duration.
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import json
 import re
@@ -212,3 +213,34 @@ def test_the_report_shows_the_residual_read_as_the_summary_does(free, tmp_path, 
     rows = re.findall(r"<tr>(.*?)</tr>", table, flags=re.S)[1:]
     cells = [re.findall(r"<td>([^<]*)</td>", r)[k] for r in rows]
     assert cells == [number(c / 1.5) for c in th["contact"]]
+
+
+def test_a_calibration_on_the_models_own_recordings_is_said_in_sample(free, tmp_path, capsys):
+    """Regression (a TALOS trial): observe --calibrate on logs three of four of which the
+    model was identified from said "the model predicts the calibration logs' torques to
+    1.04 % ... at the noise floor" as if held out. A calibration log that is one of the
+    identification's recordings (by file name) is counted and the judgement said to be
+    in-sample, in the summary, thresholds.json and the report; another log is not."""
+    from dynid.identification.info import IdentificationInfo
+    from dynid.io.model_json import save_model_json
+
+    from conftest import exact_model
+
+    path, _ = free
+    panda = dynid.panda()
+    said = {}
+    for name, files in (("own", ({"file": path.name},)), ("other", ({"file": "r9.csv"},))):
+        info = IdentificationInfo(recordings=files)
+        model = dataclasses.replace(exact_model(panda, panda), info=info)
+        saved = save_model_json(tmp_path / f"{name}.json", model)
+        out = tmp_path / name
+        args = ["observe", "--model", str(saved), "--data", str(path), "--calibrate"]
+        capsys.readouterr()
+        assert main([*args, "--no-figures", "--out", str(out)]) == 0
+        check = json.loads((out / "thresholds.json").read_text())["calibration"]["model_check"]
+        page = html.unescape((out / "report.html").read_text())
+        said[name] = (check["fitted"], capsys.readouterr().out, page)
+    words = "all are the identification's own recordings, so in-sample"
+    assert said["own"][0] == [1, 1] and said["other"][0] == [0, 1]
+    assert words in said["own"][1] and words in said["own"][2]
+    assert "in-sample" not in said["other"][1] and "in-sample" not in said["other"][2]

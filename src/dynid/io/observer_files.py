@@ -30,7 +30,9 @@
                      "sigma_max": [...],  # N m per joint, the largest sigma (uncertainty)
                      "model_check": {     # the model judged on the logs as validate does
                          "relative_error_percent": e, "noise_floor_percent": f,
-                         "verdict": {"level", "label", "reason", "ratio"}}},
+                         "verdict": {"level", "label", "reason", "ratio"},
+                         "fitted": [k, m]}},  # k of the m logs the model's training
+                                          # recordings (in-sample)
      "units": {...}}
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
@@ -713,6 +715,7 @@ def save_observation(
                         "reason": v.reason,
                         "ratio": v.ratio,
                     },
+                    "fitted": list(m.fitted),
                 }
         return [
             save_thresholds(

@@ -55,29 +55,50 @@ class ModelCheck:
         The relative error of the model's torques with its friction on the logs [%].
     floor_percent : float
         The noise floor of the same torques [%].
+    fitted : tuple of int
+        ``(k, m)``: ``k`` of the ``m`` calibration logs are recordings the model was
+        identified from (judged in-sample); ``(0, m)`` or ``()`` none.
     """
 
     verdict: Verdict
     error_percent: float
     floor_percent: float
+    fitted: tuple[int, ...] = ()
 
     def words(self) -> str:
         """:func:`model_words` of this judgement."""
         v = self.verdict
-        return model_words(self.error_percent, self.floor_percent, v.level, v.label, v.ratio)
+        return model_words(
+            self.error_percent, self.floor_percent, v.level, v.label, v.ratio, self.fitted
+        )
 
 
 def model_words(
-    error_percent: float, floor_percent: float, level: str, label: str, ratio: float | None
+    error_percent: float,
+    floor_percent: float,
+    level: str,
+    label: str,
+    ratio: float | None,
+    fitted: tuple[int, ...] = (),
 ) -> str:
     """``"the model predicts the calibration logs' torques to 3.21 %, 1.04 x the noise
     floor of 3.09 % (validate's verdict: at the noise floor)"``, and for a poor or
     unusable model that the thresholds are wide because of it: the sentence of a
-    :class:`ModelCheck` (``ratio``: the verdict's, each sample against its own noise)."""
+    :class:`ModelCheck` (``ratio``: the verdict's, each sample against its own noise;
+    ``fitted`` ``(k, m)``: ``k`` of the ``m`` logs are the model's own training
+    recordings, said, since a judgement on them is in-sample)."""
     said = f"the model predicts the calibration logs' torques to {error_percent:.3g} %"
     if ratio is not None:
         said += f", {ratio:.3g} x the noise floor of {floor_percent:.3g} %"
-    said += f" (validate's verdict: {label})"
+    said += f" (validate's verdict: {label}"
+    if len(fitted) == 2 and fitted[0] > 0:
+        k, m = fitted
+        whose = "all are" if k == m else f"{k} of {m} are"
+        said += (
+            f"; {whose} the identification's own recordings, so in-sample: dynid validate "
+            "on a recording left out of the fit judges the model"
+        )
+    said += ")"
     if level in ("poor", "unusable"):
         said += (
             ": the thresholds are wide because of the model's error, not the sensors' "

@@ -61,8 +61,15 @@ def _model_check(cal: dict) -> tuple[str, str] | None:
     from ..observer.calibration_check import model_words  # here: any run's page loads this
 
     ratio = v.get("ratio")
+    fitted = m.get("fitted")
+    counted = isinstance(fitted, list) and len(fitted) == 2 and all(map(is_number, fitted))
     said = model_words(
-        err, floor, v["level"], str(v.get("label", v["level"])), ratio if is_number(ratio) else None
+        err,
+        floor,
+        v["level"],
+        str(v.get("label", v["level"])),
+        ratio if is_number(ratio) else None,
+        tuple(int(x) for x in fitted) if counted else (),
     )
     return f"<b>Model</b>: {esc(said)}", str(v["level"])
 

@@ -976,7 +976,9 @@ def _model_check(opts: ObserveOptions, model: ObserverModel, read: Recorded) -> 
     except DynidError:
         return None
     error = float(got.validation.errors.relative_error_percent)
-    return ModelCheck(got.verdict, error, float(got.noise_floor_percent))
+    fitted = judged.info.fitted_on(opts.data) if isinstance(judged, IdentifiedModel) else ()
+    count = (len(fitted), len(opts.data))
+    return ModelCheck(got.verdict, error, float(got.noise_floor_percent), count)
 
 
 def _checked(
