@@ -61,8 +61,9 @@ def _model_check(cal: dict) -> tuple[str, str] | None:
     from ..observer.calibration_check import model_words  # here: any run's page loads this
 
     ratio = v.get("ratio")
-    fitted = m.get("fitted")
-    counted = isinstance(fitted, list) and len(fitted) == 2 and all(map(is_number, fitted))
+    got = m.get("fitted")
+    fitted: list[Any] = got if isinstance(got, list) else []
+    counted = len(fitted) == 2 and all(map(is_number, fitted))
     said = model_words(
         err,
         floor,

@@ -976,7 +976,8 @@ def _model_check(opts: ObserveOptions, model: ObserverModel, read: Recorded) -> 
     except DynidError:
         return None
     error = float(got.validation.errors.relative_error_percent)
-    fitted = judged.info.fitted_on(opts.data) if isinstance(judged, IdentifiedModel) else ()
+    names = [Path(p).name for p in opts.data]
+    fitted = judged.info.fitted_on(names) if isinstance(judged, IdentifiedModel) else ()
     count = (len(fitted), len(opts.data))
     return ModelCheck(got.verdict, error, float(got.noise_floor_percent), count)
 
