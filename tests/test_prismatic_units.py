@@ -358,3 +358,21 @@ def test_observe_writes_and_prints_the_rails_units(rail_fit, logs, tmp_path):
     events, table = save_observation(tmp_path, found, joints=names, calibrating=False)
     assert json.loads(events.read_text())["units"]["peak"] == "N m (rail: N)"
     assert table.read_text().startswith("# dynid residuals; units: t [s], r [N m (rail: N)]")
+
+
+def test_a_verdicts_hint_says_the_rails_force_in_newtons():
+    """A residual that follows the rail's velocity is said in N (was: N m)."""
+    from dynid.identification.residual_dependence import dependence_hint
+
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 10.0, 4000)
+    q = np.column_stack([0.5 * np.sin(t), np.sin(0.7 * t)])
+    dq = np.column_stack([0.5 * np.cos(t), 0.7 * np.cos(0.7 * t)])
+    error = np.column_stack([30.0 * dq[:, 0], np.zeros_like(t)])
+    error += 0.01 * rng.standard_normal(error.shape)
+    noise = np.array([0.01, 0.01])
+    said = dependence_hint([q], [dq], [error], noise, ["rail", "swing"], prismatic=(True, False))
+    assert said is not None and said.startswith("rail: ")
+    assert " N RMS residual follows its velocity" in said and "N m" not in said
+    plain = dependence_hint([q], [dq], [error], noise, ["rail", "swing"])
+    assert plain is not None and " N m RMS residual follows its velocity" in plain

@@ -241,6 +241,7 @@ class HeldOutTorques:
                 [v.log.tau],
                 self.offsets,
                 self.left_out,
+                prismatic=None if self.robot is None else tuple(map(bool, self.robot.prismatic)),
             )
         )
         if said is not None and verdict.level == "good":  # at the floor, the factors said
