@@ -376,3 +376,26 @@ def test_a_verdicts_hint_says_the_rails_force_in_newtons():
     assert " N RMS residual follows its velocity" in said and "N m" not in said
     plain = dependence_hint([q], [dq], [error], noise, ["rail", "swing"])
     assert plain is not None and " N m RMS residual follows its velocity" in plain
+
+
+def test_payload_writes_and_prints_the_rails_units(logs):
+    """payload.json's residual units and payload's residual line say N for the rail (were:
+    N m)."""
+    from dynid.cli.payload import residual_line
+    from dynid.feasibility.payload import PayloadEstimate
+    from dynid.io.payload_json import payload_to_dict
+    from dynid.model.units import unit_said
+
+    robot = _robot(logs)
+    z3, z6, i3 = np.zeros(3), np.zeros(6), 0.01 * np.eye(3)
+    est = PayloadEstimate(
+        frame="arm", link=robot.n - 1, phi=np.r_[1.5, np.zeros(9)], mass=1.5, com=z3,
+        inertia=i3, std_mass=0.01, std_com=z3, std_inertia=z6, covariance=np.eye(4),
+        route="torque log, gravity and dynamics", inertia_identified=False,
+        constraint_active=False, margin=1e-6, rank=4, condition_number=10.0,
+        residual_rms=0.012, n_rows=100, friction=None, notes=(), noise_rms=0.01,
+    )  # fmt: skip
+    units = payload_to_dict(est, robot)["units"]
+    assert units["noise_rms"] == "N m (rail: N)"
+    line = residual_line(est, unit_said(robot, "N m"))
+    assert line.startswith("residual RMS 0.012 N m (rail: N), 1.2 x the torque noise (0.01 N m")
