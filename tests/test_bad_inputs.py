@@ -1009,7 +1009,8 @@ CASES = [
     # column maps: a quantity once, a column for one quantity only
     C("columns-one-column-two-quantities", None, f"validate --robot panda --data {{d}}/log.csv --columns tau=q{{i}} --out {OUT}", 2, "log.csv: column 'q1' is named by the templates of both 'q' and 'tau'"),
     C("static-columns-one-column-two-quantities", None, f"identify --data {{d}}/s.csv --columns g=q{{i}} --out {OUT}", 2, "s.csv: column 'q1' is named by the templates of both 'q' and 'g'"),
-    C("units-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --units q=deg,q=rad --out {OUT}", 2, "--units: 'q' is given twice in 'q=deg,q=rad'"),
+    C("units-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --units q=deg,q=rad --out {OUT}", 2, "--units q=deg,q=rad: two units of q must be one length unit for the prismatic joints (m, mm) and one angle unit for the revolute ones; hint: --units q=mm,q=deg"),
+    C("units-time-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --units t=ms,t=us --out {OUT}", 2, "--units: 't' is given twice in 't=ms,t=us'"),
     C("columns-given-twice", None, f"validate --robot panda --data {{d}}/log.csv --columns q=q{{i}},q=dq{{i}} --out {OUT}", 2, "--columns: 'q' is given twice"),
     C("units-factor-underscore", None, f"validate --robot panda --data {{d}}/log.csv --units tau=1_0 --out {OUT}", 2, "unknown unit '1_0' for 'tau'"),
     C("bounds-mass-1e300", bounds_mass_1e300, f"retrieve --model {{d}}/res/identification.json --bounds {{d}}/bounds.json --out {OUT}", 2, "bounds.json: mass_max must be at most 1e+06 kg per link; got [1e+300,"),

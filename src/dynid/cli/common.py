@@ -639,7 +639,9 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="MAP",
         help="units of --data: 'q=deg,dq=deg/s,tau=mNm,t=ms' (converted to SI, each "
-        "quantity by its own entry: q=deg leaves dq as read; tau=mA or A: motor "
+        "quantity by its own entry: q=deg leaves dq as read; a length unit, q=mm, reads the "
+        "prismatic joints, an angle unit the revolute ones, both given for both kinds: "
+        "q=mm,q=deg,dq=mm/s,dq=deg/s; tau=mA or A: motor "
         "currents, with a --drive of effort = current; tau=-1 flips every joint's sign, "
         "tau2=-1 joint 2's alone, rec2.csv:tau2=-1 or rec2.csv:tau=-1 in that file alone)",
     )

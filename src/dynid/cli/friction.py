@@ -154,7 +154,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
     fit, sel = result.fit, result.selection
     meta = result.metadata(str(args.model.name) if args.model is not None else args.robot)
     selection = None if sel is None else sel.as_dict()
-    save_friction_json(args.out / "friction.json", fit, metadata=meta, selection=selection)
+    save_friction_json(
+        args.out / "friction.json", fit, metadata=meta, selection=selection, robot=robot
+    )
     names = list(robot.joint_names)
     if not args.no_figures:
         law = fit.kind if sel is None else sel.label(sel.chosen)  # as the table names it
@@ -164,7 +166,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
     if sel is not None:
         console.print(sel.table())
-    console.print(format_friction_rms(names, fit, result.noise_std, result.decimate))
+    console.print(format_friction_rms(names, fit, result.noise_std, result.decimate, robot))
     if result.pieces is not None:
         console.print(result.pieces.describe())
     own = model.info.log if isinstance(model, IdentifiedModel) else None

@@ -74,6 +74,8 @@ from ..identification.verdict import FLOOR_FAIR
 from ..io.model_json import save_model_json
 from ..io.payload_json import save_payload_json
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
+from ..model.robot import Robot
+from ..model.units import unit_said
 from ..workflows.export import ExportRobotOptions, save_export
 from ..workflows.payload import PayloadFileResult, identify_payload_files
 from .applies import is_urdf, urdf_chain
@@ -192,7 +194,7 @@ def run(args: argparse.Namespace, console: Console) -> int:
         )
         loaded = save_export(args.out / ROBOT_WITH_LOAD, plan)
     path = save_payload_json(args.out / "payload.json", result.estimate, kin, with_tool=loaded.name)
-    print_payload(console, result, label)
+    print_payload(console, result, label, kin)
     if isinstance(arm, IdentifiedModel):
         console.print(
             f"note: {args.model.name} holds base parameters (combinations of the links' "
@@ -221,9 +223,12 @@ def _options(args: argparse.Namespace, n: int, drive: Any) -> dict[str, Any]:
     )
 
 
-def print_payload(console: Console, result: PayloadFileResult, label: str) -> None:
+def print_payload(
+    console: Console, result: PayloadFileResult, label: str, robot: Robot | None = None
+) -> None:
     """The estimate (mass, CoM, inertia with their std), the recordings, the preprocessing,
-    the notes and whether setLoad values were written."""
+    the notes and whether setLoad values were written (the torques' units per joint kind
+    of ``robot``)."""
     est = result.estimate
     console.print(f"payload on frame {est.frame!r} ({est.route}; arm: {label})")
     doubt = "  in doubt" if est.doubts else ""
@@ -237,8 +242,9 @@ def print_payload(console: Console, result: PayloadFileResult, label: str) -> No
         ):
             flag = "  not determined" if f"I{name}" in est.undetermined else ""
             console.print(f"  I{name}      {v:+.4e} kg m^2  (std {s:.2g}){flag}")
-    console.print(f"  {residual_line(est)}")
-    if (judged := judged_line(est)) is not None:
+    unit = unit_said(robot, "N m")
+    console.print(f"  {residual_line(est, unit)}")
+    if (judged := judged_line(est, unit)) is not None:
         console.print(f"  {judged}")
     if est.torque_scale is not None:
         console.print(f"  {scale_line(est.torque_scale, est.mass, est.floor_rms)}")
@@ -298,7 +304,7 @@ def scale_line(t: TorqueScale, mass: float, noise_rms: float | None = None) -> s
     )
 
 
-def residual_line(est: PayloadEstimate) -> str:
+def residual_line(est: PayloadEstimate, unit: str = "N m") -> str:
     """``residual RMS 0.0067 N m, 1.5 x the torque noise (0.0044 N m after the low-pass)``
     for torque logs, with the states' noise through the arm's model when known (``1.29 x
     the noise (the torques' 0.0073 N m after the low-pass and the states' through the
@@ -306,32 +312,33 @@ def residual_line(est: PayloadEstimate) -> str:
     :mod:`~dynid.feasibility.payload_floor`; over
     :data:`~dynid.identification.verdict.FLOOR_FAIR` x, what it means:
     :func:`~dynid.feasibility.payload_doubts.misfit_doubts`); the static rows' residual
-    without a unit of its own."""
+    without a unit of its own; ``unit``: the torques' (``N m (rail: N)`` on an arm with a
+    prismatic joint, :func:`~dynid.model.units.unit_said`)."""
     if not est.noise_rms:  # static data, or no noise read from the logs
         mixed = est.route.startswith("static M")
-        unit = " (rows of M [kg m^2] and g [N m])" if mixed else " N m"
-        return f"residual RMS {est.residual_rms:.2g}{unit}"
+        said = " (rows of M [kg m^2] and g [N m])" if mixed else f" {unit}"
+        return f"residual RMS {est.residual_rms:.2g}{said}"
     j = est.judged
     fit = j is None or j.kind == "fit"
     ratio = est.residual_rms / est.noise_rms
-    noise = f"the torque noise ({est.noise_rms:.2g} N m after the low-pass)"
+    noise = f"the torque noise ({est.noise_rms:.2g} {unit} after the low-pass)"
     if j is not None and j.states_rms is not None and fit and j.ratio is not None:
         ratio = j.ratio
-        noise += f" and the states' noise through the arm's model ({j.states_rms:.2g} N m)"
-    return f"residual RMS {est.residual_rms:.2g} N m, {ratio:.3g} x {noise}" + (
+        noise += f" and the states' noise through the arm's model ({j.states_rms:.2g} {unit})"
+    return f"residual RMS {est.residual_rms:.2g} {unit}, {ratio:.3g} x {noise}" + (
         f": over {FLOOR_FAIR:g} x, torques the arm's model leaves, which the load took"
         if ratio > FLOOR_FAIR and fit
         else ""
     )
 
 
-def judged_line(est: PayloadEstimate) -> str | None:
+def judged_line(est: PayloadEstimate, unit: str = "N m") -> str | None:
     """``judged   the difference from the unloaded arm's residual at matched states (100 %
     of the samples): 0.012 N m, 1.16 x the noise of both recordings (0.01 N m); within 3 x:
     the arm's misfit is common to both, not the load's``: the residual the load's doubt
     was judged on and its ratio (:attr:`PayloadEstimate.judged`,
     :mod:`~dynid.feasibility.payload_difference`); None when not judged (static data, or
-    the torque noise not known)."""
+    the torque noise not known); ``unit`` as :func:`residual_line`'s."""
     j = est.judged
     if j is None or (ratio := j.ratio) is None:
         return None
@@ -346,9 +353,9 @@ def judged_line(est: PayloadEstimate) -> str | None:
         )
     return (
         "judged   the difference from the unloaded arm's residual at matched states "
-        f"({100 * j.matched:.0f} % of the samples): {j.residual_rms:.2g} N m, {ratio:.3g} x "
-        f"the noise of both recordings ({j.noise_rms:.2g} N m"
-        + ("" if j.states_rms is None else f", the states' {j.states_rms:.2g} N m")
+        f"({100 * j.matched:.0f} % of the samples): {j.residual_rms:.2g} {unit}, {ratio:.3g} x "
+        f"the noise of both recordings ({j.noise_rms:.2g} {unit}"
+        + ("" if j.states_rms is None else f", the states' {j.states_rms:.2g} {unit}")
         + "); "
         + (
             f"over {FLOOR_FAIR:g} x: the load does not explain what changed between them"

@@ -27,6 +27,8 @@ from ..identification.outlying_spans import cut_text
 from ..identification.pieces import gaps_text
 from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints, own_rotors
 from ..io.observer_files import log_labels
+from ..model.robot import Robot
+from ..model.units import JointKinds, joint_unit, unit_said, values_said
 from ..observer.calibration_check import CalibrationCheck
 from ..observer.detection import undetected_at_rest
 from ..observer.friction import standstill_margin
@@ -170,7 +172,10 @@ def term_lines(model: IdentifiedModel) -> list[str]:
             stems.append(stem)
             units[stem] = "rad/s"
             cells |= {(stem, j + 1): f"{float(x):.3g}" for j, x in enumerate(values)}
-        heads = [f"{stem} [{units[stem]}]" if units[stem] else stem for stem in stems]
+        kinds = model.robot if row == "joint" else None  # a motor turns: rad
+        heads = [
+            f"{stem} [{unit_said(kinds, units[stem])}]" if units[stem] else stem for stem in stems
+        ]
         widths = [
             max(len(h), *(len(cells.get((stem, j), "-")) for j in range(1, n + 1)))
             for h, stem in zip(heads, stems, strict=True)
@@ -325,7 +330,7 @@ def _scales_lines(scales: dict[str, tuple[float, ...]], model: IdentifiedModel) 
         out.append(
             f"  width: the smooth Coulomb fc tanh(dq / width), smooth:{k} = "
             + ("K_j x max(band_j, " if each else f"{k} x max(band, ")
-            + f"{MIN_WIDTH:g} rad/s)"
+            + f"{MIN_WIDTH:g} {unit_said(model.robot, 'rad/s')})"
             + (" per joint j" if each else "")
         )
     return out
@@ -747,18 +752,20 @@ def format_consistent(result: ConsistentResult) -> str:
         lines += heldout_table(r.heldout)
     for fr in friction_parts(r.friction):
         at = "motors" if fr.at_motors else "joints"
+        kinds = None if fr.at_motors else r.robot  # a motor turns: rad
         lines.append(
             f"friction at the {at}: "
             + "; ".join(
-                f"{name} [{unit}]: " + " ".join(f"{x:.4g}" for x in fr.params[:, j])
+                f"{name} [{unit_said(kinds, unit)}]: "
+                + " ".join(f"{x:.4g}" for x in fr.params[:, j])
                 for j, (name, unit) in enumerate(zip(fr.names, fr.law.units, strict=True))
             )
         )
     if r.spring is not None:
         lines.append(
-            "joint spring k (q - q0): k [N m/rad] (>= 0): "
+            f"joint spring k (q - q0): k [{unit_said(r.robot, 'N m/rad')}] (>= 0): "
             + " ".join(f"{x:.4g}" for x in r.spring.k)
-            + "; q0 [rad]: "
+            + f"; q0 [{unit_said(r.robot, 'rad')}]: "
             + " ".join(f"{x:.4g}" for x in r.spring.q0)
         )
     lines += _determined_lines(r)
@@ -821,8 +828,9 @@ def _determined_lines(r: FeasibleResult) -> list[str]:
         d = r.drive  # a direct drive (K = 1, joint-side torques): the armature term's
         bare = d is None or (d.is_identity and np.array_equal(d.transmission, np.eye(d.n)))
         where = "armature (joint side)" if bare else "rotor inertia at the motors"
+        unit = unit_said(r.robot if bare else None, "kg m^2")
         out.append(
-            f"{where} [kg m^2] (>= 0): "
+            f"{where} [{unit}] (>= 0): "
             + " ".join(f"{x:.4g}" + ("*" if marked and marked[m] else "") for m, x in enumerate(ia))
         )
         if any(marked):
@@ -868,15 +876,20 @@ def format_rms_table(names: list[str], columns: dict[str, np.ndarray]) -> str:
 
 
 def format_friction_rms(
-    names: list[str], fit: FrictionFit, noise: np.ndarray | None, decimate: int = 1
+    names: list[str],
+    fit: FrictionFit,
+    noise: np.ndarray | None,
+    decimate: int = 1,
+    robot: JointKinds | None = None,
 ) -> str:
     """``dynid friction``'s table: per joint the residual RMS before and after the friction
-    [N m] and the torques' sensor noise, and what they are: on the recordings the friction
-    was fitted to, the torques as measured at every sample (every ``decimate``-th, the
-    identification's decimation)."""
-    cols = {"RMS before [N m]": fit.rms_before, "RMS after [N m]": fit.rms_after}
+    [N m; a prismatic joint of ``robot`` in N] and the torques' sensor noise, and what they
+    are: on the recordings the friction was fitted to, the torques as measured at every
+    sample (every ``decimate``-th, the identification's decimation)."""
+    unit = unit_said(robot, "N m")
+    cols = {f"RMS before [{unit}]": fit.rms_before, f"RMS after [{unit}]": fit.rms_after}
     if noise is not None:
-        cols["sensor noise [N m]"] = noise
+        cols[f"sensor noise [{unit}]"] = noise
     at = (
         "every sample"
         if decimate <= 1
@@ -920,18 +933,19 @@ def format_newton_euler_rms(val: NewtonEulerValidation) -> str:
     return "\n".join(rows)
 
 
-def _gain_noise_line(noise: GainNoise | None, names: Sequence[str]) -> list[str]:
+def _gain_noise_line(noise: GainNoise | None, robot: Robot) -> list[str]:
     """One line when the velocities' noise times the gain dominates some joints'
     calibration residual (:mod:`dynid.observer.gain_noise`): their thresholds grow with
-    ``--gain``."""
+    ``--gain`` (in ``robot``'s units per joint kind)."""
     if noise is None or not noise.dominated:
         return []
-    js = noise.dominated
+    js, names = noise.dominated, robot.joint_names
+    own = [joint_unit("N m", bool(robot.prismatic[j])) for j in js]
     gains = sorted({float(noise.gain[j]) for j in js})
     share = noise.share
     return [
         f"velocity noise x gain: on {', '.join(names[j] for j in js)} the velocities' noise "
-        f"through K_O M(q) (RMS {', '.join(f'{noise.predicted[j]:.3g}' for j in js)} N m at "
+        f"through K_O M(q) (RMS {_said(noise.predicted, js, own)} at "
         f"K_O {'/'.join(f'{g:g}' for g in gains)} 1/s) makes up "
         f"{', '.join(f'{100 * share[j]:.0f}' for j in js)} % of the residual's mean square: "
         "these thresholds grow in proportion to --gain, so a larger gain does not detect "
@@ -939,22 +953,40 @@ def _gain_noise_line(noise: GainNoise | None, names: Sequence[str]) -> list[str]
     ]
 
 
-def uncertainty_words(k_sigma: float | None, noise: NDArray[np.float64], margin: float) -> str:
+def _said(values: NDArray[np.float64], js: Sequence[int], units: Sequence[str]) -> str:
+    """``values`` of joints ``js`` with their ``units`` (one each): ``"0.1, 0.2 N m"``, or
+    each with its own where they differ (``"0.1 N, 0.2 N m"``)."""
+    same = len(set(units)) == 1
+    text = ", ".join(
+        f"{values[j]:.3g}" + ("" if same else f" {u}") for j, u in zip(js, units, strict=True)
+    )
+    return text + (f" {units[0]}" if same else "")
+
+
+def uncertainty_words(
+    k_sigma: float | None,
+    noise: NDArray[np.float64],
+    margin: float,
+    robot: JointKinds | None = None,
+) -> str:
     """What the contact threshold is when it holds the model's uncertainty: ``k sigma(t)``
-    plus a noise floor, not the fixed level plus something, so that while moving it can
-    lie below the fixed (``--no-uncertainty``) level."""
+    plus a noise floor (in ``robot``'s units per joint kind), not the fixed level plus
+    something, so that while moving it can lie below the fixed (``--no-uncertainty``)
+    level."""
+    floor = values_said(robot, [f"{v:.3g}" for v in noise], "N m")
     return (
         f"contact threshold applied: {k_sigma:g} sigma(t) + a noise floor of "
-        f"{', '.join(f'{v:.3g}' for v in noise)} N m (sigma: the model's uncertainty at "
+        f"{floor} (sigma: the model's uncertainty at "
         f"each sample; the floor: {margin:g} x the largest |r| - {k_sigma:g} sigma of the "
         "calibration), its largest along the motion the 'contact, moving' column; it "
         "replaces the fixed level and may lie below it"
     )
 
 
-def _check_lines(check: CalibrationCheck | None) -> list[str]:
+def _check_lines(check: CalibrationCheck | None, robot: JointKinds | None = None) -> list[str]:
     """Whether the calibrated observer is good enough: its false alarms on its own logs
-    and the smallest external torque it detects per joint while moving."""
+    and the smallest external torque it detects per joint while moving (in ``robot``'s
+    units per joint kind)."""
     if check is None:
         return []
     out = []
@@ -966,14 +998,14 @@ def _check_lines(check: CalibrationCheck | None) -> list[str]:
         )
     out.append(
         "smallest external torque detected while a joint moves: "
-        + ", ".join(f"{v:.3g}" for v in check.detectable)
-        + " N m (the largest contact threshold along the motion)"
+        + values_said(robot, [f"{v:.3g}" for v in check.detectable], "N m")
+        + " (the largest contact threshold along the motion)"
         + (
             ""
             if check.collision is None
             else "; collision level while moving: "
-            + ", ".join(f"{v:.3g}" for v in check.collision)
-            + " N m (the largest collision threshold along it)"
+            + values_said(robot, [f"{v:.3g}" for v in check.collision], "N m")
+            + " (the largest collision threshold along it)"
         )
     )
     if check.model is not None:  # the model behind the thresholds
@@ -990,34 +1022,35 @@ def _margin_peak(x: LogObservation) -> NDArray[np.float64] | None:
 
 def format_observation(result: ObserveResult, names: list[str], *, calibrating: bool) -> str:
     """The thresholds per joint (and the largest residual) and, detecting, every event."""
-    th = result.thresholds
+    th, robot = result.thresholds, result.model.robot
+    u = unit_said(robot, "N m")
     if calibrating:  # the residual the rule read: after the standstill margin
         read = "|r| read" if th.quantile == 1.0 else f"|r| q{th.quantile:g}"
         read += " past margin" if th.standstill else ""  # not the report's raw largest |r|
-        cols = {f"{read} [N m]": th.contact / th.margin}
+        cols = {f"{read} [{u}]": th.contact / th.margin}
     else:
         peaks = [x.largest() for x in result.logs]
         one = len(peaks) == 1
-        cols = {("max |r| [N m]" if one else "max |r| all logs [N m]"): np.nanmax(peaks, axis=0)}
+        cols = {(f"max |r| [{u}]" if one else f"max |r| all logs [{u}]"): np.nanmax(peaks, axis=0)}
         ratios = [x.peak_ratio for x in result.logs if x.peak_ratio is not None]
         if ratios:  # what decides: the threshold at each sample, not its base value
             cols["max |r|/contact"] = np.nanmax(ratios, axis=0)
     moving = None if result.check is None else result.check.detectable
     if th.uses_uncertainty and moving is not None:  # the levels applied, then the fixed
         assert result.check is not None
-        cols["contact, moving [N m]"] = moving
+        cols[f"contact, moving [{u}]"] = moving
         if result.check.collision is not None:
-            cols["collision, moving [N m]"] = result.check.collision
+            cols[f"collision, moving [{u}]"] = result.check.collision
     fixed = " --no-uncertainty" if th.uses_uncertainty else " base" if th.standstill else ""
-    cols |= {f"contact{fixed} [N m]": th.contact, f"collision{fixed} [N m]": th.collision}
+    cols |= {f"contact{fixed} [{u}]": th.contact, f"collision{fixed} [{u}]": th.collision}
     rest = undetected_at_rest(result.model, th, moving)
     level = th.contact if moving is None else moving
     at_rest = calibrating and th.standstill and np.any(rest > level)
     if at_rest:
-        cols["at rest [N m]"] = rest
+        cols[f"at rest [{u}]"] = rest
     truth = [err for x in result.logs if (err := x.truth_error()) is not None]
     if truth:
-        cols["RMS r - tau_ext [N m]"] = np.sqrt(np.mean(np.square(truth), axis=0))
+        cols[f"RMS r - tau_ext [{u}]"] = np.sqrt(np.mean(np.square(truth), axis=0))
     rows = [format_rms_table(names, cols)]
     if truth:
         rows.append(
@@ -1040,22 +1073,22 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
             "contact level while moving)"
         )
     if th.uses_uncertainty and th.noise is not None:
-        rows.append(uncertainty_words(th.k_sigma, th.noise, th.margin))
+        rows.append(uncertainty_words(th.k_sigma, th.noise, th.margin, robot))
     if calibrating and th.standstill and th.rest is not None:
         coulomb = standstill_margin(result.model.friction, np.zeros((1, th.n)))[0]
-        rows += rest_margin_lines(th.rest, coulomb, names, th.margin)
+        rows += rest_margin_lines(th.rest, coulomb, names, th.margin, robot)
     margins = [m for x in result.logs if (m := _margin_peak(x)) is not None]
     if th.standstill and margins and np.any(margins):
         top = np.max(margins, axis=0)
         rows.append(
             "plus the standstill margin of the friction (Coulomb level inside its band, "
             "smooth steps within the velocity noise, lagged; "
-            f"up to {', '.join(f'{v:.3g}' for v in top)} N m)"
+            f"up to {values_said(robot, [f'{v:.3g}' for v in top], 'N m')})"
         )
     if calibrating:
-        rows += _gain_noise_line(result.gain_noise, names)
+        rows += _gain_noise_line(result.gain_noise, robot)
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
-        rows += _check_lines(result.check)
+        rows += _check_lines(result.check, robot)
         return "\n".join(rows)
     if "max |r|/contact" in cols:
         least = "" if result.min_duration_s is None else f" for {result.min_duration_s:g} s"
@@ -1065,7 +1098,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         )
     labels = log_labels([x.path for x in result.logs])
     if len(result.logs) > 1:  # the pooled column holds the contacts of every log
-        rows.append("max |r| per log [N m], joints in the table's order:")
+        rows.append(f"max |r| per log [{u}], joints in the table's order:")
         width = max(map(len, labels))
         for label, x in zip(labels, result.logs, strict=True):
             rows.append(f"  {label:<{width}}  " + "  ".join(f"{v:8.4g}" for v in x.largest()))
@@ -1079,7 +1112,8 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         top = max(e.joints, key=lambda j: abs(e.peak[j - 1]))
         rows.append(
             f"  {log}: {e.level:<9} {e.start:9.3f} s .. {e.end:9.3f} s  joints "
-            f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} N m (joint {top})"
+            f"{','.join(map(str, e.joints))}  peak {e.peak[top - 1]:+.2f} "
+            f"{joint_unit('N m', bool(robot.prismatic[top - 1]))} (joint {top})"
             + (f"  {result.wrench.noun} damped on {100.0 * damped:.3g} %" if damped else "")
         )
     if any(d for *_, d in events):

@@ -94,6 +94,8 @@ from pathlib import Path
 from ..friction.pooled import joined_validation
 from ..identification.model import IdentifiedModel
 from ..io.validation_json import save_validation_json
+from ..model.robot import Robot
+from ..model.units import unit_said
 from ..workflows.validate import ValidateOptions, ValidateResult, validate_files
 from .applies import urdf_chain
 from .common import (
@@ -183,11 +185,11 @@ def run(args: argparse.Namespace, console: Console) -> int:
         model, args.data, options, feasible=args.params, label=label, source=args.model
     )
     path = save_validation_json(
-        args.out / "validation.json", result.validation, **result.metadata()
+        args.out / "validation.json", result.validation, robot=robot, **result.metadata()
     )
     if not args.no_figures:
         _save_figures(args.out, result, list(robot.joint_names), label)
-    print_validation(console, result, list(robot.joint_names), path)
+    print_validation(console, result, robot, path)
     return 1 if result.verdict.unusable else 0
 
 
@@ -213,14 +215,14 @@ def _save_figures(out: Path, result: ValidateResult, names: list[str], label: st
     )  # fmt: skip
 
 
-def print_validation(
-    console: Console, result: ValidateResult, names: list[str], path: Path
-) -> None:
-    """The RMS table, the pieces, the error per recording and overall, the verdict."""
-    val = result.validation
-    cols = {f"RMS no {val.added} [N m]": val.without_friction.rms}
+def print_validation(console: Console, result: ValidateResult, robot: Robot, path: Path) -> None:
+    """The RMS table (in ``robot``'s units per joint kind), the pieces, the error per
+    recording and overall, the verdict."""
+    val, names = result.validation, list(robot.joint_names)
+    unit = unit_said(robot, "N m")
+    cols = {f"RMS no {val.added} [{unit}]": val.without_friction.rms}
     if val.with_friction is not None:
-        cols[f"RMS + {val.added} [N m]"] = val.with_friction.rms
+        cols[f"RMS + {val.added} [{unit}]"] = val.with_friction.rms
     console.print(format_rms_table(names, cols), val.pieces.describe())
     say_torque_delay(console, result.applied_delay)
     if len(val.recordings) > 1:

@@ -73,6 +73,7 @@ from ..identification.spikes import despiked
 from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..model.units import units_said
 from ..regressors.terms import LinearFriction
 from .fit import model_drive, torques_through
 from .pooled import joined_validation
@@ -157,6 +158,9 @@ class HeldOutTorques:
         (:attr:`~dynid.identification.drive_gains.DriveGains.named`), the verdict says
         them in place of what each joint's residual follows (the springs and the tilt
         they explain are not judged).
+    robot : Robot or None
+        The model's robot: the units of ``as_dict`` per joint kind (a prismatic joint's
+        force in N, :func:`~dynid.model.units.unit_said`); None: every joint's in N m.
     """
 
     validation: Validation
@@ -175,6 +179,7 @@ class HeldOutTorques:
     prepared: tuple[TorqueLog, ...] = ()
     left_out: Mapping[int, tuple[str, ...]] = field(default_factory=dict)
     gains: DriveGains | None = None
+    robot: Robot | None = None
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -236,6 +241,7 @@ class HeldOutTorques:
                 [v.log.tau],
                 self.offsets,
                 self.left_out,
+                prismatic=None if self.robot is None else tuple(map(bool, self.robot.prismatic)),
             )
         )
         if said is not None and verdict.level == "good":  # at the floor, the factors said
@@ -302,13 +308,16 @@ class HeldOutTorques:
             "gravity_tilt": None if self.tilt is None else self.tilt.as_dict(),
             "springs": None if self.springs is None else self.springs.as_dict(),
             "drive_gains": None if self.gains is None else self.gains.as_dict(),
-            "units": {
-                "rms": "N m",
-                "noise_rms": "N m",
-                "sensor_noise_rms": "N m",
-                "input_noise_rms": "N m",
-                "relative_error_percent": "%",
-            },
+            "units": units_said(
+                self.robot,
+                {
+                    "rms": "N m",
+                    "noise_rms": "N m",
+                    "sensor_noise_rms": "N m",
+                    "input_noise_rms": "N m",
+                    "relative_error_percent": "%",
+                },
+            ),
         }
 
 
@@ -498,7 +507,7 @@ def _held_out(
     given = None if model.info.log.cutoff_source == "motion" else model.info.log.cutoff_hz
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model),
-        offsets=offsets_of(model), left_out=friction_left_out(model),
+        offsets=offsets_of(model), left_out=friction_left_out(model), robot=model.robot,
     )  # fmt: skip
     verdict, floor = held._judged()
     total = floor.total_rms

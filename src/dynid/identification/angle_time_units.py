@@ -83,16 +83,26 @@ class GivenUnits:
         The ``--units`` text as given (``"t=us,q=deg,tau=-1"``); None when not known (a
         TOML map, the defaults).
     factors : mapping of str to float
-        Quantity -> the factor to SI it was read with (``{"q": pi / 180}``); missing: 1.
+        Quantity -> the factor to SI it was read with (``{"q": pi / 180}``; of ``q``,
+        ``dq``, ``ddq`` the revolute joints'); missing: 1.
+    lengths : mapping of str to float
+        Quantity -> the factor to SI the prismatic joints' ``q``, ``dq``, ``ddq`` were
+        read with (``{"dq": 1e-3}`` for ``dq=mm/s``); missing: 1.
     """
 
     text: str | None = None
     factors: Mapping[str, float] = field(default_factory=dict)
+    lengths: Mapping[str, float] = field(default_factory=dict)
 
     def factor(self, quantity: str) -> float:
         """The factor [1] ``quantity`` was read with, its sign left out (a sign flip is no
         unit)."""
         return abs(float(self.factors.get(quantity, 1.0)))
+
+    def length_factor(self, quantity: str) -> float:
+        """The factor [1] a prismatic joint's ``quantity`` was read with, its sign left
+        out."""
+        return abs(float(self.lengths.get(quantity, 1.0)))
 
 
 def unit_name(quantity: str, factor: float) -> str:
@@ -113,24 +123,38 @@ def named_unit(
     return None
 
 
-def units_with(text: str | None, entries: Mapping[str, str]) -> str:
-    """The ``--units`` text ``text`` with ``entries`` (quantity -> unit) in place of its
-    own for those quantities, a new one written after its neighbour in ``t, q, dq, ddq``
-    (``units_with("t=us,q=deg,tau=-1", {"dq": "deg/s"})`` is
-    ``"t=us,q=deg,dq=deg/s,tau=-1"``); ``entries`` alone without a text."""
+def units_with(text: str | None, entries: Mapping[str, str] | Sequence[tuple[str, str]]) -> str:
+    """The ``--units`` text ``text`` with ``entries`` (quantity -> unit, or such pairs) in
+    place of its own for those quantities, a new one written after its neighbour in ``t,
+    q, dq, ddq`` (``units_with("t=us,q=deg,tau=-1", {"dq": "deg/s"})`` is
+    ``"t=us,q=deg,dq=deg/s,tau=-1"``); ``entries`` alone without a text. A joint
+    quantity's unit replaces the one of its kind alone (``q=mm,q=deg`` with ``dq=mm/s``
+    and ``dq=deg/s`` for a robot of prismatic and revolute joints)."""
     parts = [p.strip() for p in (text or "").split(",") if p.strip()]
     keys = [p.partition("=")[0].strip() for p in parts]
-    for key, unit in entries.items():
+    kinds = [_kind(p.partition("=")[2]) for p in parts]
+    pairs = list(entries.items()) if isinstance(entries, Mapping) else list(entries)
+    for key, unit in pairs:
         entry = f"{key}={unit}"
-        if key in keys:
-            parts[keys.index(key)] = entry
+        same = [i for i, k in enumerate(keys) if k == key and kinds[i] in (None, _kind(unit))]
+        if same:
+            parts[same[0]] = entry
+            kinds[same[0]] = _kind(unit)
             continue
-        before = _ORDER[: _ORDER.index(key)] if key in _ORDER else ()
+        before = _ORDER[: _ORDER.index(key) + 1] if key in _ORDER else ()
         at = max((i + 1 for i, k in enumerate(keys) if k in before), default=0)
         at = at if key in _ORDER else len(parts)
         parts.insert(at, entry)
         keys.insert(at, key)
+        kinds.insert(at, _kind(unit))
     return ",".join(parts)
+
+
+def _kind(unit: str) -> str | None:
+    """``"length"`` or ``"angle"`` of a joint quantity's unit (``mm/s``, ``deg``); None
+    for another (a number, a time unit)."""
+    head = unit.strip().partition("/")[0]
+    return "length" if head in ("m", "mm") else "angle" if head in ("rad", "deg") else None
 
 
 def degrees_findings(robot: Robot, log: TorqueLog) -> list[str]:
@@ -290,7 +314,7 @@ def joined_unit_findings(findings: Sequence[str], given: str | None = None) -> s
             others.append(hint)
     if units and given:
         pairs = (u.partition("=") for u in ",".join(units).split(","))
-        units = [units_with(given, {k: v for k, _, v in pairs})]
+        units = [units_with(given, [(k, v) for k, _, v in pairs])]
     hints = ([f"--units {','.join(units)}"] if units else []) + others
     return "; and ".join(whats) + (f"; hint: {'; '.join(hints)}" if hints else "")
 

@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.robot import Robot
+from ..model.units import joint_unit
 from ..regressors.terms import PART_LABELS, LinearFriction
 from .gravity_tilt import GravityTilt
 from .residual_spring import ResidualSpring
@@ -554,6 +555,7 @@ def dependence_hint(
     ddq: Sequence[NDArray[np.float64]] | None = None,
     inertia: str | None = None,
     lacks: str | None = None,
+    prismatic: Sequence[bool] | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -577,7 +579,8 @@ def dependence_hint(
     ``inertia`` the remedy said where the caller knows it (a URDF holds no armature);
     ``lacks``: the robot file the model was read from (``"a URDF"``), whose missing
     offsets and friction are named with the joints and said once after them
-    (:func:`cannot_hold_note`)."""
+    (:func:`cannot_hold_note`); ``prismatic``: the joints' kinds, a prismatic joint's
+    clause in its own units (N, N/m: :func:`~dynid.model.units.joint_unit`)."""
     if tilt is not None and tilt.named and tilt.rows.size == 0:
         return tilt.sentence()  # judged on other samples (a block's whole log): said alone
     if tilt is not None and tilt.named:
@@ -589,7 +592,7 @@ def dependence_hint(
         rest = dependence_hint(
             kept(q), kept(dq), [tilt.rest], noise_rms, joint_names, terms, offsets=offsets,
             left_out=left_out, ddq=None if ddq is None else kept(ddq), inertia=inertia,
-            lacks=lacks,
+            lacks=lacks, prismatic=prismatic,
         )  # fmt: skip
         return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
     found = residual_dependence(q, dq, error, noise_rms, ratios, ddq)
@@ -600,7 +603,9 @@ def dependence_hint(
     for d in worst[:NAMED]:
         remedy = inertia if first is None else f"as for {first}"
         name = joint_names[d.joint]
-        clauses.append(_sentence(d, name, terms, springs, offsets, left_out, remedy, still, lacks))
+        clause = _sentence(d, name, terms, springs, offsets, left_out, remedy, still, lacks)
+        rail = prismatic is not None and d.joint < len(prismatic) and bool(prismatic[d.joint])
+        clauses.append(joint_unit(clause, rail))  # its N m and rad said as N and m
         if first is None and acceleration_led(d) and not still_led(d):
             first = name
         if still is None and still_led(d):
@@ -673,6 +678,7 @@ def with_dependence_hint(
     ddq: Sequence[NDArray[np.float64]] | None = None,
     inertia: str | None = None,
     lacks: str | None = None,
+    prismatic: Sequence[bool] | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself; with the
@@ -685,14 +691,15 @@ def with_dependence_hint(
     (:func:`offsets_of`), with which a constant residual is told; ``left_out``: its
     friction coefficients left out per joint (:func:`friction_left_out`); ``ddq`` and
     ``inertia``: the accelerations and the remedy of a residual that follows them;
-    ``lacks``: the robot file the model was read from (:func:`dependence_hint`)."""
+    ``lacks``: the robot file the model was read from; ``prismatic``: the joints' kinds
+    (:func:`dependence_hint`)."""
     if verdict.level == "good":
         return verdict
     if (exact := round_off(error, torques)) is not None:
         return with_hint(verdict, round_off_note(exact))
     said = dependence_hint(
         q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets, left_out,
-        ddq, inertia, lacks,
+        ddq, inertia, lacks, prismatic,
     )  # fmt: skip
     return with_hint(verdict, said)
 

@@ -192,6 +192,9 @@ def velocity_scale_finding(
     given = given or GivenUnits()
     k = joint_rate_factors(log)
     k[list(skip)] = np.nan
+    pri = np.asarray(robot.prismatic, dtype=bool)
+    if not pri.all():  # an angle unit is the revolute joints' (the rail's: prismatic_scale_)
+        k[pri] = np.nan
     if (found := _scaled(k)) is None:
         return _acceleration_finding(robot, log, given)
     scaled, c = found
@@ -246,22 +249,29 @@ def prismatic_scale_finding(
     rev = judged & ~pri
     if not rev.any() or not (judged & pri).any():
         return None
-    ratio = np.where(judged & pri, k / float(np.median(k[rev])), np.nan)
-    read = given.factor("dq") if _length_rate("dq", given.factor("dq")) else 1.0
+    ref = float(np.median(k[rev]))
+    degrees = min(abs(ref * _DEG - 1.0), abs(ref / _DEG - 1.0)) < RATE_AGREES
+    ref = 1.0 if degrees else ref  # the revolute joints' deg/s: velocity_scale_finding's
+    ratio = np.where(judged & pri, k / ref, np.nan)
+    read = given.length_factor("dq")
     for c in (1e-3, 1e3):
         joints = np.flatnonzero(np.abs(ratio / c - 1.0) < RATE_AGREES)
         unit = _length_rate("dq", read * c)
         if joints.size == 0 or unit is None:
             continue
         entries = {"dq": unit}
-        if log.ddq is not None and math.isclose(given.factor("ddq"), given.factor("dq")):
+        if log.ddq is not None and math.isclose(
+            given.length_factor("ddq"), given.length_factor("dq")
+        ):
             entries["ddq"] = _length_rate("ddq", read * c) or f"{read * c:.10g}"
         names = ", ".join(robot.joint_names[j] for j in joints)
         s = "s" if joints.size > 1 else ""
         times = 1.0 / float(np.median(ratio[joints]))
         said = (
             f"the velocity columns of the prismatic joint{s} {names} are {times:.4g} times "
-            "the derivative of their positions while the revolute joints' agree with theirs: "
+            "the derivative of their positions"
+            + ("" if degrees else " while the revolute joints' agree with theirs")
+            + ": "
             f"velocities in {unit} read as {_length_rate('dq', read)}, a unit, not a time "
             "column in ms (which would scale every joint alike) nor a lag; hint: --units "
             + ",".join(f"{q}={u}" for q, u in entries.items())

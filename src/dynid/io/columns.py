@@ -16,7 +16,9 @@ A :class:`ColumnMap` names, per quantity, the column template of a file and its 
   (``m, mm`` for prismatic joints); ``dq`` in ``rad/s, deg/s`` (``m/s, mm/s``); ``ddq``
   in ``rad/s^2, deg/s^2`` (``m/s^2, mm/s^2``): once the robot is known
   (:meth:`ColumnMap.for_robot`) a length unit scales the prismatic joints' columns alone,
-  an angle unit the revolute joints' alone; ``tau`` and ``g`` in ``Nm, N m, N, mNm,
+  an angle unit the revolute joints' alone, and a quantity given twice, one length and one
+  angle unit (``q=mm,q=deg``; in TOML a list, ``q = ["mm", "deg"]``), reads each kind of
+  joint in its own; ``tau`` and ``g`` in ``Nm, N m, N, mNm,
   mN m``, ``tau`` also in ``A, mA`` (motor currents, read through a drive whose effort
   is current); ``M`` in ``kg m^2, g m^2``; or a number, the factor to SI. A unit given
   is the user's word, not a finding: the map says it once (:meth:`ColumnMap.unit_note`),
@@ -182,6 +184,11 @@ class ColumnMap:
         a length unit of ``q``, ``dq``, ``ddq`` (``mm``, ``mm/s``) then scales the
         prismatic joints' columns alone, an angle unit (``deg``, ``deg/s``) the revolute
         joints' alone; None (not known): a unit scales every joint's.
+    lengths : mapping of str to str
+        Quantity -> the length unit given beside its angle unit (``--units q=mm,q=deg``:
+        ``{"q": "mm"}``, ``names`` holding ``{"q": "deg"}``): the prismatic joints' columns
+        read in it, the revolute joints' in the angle unit (the robot's kinds needed,
+        :meth:`for_robot`).
     """
 
     columns: Mapping[str, str] = field(default_factory=dict)
@@ -192,6 +199,7 @@ class ColumnMap:
     file_flips: Mapping[str, Mapping[str, tuple[int, ...]]] = field(default_factory=dict)
     file_signs: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
     prismatic: tuple[bool, ...] | None = None
+    lengths: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for key in list(self.columns) + list(self.factors):
@@ -221,13 +229,16 @@ class ColumnMap:
         object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
         object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
         object.__setattr__(self, "names", MappingProxyType(dict(self.names)))
+        object.__setattr__(self, "lengths", MappingProxyType(dict(self.lengths)))
 
     @classmethod
     def from_units(
         cls, columns: Mapping[str, str], units: Mapping[str, Any], **kw: Any
     ) -> ColumnMap:
-        """Map from templates and unit names (``{"q": "deg", "tau": "mNm"}``) and single
-        joints' sign flips (``{"tau2": -1}``)."""
+        """Map from templates and unit names (``{"q": "deg", "tau": "mNm"}``; one length
+        and one angle unit of ``q``, ``dq`` or ``ddq`` as a pair, ``{"q": ["mm", "deg"]}``)
+        and single joints' sign flips (``{"tau2": -1}``)."""
+        units, lengths = _split_kinds(units)
         flips: dict[str, set[int]] = {}
         files: dict[str, dict[str, set[int]]] = {}
         whole: dict[str, set[str]] = {}  # a file's quantities negated on every joint
@@ -268,6 +279,7 @@ class ColumnMap:
             flips=signs,
             file_flips=per_file,
             file_signs={f: tuple(sorted(q)) for f, q in whole.items()},
+            lengths=lengths,
             **kw,
         )
 
@@ -292,6 +304,7 @@ class ColumnMap:
             file_flips={name: own} if own else {},
             file_signs={name: negated} if negated else {},
             prismatic=self.prismatic,
+            lengths=self.lengths,
         )
 
     def unknown_files(self, names: Sequence[str]) -> tuple[str, ...]:
@@ -324,6 +337,8 @@ class ColumnMap:
             given = self.names.get(k, f"{f:.17g}")
             to = "A" if k == "tau" and self.tau_is_current else "SI"
             parts.append(f"{k} in {given} (x {f:.17g} to {to})")
+        for k, length in self.lengths.items():
+            parts.append(f"{k} in {length} (x {_UNITS[k][length]:.17g} to SI)")
         return None if not parts else "data read with --units " + ", ".join(parts)
 
     def template(self, quantity: str) -> str:
@@ -356,28 +371,52 @@ class ColumnMap:
         """
         kinds = tuple(bool(p) for p in prismatic)
         for quantity in _JOINT_QUANTITIES:
-            kind = self.unit_kind(quantity)
-            wanted = kind == "length"
-            if kind is None or any(p == wanted for p in kinds):
-                continue
-            said = f"--units {quantity}={self.names[quantity]}"
-            other = "revolute (rad, deg)" if wanted else "prismatic (m, mm)"
-            raise DataError(
-                f"{said}: a {kind} unit reads the {'prismatic' if wanted else 'revolute'} "
-                f"joints' columns; the robot's {len(kinds)} joint(s) are all {other}; hint: "
-                f"leave out {quantity}={self.names[quantity]}, or pass the robot the data were "
-                "recorded with"
-            )
+            for kind, unit in self._kinds_given(quantity):
+                wanted = kind == "length"
+                if any(p == wanted for p in kinds):
+                    continue
+                said = f"--units {quantity}={unit}"
+                other = "revolute (rad, deg)" if wanted else "prismatic (m, mm)"
+                raise DataError(
+                    f"{said}: a {kind} unit reads the {'prismatic' if wanted else 'revolute'} "
+                    f"joints' columns; the robot's {len(kinds)} joint(s) are all {other}; "
+                    f"hint: leave out {quantity}={unit}, or pass the robot the data were "
+                    "recorded with"
+                )
         if kinds == self.prismatic:
             return self
         return dataclasses.replace(self, prismatic=kinds)
+
+    def _kinds_given(self, quantity: str) -> list[tuple[str, str]]:
+        """The (kind, unit) pairs named for ``quantity``: its unit of :meth:`unit_kind`
+        and the length unit given beside it (:attr:`lengths`)."""
+        kind = self.unit_kind(quantity)
+        out = [] if kind is None else [(kind, str(self.names[quantity]).strip())]
+        return out + ([("length", self.lengths[quantity])] if quantity in self.lengths else [])
 
     def joint_factors(self, quantity: str, count: int) -> float | NDArray[np.float64]:
         """The factor to SI of ``quantity``: one number for every joint, or per joint
         (``count``,) where a named unit applies to the joints of its kind alone
         (:meth:`for_robot`; the others read in SI, their sign kept; joints beyond the
-        robot's, which no reader keeps, at the unit's factor)."""
+        robot's, which no reader keeps, at the unit's factor; a quantity of two units,
+        :attr:`lengths`, each kind of joint at its own).
+
+        Raises
+        ------
+        DataError
+            A quantity of two units read without the robot's kinds (:meth:`for_robot`).
+        """
         f = self.factor(quantity)
+        if quantity in self.lengths:
+            if self.prismatic is None:
+                raise DataError(
+                    f"--units {quantity}={self.lengths[quantity]},{quantity}="
+                    f"{self.names[quantity]}: the joints' kinds are needed to read each in its "
+                    "own unit; give the robot"
+                )
+            length = _UNITS[quantity][self.lengths[quantity]]
+            kinds = np.array([*self.prismatic, *[False] * max(0, count - len(self.prismatic))])
+            return np.where(kinds[:count], length, f)
         kind = self.unit_kind(quantity)
         if self.prismatic is None or kind is None or f in (1.0, -1.0):
             return f
@@ -393,19 +432,25 @@ class ColumnMap:
         if self.prismatic is None or len(set(self.prismatic)) < 2:
             return ()
         out = []
+        si = {"q": ("rad", "m"), "dq": ("rad/s", "m/s"), "ddq": ("rad/s^2", "m/s^2")}
         for quantity in _JOINT_QUANTITIES:
-            if (kind := self.unit_kind(quantity)) is None:
-                continue
-            wanted = kind == "length"
-            which = [n for n, p in zip(joint_names, self.prismatic, strict=False) if p == wanted]
-            si = {"q": ("rad", "m"), "dq": ("rad/s", "m/s"), "ddq": ("rad/s^2", "m/s^2")}
-            kinds = ("prismatic", "revolute") if wanted else ("revolute", "prismatic")
-            s = "s" if len(which) > 1 else ""
-            out.append(
-                f"{quantity}={self.names[quantity]} applied to the {kinds[0]} joint{s} "
-                f"{', '.join(which)}; the {kinds[1]} joints read in "
-                f"{si[quantity][0 if wanted else 1]}"
-            )
+            given = self._kinds_given(quantity)
+            for kind, unit in given:
+                wanted = kind == "length"
+                which = [
+                    n for n, p in zip(joint_names, self.prismatic, strict=False) if p == wanted
+                ]
+                kinds = ("prismatic", "revolute") if wanted else ("revolute", "prismatic")
+                s = "s" if len(which) > 1 else ""
+                rest = (
+                    ""
+                    if len(given) > 1
+                    else f"; the {kinds[1]} joints read in {si[quantity][0 if wanted else 1]}"
+                )
+                out.append(
+                    f"{quantity}={unit} applied to the {kinds[0]} joint{s} {', '.join(which)}"
+                    + rest
+                )
         return tuple(out)
 
     def mapped(self, quantity: str) -> bool:
@@ -505,19 +550,66 @@ def _sign_flip(key: str, value: Any) -> bool:
     )
 
 
-def _pairs(text: str, what: str) -> dict[str, str]:
-    out = {}
+def _pairs(text: str, what: str) -> dict[str, str | list[str]]:
+    """``key=value`` entries of ``text``; a joint quantity's (``q``, ``dq``, ``ddq``)
+    given twice of ``--units`` as the pair of its values (``q=mm,q=deg``: ``["mm",
+    "deg"]``, judged by :func:`_split_kinds`), any other key given twice refused."""
+    out: dict[str, str | list[str]] = {}
     for part in text.split(","):
         part = part.strip()
         if not part:
             continue
         key, sep, value = part.partition("=")
-        if not sep or not key.strip() or not value.strip():
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
             raise DataError(f"{what} must read 'quantity=value,...'; got {part!r} in {text!r}")
-        if key.strip() in out:
-            raise DataError(f"{what}: {key.strip()!r} is given twice in {_checks.short(text)}")
-        out[key.strip()] = value.strip()
+        if key in out:
+            held = out[key]
+            if what == "--units" and key in _JOINT_QUANTITIES:
+                out[key] = [held, value] if isinstance(held, str) else [*held, value]
+                continue
+            raise DataError(f"{what}: {key!r} is given twice in {_checks.short(text)}")
+        out[key] = value
     return out
+
+
+def _split_kinds(units: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, str]]:
+    """``units`` with each joint quantity given two units (``{"q": ["mm", "deg"]}``) kept
+    at its angle unit, and those quantities' length units (``{"q": "mm"}``).
+
+    Raises
+    ------
+    DataError
+        Two units of a quantity that are not one length and one angle unit (``q=deg,
+        q=rad``, a number among them, a third), or two units of another quantity, in one
+        line.
+    """
+    kept: dict[str, Any] = {}
+    lengths: dict[str, str] = {}
+    for key, value in units.items():
+        if not isinstance(value, list | tuple):
+            kept[key] = value
+            continue
+        said = ",".join(f"{key}={v}" for v in value)
+        if key not in _JOINT_QUANTITIES:
+            raise DataError(
+                f"--units {said}: {key!r} takes one unit; only q, dq and ddq take two, one "
+                "for the prismatic joints and one for the revolute ones"
+            )
+        names = [str(v).strip() for v in value]
+        table = _UNITS[key]
+        kinds = ["length" if n.partition("/")[0] in _LENGTH else "angle" for n in names]
+        if len(names) != 2 or any(n not in table for n in names) or kinds[0] == kinds[1]:
+            ex = {"q": ("mm", "deg"), "dq": ("mm/s", "deg/s"), "ddq": ("mm/s^2", "deg/s^2")}[key]
+            lengths_of = ", ".join(n for n in table if n.partition("/")[0] in _LENGTH)
+            raise DataError(
+                f"--units {said}: two units of {key} must be one length unit for the "
+                f"prismatic joints ({lengths_of}) and one angle unit for the revolute ones; "
+                f"hint: --units {key}={ex[0]},{key}={ex[1]}"
+            )
+        lengths[key] = names[kinds.index("length")]
+        kept[key] = names[kinds.index("angle")]
+    return kept, lengths
 
 
 def parse_column_map(columns: str | None = None, units: str | None = None, **kw: Any) -> ColumnMap:
@@ -526,9 +618,10 @@ def parse_column_map(columns: str | None = None, units: str | None = None, **kw:
     Raises
     ------
     DataError
-        Malformed text, a quantity given twice, an unknown quantity or unit.
+        Malformed text, a quantity given twice (but ``q``, ``dq`` or ``ddq`` of ``--units``
+        in one length and one angle unit, ``q=mm,q=deg``), an unknown quantity or unit.
     """
-    cols = _pairs(columns or "", "--columns")
+    cols = {k: str(v) for k, v in _pairs(columns or "", "--columns").items()}
     unit = _pairs(units or "", "--units")
     return ColumnMap.from_units(cols, unit, **kw)
 
@@ -848,7 +941,7 @@ def _guessed_hint(header: Sequence[str], name: str, cmap: ColumnMap) -> str:
     spec, _, said = guess.partition(" --units ")
     units = dict(e.split("=", 1) for e in said.strip("'").split(",") if "=" in e)
     units.update(_given_units(cmap))
-    text = ",".join(f"{k}={v}" for k, v in units.items())
+    text = ",".join(f"{k}={v}" for k, v in [*units.items(), *cmap.lengths.items()])
     return f"; hint: {spec}" + (f" --units '{text}'" if text else "") + " reads the file"
 
 

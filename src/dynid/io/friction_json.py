@@ -43,6 +43,7 @@ from ..exceptions import DataError, DynidError
 from ..friction.fit import FrictionFit
 from ..friction.laws import LAWS
 from ..friction.model import FrictionModel, FrictionSum, friction_parts
+from ..model.units import JointKinds, units_said
 from .drive_file import drive_from_record
 from .json_files import load_json
 from .schema import Field, Format, Record, check, describe, fault, save_document
@@ -62,8 +63,13 @@ def save_friction_json(
     *,
     metadata: dict[str, Any] | None = None,
     selection: dict[str, Any] | None = None,
+    robot: JointKinds | None = None,
 ) -> Path:
     """Write a friction model (or a fit, with its RMS before/after) to ``path``.
+
+    ``robot``: the joints' names and kinds (a ``Robot``), the units of the friction at
+    the joints said per joint kind (:func:`~dynid.model.units.unit_said`: a prismatic
+    joint's ``fv`` in N s/m); None: every joint's as a revolute joint's.
 
     ``selection``: the held-out comparison of the candidate laws
     (:meth:`~dynid.friction.select.FrictionSelection.as_dict`), written as ``selection``.
@@ -82,7 +88,7 @@ def save_friction_json(
         fit, model = friction, friction.friction
     else:
         fit, model = None, friction
-    parts = [_law_doc(p) for p in friction_parts(model)]
+    parts = [_law_doc(p, robot) for p in friction_parts(model)]
     joints: list[dict[str, float | bool]] = (
         parts[0]["joints"] if len(parts) == 1 else [{} for _ in range(model.n)]
     )
@@ -92,7 +98,7 @@ def save_friction_json(
             d["rms_before"] = float(fit.rms_before[j])
             d["rms_after"] = float(fit.rms_after[j])
             d["identified"] = bool(fit.identified[j])
-        units.update(rms_before="N m", rms_after="N m")
+        units.update(units_said(robot, {"rms_before": "N m", "rms_after": "N m"}))
     drive = model.drive
     doc: dict[str, Any] = {
         "schema": FORMAT,
@@ -112,9 +118,10 @@ def save_friction_json(
     return save_document(path, Format(FORMAT, _record(str(doc["model"])), _WHAT), doc)
 
 
-def _law_doc(model: FrictionModel) -> dict[str, Any]:
+def _law_doc(model: FrictionModel, robot: JointKinds | None = None) -> dict[str, Any]:
     """One law's ``model``, ``at``, ``convention``, ``units`` and ``joints`` (its
-    parameters and standstill band per joint)."""
+    parameters and standstill band per joint; the units of a law at the joints said per
+    joint kind of ``robot``, a law at the motors' as the motors turn)."""
     law, P = model.law, model.as_array()
     band = model.band if law.standstill else None
     joints = []
@@ -126,6 +133,8 @@ def _law_doc(model: FrictionModel) -> dict[str, Any]:
     units = dict(zip(law.params, law.units, strict=True))
     if band is not None:
         units[law.band_key] = "rad/s"
+    if not model.at_motors:
+        units = units_said(robot, units)
     return {
         "model": model.kind,
         "at": "motor" if model.at_motors else "joint",

@@ -63,6 +63,7 @@ from ..identification.info import IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
 from ..model.drive import Drive
+from ..model.units import units_said
 from ..regressors.base import BaseParameters
 from .drive_file import drive_from_record
 from .json_files import finite_or_none, load_json
@@ -167,7 +168,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     out["robot"] = robot_to_dict(model.description, inertials=True)
     out["metadata"] = info_to_dict(info, model.drive) | friction_metadata(model)
     law = LAWS[frictions[0].law if len(frictions) == 1 else "classical"]
-    out["units"] = {
+    units = {
         "value": "SI of each expression: m kg, mc kg m, J kg m^2",
         "std": "as value",
         "std_percent": "%",
@@ -176,6 +177,7 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         "sigma": "as residual_rms",
         "friction": ", ".join(f"{p} {u}" for p, u in zip(law.params, law.units, strict=True)),
     }
+    out["units"] = units_said(model.description, units, ("residual_rms", "friction"))
     out["conventions"] = {
         "standard_parameters": "per link m, mcx, mcy, mcz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz; J about "
         "the link origin, link axes",

@@ -80,6 +80,7 @@ from numpy.typing import NDArray
 from .. import __version__
 from .._checks import text
 from ..exceptions import DataError, DynidError
+from ..model.units import JointKinds, unit_said, units_said
 from ..observer.carried_load import CarriedLoad, load_words
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
@@ -319,8 +320,10 @@ def save_thresholds(
     *,
     joints: Sequence[str],
     calibration: dict[str, Any] | None = None,
+    robot: JointKinds | None = None,
 ) -> Path:
-    """Write ``thresholds.json`` (module docstring); returns the path."""
+    """Write ``thresholds.json`` (module docstring; its units per joint kind of
+    ``robot``, :func:`~dynid.model.units.unit_said`); returns the path."""
     th, o = thresholds, thresholds.options
     doc = {
         "dynid_version": __version__,
@@ -349,7 +352,9 @@ def save_thresholds(
             **_fingerprint(th.model),
             **(calibration or {}),
         },
-        "units": {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"},
+        "units": units_said(
+            robot, {"contact": "N m", "collision": "N m", "noise": "N m", "gain": "1/s"}
+        ),
     }
     return save_document(path, THRESHOLDS, doc)
 
@@ -445,6 +450,7 @@ def save_events(
     damped: Sequence[float] | None = None,
     unexplained: Sequence[float] | None = None,
     false_alarm: Sequence[bool | None] | None = None,
+    robot: JointKinds | None = None,
 ) -> Path:
     """Write ``events.json`` (schema ``dynid-events/1``; ``logs``: each event's log name,
     written as its ``log``; ``joints``: the model's joint names, written beside the
@@ -452,7 +458,8 @@ def save_events(
     where the wrench estimate was damped, written as its ``damped_share``;
     ``unexplained``: the share of its residual the estimate leaves, its
     ``unexplained_share`` (NaN written null); ``false_alarm``: whether the score counted
-    it a false alarm, None where its log was not scored); returns the path."""
+    it a false alarm, None where its log was not scored; ``robot``: the peaks' units per
+    joint kind, :func:`~dynid.model.units.unit_said`); returns the path."""
     doc = {
         "dynid_version": __version__,
         **({} if joints is None else {"joints": list(joints)}),
@@ -476,9 +483,9 @@ def save_events(
             for k, e in enumerate(events)
         ],
         **(meta or {}),
-        "units": {"start": "s", "end": "s", "peak": "N m", "joints": "1-based"}
+        "units": {"start": "s", "end": "s", "peak": unit_said(robot, "N m"), "joints": "1-based"}
         | {k: "s" for k in ("duration_s", "flagged_s") if k in (meta or {})}
-        | ({"dropped": _DROPPED_UNITS} if "dropped" in (meta or {}) else {}),
+        | ({"dropped": _dropped_units(robot)} if "dropped" in (meta or {}) else {}),
     }
     return save_document(path, EVENTS, doc)
 
@@ -488,8 +495,10 @@ def _finite(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
 
-#: The units of ``events.json``'s ``dropped``.
-_DROPPED_UNITS = "start, end, duration_s, min_duration_s, merge_s: s; peak: N m; ratio: 1"
+def _dropped_units(robot: JointKinds | None) -> str:
+    """The units of ``events.json``'s ``dropped`` (its peaks' per joint kind)."""
+    peak = unit_said(robot, "N m")
+    return f"start, end, duration_s, min_duration_s, merge_s: s; peak: {peak}; ratio: 1"
 
 
 def save_residuals_csv(
@@ -502,10 +511,11 @@ def save_residuals_csv(
     frame: str | None = None,
     kind: WrenchKind = FULL,
     loads: Sequence[CarriedLoad] = (),
+    unit: str = "N m",
 ) -> Path:
-    """Write ``residuals.csv``: ``t, r1..rn`` (and the wrench at ``frame``, or the force
-    alone: ``kind``; the ``loads`` whose torque ``r`` lacks said in its header); returns
-    the path."""
+    """Write ``residuals.csv``: ``t, r1..rn`` (``r`` in ``unit``; and the wrench at
+    ``frame``, or the force alone: ``kind``; the ``loads`` whose torque ``r`` lacks said in
+    its header); returns the path."""
     with residuals_csv(
         path,
         t.shape[0],
@@ -513,6 +523,7 @@ def save_residuals_csv(
         frame=frame if wrench is not None else None,
         kind=kind,
         loads=loads,
+        unit=unit,
     ) as put:
         put(t, r, wrench, damped)
     return Path(path)
@@ -527,15 +538,18 @@ def residuals_csv(
     frame: str | None = None,
     kind: WrenchKind = FULL,
     loads: Sequence[CarriedLoad] = (),
+    unit: str = "N m",
 ) -> Iterator[Callable[..., None]]:
     """``residuals.csv`` written a block of rows at a time: yields ``put(t, r, wrench=None,
     damped=None)`` for consecutive blocks ``t`` (m,), ``r`` (m, n) and, with ``frame``,
     the wrench (m, 6) and its flag (m,), its units line saying what was estimated
     (``kind``) and the carried loads whose torque the residual lacks
-    (:func:`load_header`); the file (``rows`` in its header) appears when the block
-    ends normally (atomic), the bytes of :func:`save_residuals_csv` of the whole."""
+    (:func:`load_header`), the residual in ``unit`` (:func:`~dynid.model.units.unit_said`:
+    ``N m (rail: N)`` on an arm with a prismatic joint); the file (``rows`` in its header)
+    appears when the block ends normally (atomic), the bytes of :func:`save_residuals_csv`
+    of the whole."""
     names = ["t"] + [f"r{j + 1}" for j in range(n)]
-    units = "t [s], r [N m]"
+    units = f"t [s], r [{unit}]"
     if frame is not None:
         names += ["fx", "fy", "fz", "mx", "my", "mz", "damped"]
         units += f"; {_estimate_units(frame, kind)}"
@@ -618,11 +632,12 @@ class ResidualTables:
         frame: str | None,
         kind: WrenchKind = FULL,
         loads: Sequence[CarriedLoad] = (),
+        unit: str = "N m",
     ) -> Iterator[Callable[..., None]]:
         """The writer of log ``index`` of ``paths`` (:func:`residuals_csv`; ``loads``:
-        those whose torque the residual lacks)."""
+        those whose torque the residual lacks; ``unit``: the residual's)."""
         path = self.out / f"{residual_names(paths)[index]}.csv"
-        with residuals_csv(path, rows, n, frame=frame, kind=kind, loads=loads) as put:
+        with residuals_csv(path, rows, n, frame=frame, kind=kind, loads=loads, unit=unit) as put:
             yield put
         if path not in self.written:
             self.written.append(path)
@@ -719,7 +734,11 @@ def save_observation(
                 }
         return [
             save_thresholds(
-                out / "thresholds.json", result.thresholds, joints=joints, calibration=cal
+                out / "thresholds.json",
+                result.thresholds,
+                joints=joints,
+                calibration=cal,
+                robot=result.model.robot,
             )
         ]
     paths = []
@@ -739,6 +758,7 @@ def save_observation(
                 frame=None if w is None else w.frame,
                 kind=FULL if w is None else w.kind,
                 loads=x.loads,
+                unit=unit_said(result.model.robot, "N m"),
             )  # fmt: skip
         )
     labels = log_labels([x.path for x in result.logs])
@@ -777,6 +797,7 @@ def save_observation(
             damped=shares,
             unexplained=left,
             false_alarm=None if all(f is None for f in false) else false,
+            robot=result.model.robot,
         ),
     )
     return paths

@@ -79,6 +79,7 @@ from ..feasibility.payload import PayloadEstimate
 from ..feasibility.payload_scale import unjudged_ratio
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
+from ..model.units import unit_said
 from .json_files import save_json
 
 __all__ = ["PAYLOAD_SCHEMA", "payload_to_dict", "save_payload_json"]
@@ -149,10 +150,11 @@ def payload_to_dict(
                 "mass": "kg",
                 "com": "m",
                 "inertia": "kg m^2",
-                "residual_rms": "N m (torque logs); the rows' SI units (static data)",
-                "noise_rms": "N m",
+                "residual_rms": f"{(u := unit_said(robot, 'N m'))} (torque logs); the rows' SI "
+                "units (static data)",
+                "noise_rms": u,
                 "judged_residual": (
-                    "residual_rms, noise_rms, states_noise_rms: N m; ratio, matched: 1"
+                    f"residual_rms, noise_rms, states_noise_rms: {u}; ratio, matched: 1"
                 ),
                 "torque_scale": "value, std: 1; mass, std_mass: kg",
             },

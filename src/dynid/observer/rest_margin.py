@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..friction.model import FrictionModel, FrictionSum, friction_parts
+from ..model.units import JointKinds, joint_unit
 from .friction import canonical_friction
 from .thresholds import RestMargin
 
@@ -220,13 +221,17 @@ class RestTally:
 
 
 def rest_margin_lines(
-    rest: RestMargin, coulomb: NDArray[np.float64], names: list[str], margin: float
+    rest: RestMargin,
+    coulomb: NDArray[np.float64],
+    names: list[str],
+    margin: float,
+    robot: JointKinds | None = None,
 ) -> list[str]:
     """What the standstill margin is at a settled rest, one line per joint whose Coulomb
     bound ``coulomb`` (n,) [N m] (:func:`~dynid.observer.friction.standstill_margin` at
     rest) is not zero, and why: calibrated from the rests, the Coulomb bound which the
     rests reach, or the Coulomb bound for too few rests; ``margin`` the thresholds' safety
-    factor, ``names`` the joints'."""
+    factor, ``names`` the joints' (a prismatic joint of ``robot`` said in N)."""
     head = (
         f"standstill margin at rest (a joint inside its standstill band for {rest.settle_s:g} s "
         f"or more): min(Coulomb bound, {margin:g} x the residual at the calibration's rests "
@@ -238,18 +243,19 @@ def rest_margin_lines(
         c, level, k = float(coulomb[j]), float(rest.level[j]), int(rest.rests[j])
         if c <= 0.0:
             continue
+        u = "N m" if robot is None else joint_unit("N m", bool(robot.prismatic[j]))
         if not np.isfinite(level):
             out.append(
-                f"  {name}: Coulomb bound {c:.3g} N m: too few rests ({k} of the "
+                f"  {name}: Coulomb bound {c:.3g} {u}: too few rests ({k} of the "
                 f"{rest.min_rests} needed)"
             )
         elif level < c:
             out.append(
-                f"  {name}: {level:.3g} N m calibrated from {k} rests (Coulomb bound {c:.3g} N m)"
+                f"  {name}: {level:.3g} {u} calibrated from {k} rests (Coulomb bound {c:.3g} {u})"
             )
         else:
             out.append(
-                f"  {name}: Coulomb bound {c:.3g} N m: its {k} rests reach it (calibrated "
-                f"{level:.3g} N m: the friction held at rest)"
+                f"  {name}: Coulomb bound {c:.3g} {u}: its {k} rests reach it (calibrated "
+                f"{level:.3g} {u}: the friction held at rest)"
             )
     return out if len(out) > 1 else []

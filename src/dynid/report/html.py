@@ -24,6 +24,7 @@ __all__ = [
     "cell",
     "esc",
     "figure",
+    "file_unit",
     "href",
     "is_matrix",
     "is_number",
@@ -63,6 +64,14 @@ def esc(text: object) -> str:
     locale (undecodable bytes held as surrogates) shows as the characters its bytes spell."""
     shown = str(text).encode("utf-8", "surrogateescape").decode("utf-8", "replace")
     return html.escape(shown, quote=True)
+
+
+def file_unit(doc: Any, key: str, default: str = "N m") -> str:
+    """The unit a JSON result's ``units`` give ``key`` (``"N m (rail: N)"`` on an arm with
+    a prismatic joint), ``default`` for a file without it (an earlier one)."""
+    units = doc.get("units") if isinstance(doc, dict) else None
+    unit = units.get(key) if isinstance(units, dict) else None
+    return unit if isinstance(unit, str) else default
 
 
 def href(path: str) -> str:

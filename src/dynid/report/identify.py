@@ -50,6 +50,7 @@ from .html import (
     cell,
     esc,
     figure,
+    file_unit,
     is_number,
     number,
     percent,
@@ -811,9 +812,9 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
             rows.append([*row, cell(ratio), cell(rel[j])])
         headers = [
             "joint",
-            "held-out RMS error [N m]",
-            "sensor noise RMS [N m]",
-            *(["states' noise through the model RMS [N m]"] if states else []),
+            f"held-out RMS error [{(u := file_unit(held, 'rms'))}]",
+            f"sensor noise RMS [{u}]",
+            *([f"states' noise through the model RMS [{u}]"] if states else []),
             "error / noise" + (" (each sample against its own)" if weighed else ""),
             "held-out relative error [%]",
         ]

@@ -15,6 +15,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from ..model.units import Joints, unit_said
 from .html import capitalised, cell, esc, is_number, number, section, table
 
 __all__ = ["terms_sections"]
@@ -44,13 +45,29 @@ def _heading(term: dict[str, Any]) -> str:
     return f"{capitalised(name)} (value \u00b1 std)"
 
 
-def _unit(code: str) -> str:
+def _unit(code: str, joints: Joints | None = None) -> str:
+    """`` [unit]`` of a coefficient kind, said per kind of ``joints`` (none: at motors)."""
     unit = _UNITS.get(code) or _UNITS.get(code[1:], "")  # "jfv": friction at the joints
-    return f" [{unit}]" if unit else ""
+    return f" [{unit_said(joints, unit)}]" if unit else ""
+
+
+def _joints(doc: dict[str, Any]) -> Joints | None:
+    """The joints' names and kinds of an identification record's ``robot`` (None: not
+    held)."""
+    robot = doc.get("robot")
+    if not isinstance(robot, dict):
+        return None
+    names, kinds = robot.get("joint_names"), robot.get("prismatic")
+    if not (isinstance(names, list) and isinstance(kinds, list) and len(names) == len(kinds)):
+        return None
+    return Joints(tuple(str(x) for x in names), tuple(bool(x) for x in kinds))
 
 
 def _term_table(
-    term: dict[str, Any], joint_names: list[str], combined: dict[str, str] | None = None
+    term: dict[str, Any],
+    joint_names: list[str],
+    combined: dict[str, str] | None = None,
+    joints: Joints | None = None,
 ) -> str:
     combined = combined or {}
     labels, values = term.get("labels") or [], term.get("values") or []
@@ -82,7 +99,8 @@ def _term_table(
         else:
             who = f"joint {index}"
         body.append([esc(who), *(rows[index].get(c, "") for c in codes)])
-    headers = ["motor" if at_motors else "joint", *(f"{c}{_unit(c)}" for c in codes)]
+    kinds = None if at_motors else joints  # a motor turns: rad
+    headers = ["motor" if at_motors else "joint", *(f"{c}{_unit(c, kinds)}" for c in codes)]
     mine = [str(lab) for lab in labels if str(lab) in combined]
     note = (
         "<p>combined: holds a coefficient left out as structurally dependent on it (no "
@@ -102,6 +120,7 @@ def _term_table(
 
 
 def _classical(doc: dict[str, Any], joint_names: list[str]) -> str:
+    joints = _joints(doc)
     fr = doc.get("friction")
     if not isinstance(fr, list) or not fr:
         return ""
@@ -113,7 +132,7 @@ def _classical(doc: dict[str, Any], joint_names: list[str]) -> str:
             s = std[3 * j + k] if 3 * j + k < len(std) else None
             cells.append(cell(v) + (f" &plusmn; {number(s, 2)}" if is_number(s) else ""))
         rows.append(cells)
-    headers = ["joint", "fv [N m s/rad]", "fc [N m]", "fo [N m]"]
+    headers = ["joint", *(f"{c}{_unit(c, joints)}" for c in ("fv", "fc", "fo"))]
     return section(
         "friction",
         "Friction identified with the coefficients (value \u00b1 std)",
@@ -138,5 +157,6 @@ def terms_sections(doc: dict[str, Any]) -> list[str]:
         if not isinstance(term, dict) or not term.get("labels"):
             continue
         anchor = "friction" if k == 0 and term.get("kind") == "linear_friction" else f"term-{k}"
-        out.append(section(anchor, _heading(term), _term_table(term, names, combined)))
+        table = _term_table(term, names, combined, _joints(doc))
+        out.append(section(anchor, _heading(term), table))
     return out

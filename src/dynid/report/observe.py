@@ -26,6 +26,7 @@ from .html import (
     cell,
     esc,
     figure,
+    file_unit,
     href,
     is_number,
     number,
@@ -101,10 +102,11 @@ def _calibration(doc: Any) -> tuple[str, list[str]] | None:
             said += f" ({60.0 * alarms / duration:.3g} per minute)"
     moving = cal.get("detectable") if _numbers(cal.get("detectable")) else doc.get("contact")
     if _numbers(moving):
-        said += f"; an external torque above {_span(moving)} N m is detected while a joint moves"
+        u = file_unit(doc, "contact")
+        said += f"; an external torque above {_span(moving)} {u} is detected while a joint moves"
     rest = cal.get("at_rest")
     if _numbers(rest):
-        said += f", above {_span(rest)} N m on a joint at rest"
+        said += f", above {_span(rest)} {file_unit(doc, 'contact')} on a joint at rest"
     facts = [m[0]] if (m := _model_check(cal)) is not None else []
     return esc(said + "."), facts + ([_joint_table(doc, cal)] if _numbers(moving) else [])
 
@@ -117,18 +119,18 @@ def _joint_table(doc: dict, cal: dict) -> str:
     ``collision_moving`` shows no collision column), and, where the levels grow with the
     model's uncertainty, the fixed levels of the file's ``contact`` and ``collision``
     beside them, named as such."""
-    fixed = isinstance(doc.get("uncertainty"), dict)
+    fixed, u = isinstance(doc.get("uncertainty"), dict), file_unit(doc, "contact")
     moving = cal.get("detectable") if _numbers(cal.get("detectable")) else doc.get("contact")
     given = [
-        ("contact level, moving (smallest torque detected) [N m]", moving),
-        ("at rest [N m]", cal.get("at_rest")),
-        ("collision level, moving [N m]", cal.get("collision_moving")),
+        (f"contact level, moving (smallest torque detected) [{u}]", moving),
+        (f"at rest [{u}]", cal.get("at_rest")),
+        (f"collision level, moving [{u}]", cal.get("collision_moving")),
         (
-            "contact --no-uncertainty (fixed, not applied here) [N m]",
+            f"contact --no-uncertainty (fixed, not applied here) [{u}]",
             doc.get("contact") if fixed else None,
         ),
         (
-            "collision --no-uncertainty (fixed, not applied here) [N m]",
+            f"collision --no-uncertainty (fixed, not applied here) [{u}]",
             doc.get("collision") if fixed else None,
         ),
         *_read_columns(doc, cal),
@@ -177,17 +179,20 @@ def _read_columns(doc: dict, cal: dict) -> list[tuple[str, Any]]:
     rule: dict = got if isinstance(got, dict) else {}
     contact, margin, q = doc.get("contact"), rule.get("margin"), rule.get("quantile", 1.0)
     still = bool(rule.get("standstill_margin", False))
+    u = file_unit(doc, "contact")
     out: list[tuple[str, Any]] = []
     if _numbers(contact) and is_number(margin) and margin > 0 and is_number(q):
         read = "|r| read" if q == 1.0 else f"|r| quantile {q:g}"
         read += " past the standstill margin" if still else ""
         out.append(
             (
-                f"{read} (the fixed contact level is {margin:g} x it) [N m]",
+                f"{read} (the fixed contact level is {margin:g} x it) [{u}]",
                 [c / margin for c in contact or ()],
             )
         )
-    raw = "largest raw |r|, standstill margin not taken off [N m]" if still else "largest |r| [N m]"
+    raw = (
+        f"largest raw |r|, standstill margin not taken off [{u}]" if still else f"largest |r| [{u}]"
+    )
     if still or q != 1.0 or not out:  # else the one read is the raw largest
         out.append((raw, cal.get("peak")))
     return out
@@ -372,7 +377,7 @@ def _events_parts(name: str, run: RunFiles) -> list[str]:
     )
     headers = [
         "#", "log", "level", "joints", "start [s]", "end [s]", "duration [ms]",
-        "start on the log's clock [s]", "peak [N m]",
+        "start on the log's clock [s]", f"peak [{file_unit(doc, 'peak')}]",
     ]  # fmt: skip
     if any("false_alarm" in e for e in events):  # scored against labels: which were false
         headers.append("scored")

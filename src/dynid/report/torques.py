@@ -31,7 +31,18 @@ from ..identification.verdict import (
 )
 from .constants import constants_facts
 from .delay import delay_facts, delay_section
-from .html import capitalised, cell, esc, figure, is_number, percent, section, table, verdict
+from .html import (
+    capitalised,
+    cell,
+    esc,
+    figure,
+    file_unit,
+    is_number,
+    percent,
+    section,
+    table,
+    verdict,
+)
 from .run import Answer, RunFiles
 from .springs import spring_facts, springs_section
 
@@ -217,10 +228,11 @@ def _joint_errors(doc: dict) -> str:
             row += [cell(r1[j]), cell(p1[j] if j < len(p1) else None), cell(gain)]
         rows.append(row)
     added = _added(doc)
-    headers = ["joint", f"RMS without {added} [N m]", "relative error without [%]"]
+    u = file_unit(doc, "rms")
+    headers = ["joint", f"RMS without {added} [{u}]", "relative error without [%]"]
     if r1:
         headers += [
-            f"RMS with {added} [N m]",
+            f"RMS with {added} [{u}]",
             "relative error with [%]",
             f"{added} {'lowers' if added == 'friction' else 'lower'} RMS by [%]",
         ]
@@ -281,7 +293,7 @@ def friction_answer(run: RunFiles) -> Answer | None:
     sections = (  # the figure first: the tables of a sum and its RMS would push it down
         figs,
         *_law_tables(doc, names),
-        _rms_table(joints, names),
+        _rms_table(joints, names, file_unit(doc, "rms_before")),
         _candidates_table(cands, sel.get("chosen")),
     )
     return Answer(verdict(level, head, facts), sections, shown)
@@ -350,8 +362,9 @@ def _law_tables(doc: dict, names: list[str]) -> list[str]:
     return out
 
 
-def _rms_table(joints: list[dict], names: list[str]) -> str:
-    """The residual RMS per joint before and after the friction, and whether identified."""
+def _rms_table(joints: list[dict], names: list[str], unit: str = "N m") -> str:
+    """The residual RMS per joint before and after the friction [``unit``], and whether
+    identified."""
     if not any(is_number(r.get("rms_before")) for r in joints):
         return ""
     rows = [
@@ -363,7 +376,8 @@ def _rms_table(joints: list[dict], names: list[str]) -> str:
         ]
         for j, r in enumerate(joints)
     ]
-    headers = ["joint", "residual RMS before [N m]", "residual RMS after [N m]", "identified"]
+    headers = ["joint", f"residual RMS before [{unit}]", f"residual RMS after [{unit}]"]
+    headers.append("identified")
     return section("rms", "Residual per joint (the recordings fitted)", table(headers, rows))
 
 

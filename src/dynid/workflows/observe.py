@@ -90,6 +90,7 @@ from ..io.observer_files import load_thresholds
 from ..io.robot_file import load_robot
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..model.units import unit_said
 from ..observer.calibration_check import (
     CalibrationCheck,
     ModelCheck,
@@ -579,7 +580,9 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         rows = log.t.shape[0]
         table = None
         if sink is not None:
-            table = sink.table(paths, k, rows, model.n, opts.frame, kind)
+            table = sink.table(
+                paths, k, rows, model.n, opts.frame, kind, unit=unit_said(model.robot, "N m")
+            )
         with about_file(path.name):
             prep = prepared_log(
                 path, log, model, opts.max_gap, read.joint_side[k], _delay(opts, model)

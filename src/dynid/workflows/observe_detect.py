@@ -103,10 +103,12 @@ class ResidualSink(Protocol):
         frame: str | None,
         kind: WrenchKind = FULL,
         loads: Sequence[CarriedLoad] = (),
+        unit: str = "N m",
     ) -> AbstractContextManager[Callable[..., None]]:
         """A writer ``put(t, r, wrench, damped)`` of log ``index`` of ``paths`` (``rows``
         samples, ``n`` joints, the estimate ``kind`` at ``frame`` or none, the carried
-        ``loads`` whose torque the residual lacks), called for consecutive blocks of
+        ``loads`` whose torque the residual lacks, the residual's ``unit`` said per joint
+        kind: :func:`~dynid.model.units.unit_said`), called for consecutive blocks of
         samples."""
         ...
 

@@ -574,10 +574,23 @@ def note_unread_columns(rec: Recorded, cmap: ColumnMap | None) -> None:
 
 
 def given_units(cmap: ColumnMap | None, text: str | None) -> GivenUnits:
-    """The units the logs were read with (``cmap``'s factors) and the ``--units`` text
-    given, for the unit findings' hint."""
-    factors = {} if cmap is None else {k: cmap.factor(k) for k in ("t", "q", "dq", "ddq")}
-    return GivenUnits(text, factors)
+    """The units the logs were read with (``cmap``'s factors: of ``q``, ``dq``, ``ddq``
+    the revolute joints' and the prismatic joints', each kind read in its own unit or in
+    SI, :meth:`~dynid.io.columns.ColumnMap.joint_factors`) and the ``--units`` text given,
+    for the unit findings' hint."""
+    if cmap is None:
+        return GivenUnits(text)
+    factors = {k: cmap.factor(k) for k in ("t", "q", "dq", "ddq")}
+    lengths = dict(factors)
+    kinds = cmap.prismatic
+    for k in ("q", "dq", "ddq"):
+        if kinds is None or len(set(kinds)) < 2:  # a unit read every joint
+            continue
+        f = np.atleast_1d(cmap.joint_factors(k, len(kinds)))
+        f = np.broadcast_to(f, (len(kinds),))
+        factors[k] = float(f[~np.asarray(kinds)][0])
+        lengths[k] = float(f[np.asarray(kinds)][0])
+    return GivenUnits(text, factors, lengths)
 
 
 def check_unit_findings(rec: Recorded, robot: Robot, given: GivenUnits | None = None) -> None:

@@ -180,6 +180,7 @@ def _dependence_said(
     each joint's residual follows (on what the load leaves, where one is named)."""
     terms, inertia, lacks = held
     offsets, left_out = offsets_of(model), friction_left_out(model)
+    kinds = tuple(bool(p) for p in (model if isinstance(model, Robot) else model.robot).prismatic)
     q = [v.log.q for v in val.parts]
     dq = [v.log.dq for v in val.parts]
     error = [v.log.tau - v.tau_hat for v in val.parts]
@@ -193,14 +194,14 @@ def _dependence_said(
         verdict = with_hint(verdict, load_hint(load, payload))
         rest = dependence_hint(
             q, dq, load.residual, noise.total, names, terms, offsets=offsets,
-            left_out=left_out, ddq=ddq, inertia=inertia, lacks=lacks,
+            left_out=left_out, ddq=ddq, inertia=inertia, lacks=lacks, prismatic=kinds,
         )  # fmt: skip
         verdict = with_hint(verdict, None if rest is None else f"what it leaves: {rest}")
         return ResidualHints(verdict, None, None, tilt, load)  # the load, not a spring
     tau = [v.log.tau for v in val.parts]
     verdict = with_dependence_hint(
         verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
-        tau, offsets, left_out, ddq, inertia, lacks,
+        tau, offsets, left_out, ddq, inertia, lacks, kinds,
     )  # fmt: skip
     return ResidualHints(verdict, springs, None, tilt, load)
 
