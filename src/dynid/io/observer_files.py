@@ -81,6 +81,7 @@ from .. import __version__
 from .._checks import text
 from ..exceptions import DataError, DynidError
 from ..model.units import JointKinds, unit_said, units_said
+from ..observer.calibration_check import ModelCheck
 from ..observer.carried_load import CarriedLoad, load_words
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
@@ -719,19 +720,8 @@ def save_observation(
                 cal["collision_moving"] = check.collision.tolist()
             if check.sigma_max is not None:
                 cal["sigma_max"] = check.sigma_max.tolist()
-            if (m := check.model) is not None:  # the model behind the thresholds
-                v = m.verdict
-                cal["model_check"] = {
-                    "relative_error_percent": m.error_percent,
-                    "noise_floor_percent": m.floor_percent,
-                    "verdict": {
-                        "level": v.level,
-                        "label": v.label,
-                        "reason": v.reason,
-                        "ratio": v.ratio,
-                    },
-                    "fitted": list(m.fitted),
-                }
+            if check.model is not None:  # the model behind the thresholds
+                cal["model_check"] = _model_check_info(check.model)
         return [
             save_thresholds(
                 out / "thresholds.json",
@@ -801,6 +791,18 @@ def save_observation(
         ),
     )
     return paths
+
+
+def _model_check_info(m: ModelCheck) -> dict[str, Any]:
+    """``calibration.model_check``: the model behind the thresholds judged on the
+    calibration logs as validate judges it, and how many of them it was fitted on."""
+    v = m.verdict
+    return {
+        "relative_error_percent": m.error_percent,
+        "noise_floor_percent": m.floor_percent,
+        "verdict": {"level": v.level, "label": v.label, "reason": v.reason, "ratio": v.ratio},
+        "fitted": list(m.fitted),
+    }
 
 
 def _loads_info(result: ObserveResult, labels: Sequence[str]) -> dict[str, Any]:
