@@ -39,7 +39,14 @@ from ..dynamics.terms import gravity_torques
 from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains, drive_gains
-from ..identification.floor_verdict import judged_prediction, prediction_input_noise
+from ..identification.floor_verdict import input_step, judged_prediction, prediction_input_noise
+from ..identification.fold_spread import (
+    coefficient_covariance,
+    draw_margin,
+    fit_factors,
+    loose_folds,
+    prediction_variance,
+)
 from ..identification.gravity_tilt import GravityTilt, gravity_tilt, tilt_columns
 from ..identification.holdout import DEFAULT_FOLDS, block_labels
 from ..identification.input_noise import (
@@ -70,7 +77,13 @@ from ..identification.residual_dependence import (
 from ..identification.residual_spring import ResidualSpring, residual_spring
 from ..identification.rotor_sign import per_joint
 from ..identification.spikes import despiked
-from ..identification.verdict import Verdict, with_caveat, with_hint, with_replaced_spikes
+from ..identification.verdict import (
+    NOISE_FLOOR_SHARE,
+    Verdict,
+    with_caveat,
+    with_hint,
+    with_replaced_spikes,
+)
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..model.units import units_said
@@ -161,6 +174,12 @@ class HeldOutTorques:
     robot : Robot or None
         The model's robot: the units of ``as_dict`` per joint kind (a prismatic joint's
         force in N, :func:`~dynid.model.units.unit_said`); None: every joint's in N m.
+    fitted : tuple of (int, ndarray) or None
+        The variance [N^2 m^2] the held-out folds' own coefficients, fitted without the
+        samples they predict, put into the prediction at the samples of ``inputs``
+        (:mod:`~dynid.identification.fold_spread`: every recording predicted by the fit
+        of the others); a part of the floor. None: not counted (the model itself
+        predicts, or its columns are not the folds').
     """
 
     validation: Validation
@@ -180,6 +199,7 @@ class HeldOutTorques:
     left_out: Mapping[int, tuple[str, ...]] = field(default_factory=dict)
     gains: DriveGains | None = None
     robot: Robot | None = None
+    fitted: tuple[tuple[int, NDArray[np.float64]], ...] | None = None
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -193,6 +213,7 @@ class HeldOutTorques:
             v.errors,
             self.joint_names,
             self.inputs,
+            fitted=self.fitted,
         )
 
     @property
@@ -279,7 +300,8 @@ class HeldOutTorques:
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: the errors per joint, the noise (``noise_rms``: the sensors' and the
-        states', root sum of squares; ``sensor_noise_rms``, ``input_noise_rms``: its parts,
+        states' and the folds' coefficients', root sum of squares; ``sensor_noise_rms``,
+        ``input_noise_rms``, ``fit_noise_rms`` (:attr:`fitted`): its parts,
         the latter null when not known), the floor, the torque spikes replaced before
         judging, each joint's error over its noise as the verdict weighs it
         (``joint_ratios``: the numbers its reason and the report name), the verdict (with
@@ -298,6 +320,7 @@ class HeldOutTorques:
             "noise_rms": fl.total_rms.tolist(),
             "sensor_noise_rms": self.noise_rms.tolist(),
             "input_noise_rms": None if fl.input_rms is None else fl.input_rms.tolist(),
+            "fit_noise_rms": None if fl.fit_rms is None else fl.fit_rms.tolist(),
             "relative_error_percent": float(e.relative_error_percent),
             "relative_error_percent_per_joint": e.relative_error_percent_per_joint.tolist(),
             "noise_floor_percent": fl.percent,
@@ -315,6 +338,7 @@ class HeldOutTorques:
                     "noise_rms": "N m",
                     "sensor_noise_rms": "N m",
                     "input_noise_rms": "N m",
+                    "fit_noise_rms": "N m",
                     "relative_error_percent": "%",
                 },
             ),
@@ -466,10 +490,93 @@ def _each_recording(
     if len(pieces) > k:
         block += f" ({len(pieces)} pieces between gaps)"
     inputs = _input_noise(model, v, pieces)
-    held_out = _held_out(model, v, block, logs, None, spikes, inputs, folds=np.concatenate(folds))
+    labels = np.concatenate(folds)
+    held_out = _held_out(model, v, block, logs, None, spikes, inputs, folds=labels)
+    spread = _fold_spread(model, parts, v, labels, held_out.noise_rms)
+    if spread is not None:
+        fit_rms = np.sqrt(np.mean(spread[0][1], axis=0))
+        loose = loose_folds(fit_rms, held_out.noise_rms, held_out.joint_names)
+        held_out = dataclasses.replace(
+            held_out, fitted=None if loose else spread, caveat=loose or held_out.caveat
+        )
     if prepared is None or sum(p.n_samples for p in prepared) > KEPT_SAMPLES:
         return held_out
     return dataclasses.replace(held_out, prepared=tuple(prepared))
+
+
+#: Samples of each recording at most whose regressor the folds' covariance is summed over
+#: (every k-th: the regressor is smooth, its normal equations barely change).
+_SPREAD_SAMPLES = 4_000
+
+
+def _fold_spread(
+    model: IdentifiedModel,
+    parts: Sequence[Validation],
+    v: Validation,
+    labels: NDArray[np.intp],
+    noise: NDArray[np.float64],
+) -> tuple[tuple[int, NDArray[np.float64]], ...] | None:
+    """The variance [N^2 m^2] the coefficients of each fold, fitted on the other
+    recordings (``parts``: each recording's prediction, in the folds' order) with the
+    sensors' ``noise`` (n,) [N m], put into the prediction of ``v`` (``parts`` joined;
+    ``labels`` each sample's fold), at its every k-th sample as the states' noise is
+    carried (:func:`~dynid.identification.floor_verdict.input_step`;
+    :mod:`~dynid.identification.fold_spread`); None when the folds' columns are not the
+    model's regressor (their prediction differs from it) or the noise is not known."""
+    assert model.holdout is not None
+    top = float(np.max(noise, initial=0.0))
+    if not top > 0 or any(p.log.ddq is None for p in parts):
+        return None
+    var = np.maximum(noise, NOISE_FLOOR_SHARE * top) ** 2
+    terms = tuple(t.term for t in model.terms.values())
+
+    def rows(log: TorqueLog, at: NDArray[np.intp]) -> NDArray[np.float64]:
+        assert log.ddq is not None
+        return term_regressor(model.robot, model.base, terms, log.q[at], log.dq[at], log.ddq[at])[0]
+
+    own = []
+    for p in parts:
+        k = max(1, p.log.n_samples // _SPREAD_SAMPLES)
+        own.append((k * p.step, rows(p.log, np.arange(0, p.log.n_samples, k))))
+    factor = _fit_factors(model, own, var)
+    k = input_step(v.log.n_samples)
+    at = np.arange(0, v.log.n_samples, k)
+    out = np.zeros((at.size, v.log.n))
+    weighted = model.info.estimator != "ols"
+    drawn = []
+    for fold in range(len(parts)):
+        mine = at[labels[at] == fold]
+        normals = model.holdout.train[fold]
+        fitted = np.diag(normals.G) > 0
+        Y = rows(v.log, mine)
+        x = normals.solve()
+        scale = max(float(np.sqrt(np.mean(v.log.tau[mine] ** 2))), 1e-300)
+        if not np.allclose(Y @ x, v.tau_hat[mine], rtol=0.0, atol=1e-6 * scale):
+            return None  # not the folds' columns: no part said
+        train = [(s, Y_[..., fitted]) for f, (s, Y_) in enumerate(own) if f != fold]
+        cov = coefficient_covariance(train, var, weighted=weighted)
+        out[labels[at] == fold] = prediction_variance(Y[..., fitted], cov)
+        drawn.append((k, Y[..., fitted], cov))
+    return ((k, out * factor * draw_margin(drawn)),)
+
+
+def _fit_factors(
+    model: IdentifiedModel,
+    own: list[tuple[int, NDArray[np.float64]]],
+    var: NDArray[np.float64],
+) -> NDArray[np.float64] | float:
+    """Each joint's factor of the final fit's own spread over the noise's on its samples
+    ``own`` (:func:`~dynid.identification.fold_spread.fit_factors`); 1 without the fit's
+    covariance."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    cov = fit.covariance
+    width = own[0][1].shape[-1]
+    if cov is None or np.shape(cov) != (width, width):
+        return 1.0
+    kept = np.asarray(fit.kept, dtype=bool)
+    rows = [(k, Y[..., kept]) for k, Y in own]
+    noise = coefficient_covariance(rows, var, weighted=model.info.estimator != "ols")
+    return fit_factors(rows, noise, np.asarray(cov)[np.ix_(kept, kept)])
 
 
 def _pieces(model: IdentifiedModel, held: TorqueLog, turns: NDArray[np.bool_]) -> list[TorqueLog]:

@@ -46,7 +46,13 @@ from .engine import HeldRows, Rows, fit_rows
 from .estimators import Estimator, EstimatorName, estimator_named
 from .holdout import HeldOut, cross_validate
 from .info import IdentificationInfo, Route
-from .least_squares import LeastSquaresFit, StdMethod, checked_std, conditioning_advice
+from .least_squares import (
+    LeastSquaresFit,
+    StdMethod,
+    checked_std,
+    conditioning_advice,
+    loose_coefficients,
+)
 from .model import IdentifiedModel, IdentifiedTerm
 from .serial import Serial
 from .stacking import (
@@ -75,6 +81,7 @@ __all__ = [
     "identify",
     "informative_blocks",
     "model_advice",
+    "model_loose",
     "model_columns",
     "shared_bases",
     "stack_dataset",
@@ -373,6 +380,16 @@ def model_advice(model: IdentifiedModel, what: str = "the trajectory") -> list[s
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     labels = model.base.labels + tuple(lab for t in model.appended for lab in t.labels)
     return conditioning_advice(fit, labels, what=what)
+
+
+def model_loose(model: IdentifiedModel) -> list[tuple[str, float]]:
+    """The kept coefficients of ``model``'s fit over every column whose relative standard
+    deviation is above 1000 % (:func:`~dynid.identification.least_squares.
+    loose_coefficients`), each label and its deviation [%], as :func:`model_advice` warns
+    them."""
+    fit = model.joint_fit if model.joint_fit is not None else model.fit
+    labels = model.base.labels + tuple(lab for t in model.appended for lab in t.labels)
+    return loose_coefficients(fit, labels)
 
 
 def _what(data: Dataset) -> str:

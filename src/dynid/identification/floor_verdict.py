@@ -40,6 +40,7 @@ from .verdict import Verdict, judge_prediction
 
 __all__ = [
     "INPUT_SAMPLES",
+    "input_step",
     "judged_prediction",
     "opposite_sign",
     "prediction_input_noise",
@@ -49,6 +50,12 @@ __all__ = [
 #: Samples of a piece at most at which the states' noise is carried through the model
 #: (every k-th).
 INPUT_SAMPLES = 20_000
+
+
+def input_step(n_samples: int) -> int:
+    """The step ``k`` of the samples of a piece of ``n_samples`` at which a prediction's
+    noise is carried (every k-th, at most :data:`INPUT_SAMPLES` of them)."""
+    return max(1, n_samples // INPUT_SAMPLES)
 
 
 def prediction_input_noise(
@@ -67,7 +74,7 @@ def prediction_input_noise(
     out = []
     for p in logs:
         assert p.ddq is not None  # prepared: always with ddq
-        k = max(1, p.n_samples // INPUT_SAMPLES)
+        k = input_step(p.n_samples)
         q, dq, ddq = (np.ascontiguousarray(x[::k]) for x in (p.q, p.dq, p.ddq))
         out.append((k, input_noise_var(rigid, friction, q, dq, ddq, noise)))
     return out
@@ -106,6 +113,7 @@ def judged_prediction(
     inputs: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
     *,
     opposite: bool = False,
+    fitted: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
 ) -> tuple[Verdict, NoiseFloor]:
     """The verdict of a prediction on pieces and the noise floor it was judged against.
 
@@ -124,6 +132,10 @@ def judged_prediction(
         None: not known (the sensors' noise alone).
     opposite : bool
         The torques are anti-correlated with the model's (:func:`opposite_sign`).
+    fitted : sequence of (int, ndarray), optional
+        The noise the coefficients of a fit that did not see the pieces put into the
+        prediction, per piece as ``inputs``
+        (:mod:`~dynid.identification.fold_spread`); None: not counted.
 
     Returns
     -------
@@ -132,7 +144,7 @@ def judged_prediction(
         against :func:`~dynid.identification.input_noise.noise_floor`, each joint against
         its own noise.
     """
-    fl = noise_floor(tau, error, sensor_var, inputs, rms=errors.rms)
+    fl = noise_floor(tau, error, sensor_var, inputs, rms=errors.rms, fitted=fitted)
     verdict = judge_prediction(
         errors.relative_error_percent,
         fl.percent,

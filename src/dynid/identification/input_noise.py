@@ -326,6 +326,10 @@ class NoiseFloor:
         Each joint's error over its noise, weighed so (None: no noise known).
     words : str or None
         The floor's parts for the verdict (``judge_prediction``'s ``floor_parts``).
+    fit_rms : ndarray, shape (n,), or None
+        The noise of coefficients fitted without the samples judged, through the model,
+        per joint [N m] (RMS over the samples; :mod:`~dynid.identification.fold_spread`);
+        None: not counted.
     """
 
     sensor_rms: NDArray[np.float64]
@@ -335,6 +339,7 @@ class NoiseFloor:
     ratio: float | None
     joint_ratios: NDArray[np.float64] | None
     words: str | None
+    fit_rms: NDArray[np.float64] | None = None
 
 
 def noise_floor(
@@ -343,6 +348,7 @@ def noise_floor(
     sensor_var: Sequence[NDArray[np.float64] | None],
     inputs: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
     rms: NDArray[np.float64] | None = None,
+    fitted: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
 ) -> NoiseFloor:
     """The noise floor of pieces and their prediction error weighed against it.
 
@@ -366,6 +372,10 @@ def noise_floor(
     rms : ndarray, shape (n,), optional
         The RMS error per joint over every sample [N m] (default: over ``error``'s), for
         pieces that keep every k-th sample of a longer prediction.
+    fitted : sequence of (int, ndarray (M_p, n)), optional
+        The noise of coefficients fitted without these pieces through the model, each
+        piece's as ``inputs`` (the same steps), a part of the floor weighed with the
+        states' noise and said on its own.
     """
     n = tau[0].shape[1]
     N = sum(t.shape[0] for t in tau)
@@ -373,10 +383,15 @@ def noise_floor(
         (t.shape[0] * s for t, s in zip(tau, sensor_var, strict=True) if s is not None), np.zeros(n)
     )
     norm2 = float(sum(np.sum(t**2) for t in tau))
-    put = np.zeros(n)
-    if inputs is not None:
-        put = sum((k * np.sum(V, axis=0) for k, V in inputs), np.zeros(n))
-        put *= N / max(sum(k * V.shape[0] for k, V in inputs), 1)  # to every sample
+    states = inputs is not None
+    own = None if fitted is None else _every_sample(fitted, N, n)
+    if fitted is not None:
+        inputs = (
+            fitted
+            if inputs is None
+            else [(k, V + F) for (k, V), (_, F) in zip(inputs, fitted, strict=True)]
+        )
+    put = np.zeros(n) if inputs is None else _every_sample(inputs, N, n)
     total = np.sqrt((var + put) / max(N, 1))
     percent = 100.0 * float(np.sqrt((var + put).sum() / norm2)) if norm2 > 0 else 0.0
     if rms is None:
@@ -394,18 +409,51 @@ def noise_floor(
             count += V.shape[0]
         ratios = np.sqrt(w_e2 / max(count, 1) / mean)
         ratio = float(np.sqrt(np.sum(w_e2) / max(count, 1) / np.sum(mean)))
-        words = (
-            f", of which the torques' noise {100 * np.sqrt(var.sum() / norm2):.3g} % and that "
-            f"of the states through the model {100 * np.sqrt(put.sum() / norm2):.3g} %; "
-            "the ratio weighs each sample against its own noise, which varies along the "
-            "motion, so it is not the quotient of the pooled percentages"
-        )
+        words = _floor_words(var, put, own, states, norm2)
+    mine = np.zeros(n) if own is None else own
     return NoiseFloor(
         sensor_rms=np.sqrt(var / max(N, 1)),
-        input_rms=None if inputs is None else np.sqrt(put / max(N, 1)),
+        input_rms=np.sqrt(np.maximum(put - mine, 0.0) / max(N, 1)) if states else None,
         total_rms=total,
         percent=percent,
         ratio=ratio,
         joint_ratios=ratios,
         words=words,
+        fit_rms=None if own is None else np.sqrt(own / max(N, 1)),
+    )
+
+
+def _every_sample(
+    pieces: Sequence[tuple[int, NDArray[np.float64]]], N: int, n: int
+) -> NDArray[np.float64]:
+    """The variances of ``pieces`` (each its step and its every k-th sample's (M, n))
+    summed per joint over all ``N`` samples [N^2 m^2] (n,)."""
+    put = sum((k * np.sum(V, axis=0) for k, V in pieces), np.zeros(n))
+    return np.asarray(put * N / max(sum(k * V.shape[0] for k, V in pieces), 1), np.float64)
+
+
+def _floor_words(
+    var: NDArray[np.float64],
+    put: NDArray[np.float64],
+    own: NDArray[np.float64] | None,
+    states: bool,
+    norm2: float,
+) -> str:
+    """The floor's parts in words: the torques' noise ``var``, the states' (``put`` less
+    ``own``, when ``states``) and that of coefficients fitted without the samples
+    (``own``), each summed over the samples [N^2 m^2] (n,), in % of the torques' norm."""
+
+    def pct(x: NDArray[np.float64]) -> str:
+        return f"{100 * np.sqrt(max(float(x.sum()), 0.0) / norm2):.3g} %"
+
+    parts = [f"the torques' noise {pct(var)}"]
+    if states:
+        states_var = put if own is None else put - own
+        parts.append(f"that of the states through the model {pct(states_var)}")
+    if own is not None:
+        parts.append(f"that of the coefficients fitted without these samples {pct(own)}")
+    said = ", ".join(parts[:-1]) + f" and {parts[-1]}"
+    return (
+        f", of which {said}; the ratio weighs each sample against its own noise, which "
+        "varies along the motion, so it is not the quotient of the pooled percentages"
     )

@@ -69,10 +69,13 @@ __all__ = [
     "StdMethod",
     "block_grams",
     "checked_std",
+    "LOOSE_ADVICE",
     "conditioning_advice",
     "fit_least_squares",
     "fit_with_pruning",
     "hac_covariance",
+    "loose_coefficients",
+    "loose_note",
     "unexcited_combinations",
 ]
 
@@ -199,18 +202,45 @@ def conditioning_advice(
             "configurations (dynid acquire-static --pool) or a longer, optimised trajectory "
             "(dynid excite), or fix these parameters (--max-std-percent drops them)"
         )
+    loose = loose_coefficients(fit, labels)
+    if loose:
+        out.append(
+            f"{len(loose)} {LOOSE_ADVICE} {LARGE_STD_PERCENT:g} %: {_named(loose)}; they are "
+            f"indistinguishable from zero with {what}; hint: --max-std-percent removes them, "
+            "or add excitation"
+        )
+    return out
+
+
+#: The words that tell :func:`conditioning_advice`'s advice on loose coefficients.
+LOOSE_ADVICE = "kept coefficient(s) have a standard deviation above"
+
+
+def loose_coefficients(fit: LeastSquaresFit, labels: tuple[str, ...]) -> list[tuple[str, float]]:
+    """The kept coefficients of ``fit`` (``labels``, length r) whose relative standard
+    deviation is above :data:`LARGE_STD_PERCENT` and whose standard deviation moves the
+    data (:data:`NEGLIGIBLE_EFFECT_PERCENT`): each label and its deviation [%]."""
     pct = np.asarray(fit.std_percent)
     eff = np.asarray(fit.effect_percent)
     moves = eff > NEGLIGIBLE_EFFECT_PERCENT if eff.shape == pct.shape else np.ones(pct.shape, bool)
     big = np.flatnonzero(np.asarray(fit.kept) & (pct > LARGE_STD_PERCENT) & moves)
-    if big.size:
-        names = ", ".join(f"{labels[k]} ({pct[k]:.3g} %)" for k in big[:8])
-        out.append(
-            f"{big.size} kept coefficient(s) have a standard deviation above "
-            f"{LARGE_STD_PERCENT:g} %: {names}; they are indistinguishable from zero with "
-            f"{what}; hint: --max-std-percent removes them, or add excitation"
-        )
-    return out
+    return [(labels[k], float(pct[k])) for k in big]
+
+
+def loose_note(loose: list[tuple[str, float]], what: str = "the trajectory") -> str:
+    """The note that says the ``loose`` coefficients (:func:`loose_coefficients`) of a
+    model whose held-out prediction is at the noise floor: they do not change its
+    predictions, one line in place of :func:`conditioning_advice`'s warning."""
+    return (
+        f"{len(loose)} coefficient(s) {what} leaves loose (standard deviation above "
+        f"{LARGE_STD_PERCENT:g} %: {_named(loose)}) do not change the predictions, held out "
+        "at the noise floor; --max-std-percent removes them"
+    )
+
+
+def _named(loose: list[tuple[str, float]]) -> str:
+    """The first 8 of ``loose`` in words: ``"beta19 (1.08e+03 %), ..."``."""
+    return ", ".join(f"{name} ({pct:.3g} %)" for name, pct in loose[:8])
 
 
 def fit_least_squares(

@@ -232,8 +232,8 @@ def opposite_sign(robot: Robot, log: TorqueLog, *, file: str | None = None) -> s
         )
     seen = np.flatnonzero(loaded | strong)
     return (
-        f"{said} on every joint judged ({', '.join(f'{names[k]} {corr[k]:+.2f}' for k in seen)}"
-        "): the torque sign is probably opposite to the model's there; the sign of "
+        f"{said} {_judged_joints(seen, corr, names, closer, pushing)}: the torque sign is "
+        "probably opposite to the model's there; the sign of "
         f"{', '.join(names[k] for k in unjudged)}, whose torques the model's do not explain "
         "(gravity barely loads them, and friction or a drive's rotor inertia outweighs their "
         "links'), is not told by this check; hint: --units "
@@ -481,6 +481,46 @@ def sign_confirmed(robot: Robot, logs: Sequence[TorqueLog]) -> NDArray[np.bool_]
     if not model:
         return np.zeros(robot.n, dtype=bool)
     return _confirmed(*_explained(np.concatenate(model), np.concatenate(tau)))
+
+
+def _judged_joints(
+    seen: NDArray[np.intp],
+    corr: NDArray[np.float64],
+    names: tuple[str, ...],
+    closer: dict[int, tuple[float, float]],
+    pushing: dict[int, float],
+) -> str:
+    """Where the torques are anti-correlated with the model's: ``"on every joint judged
+    (2 -0.80, 3 -0.52)"``, or, where a joint of ``seen`` (all called opposite) is not
+    (correlation ``corr`` of 0 or more: told by its friction, ``closer`` or
+    ``pushing``), ``"on every joint judged but 4 (...); 4: correlation +0.18, but ..."``:
+    a joint of positive correlation is never listed as anti-correlated (a UR5's wrist at
+    +0.18 was, under "every joint judged")."""
+    agree = [int(k) for k in seen if corr[k] < 0]
+    but = [int(k) for k in seen if corr[k] >= 0]
+    listed = ", ".join(f"{names[k]} {corr[k]:+.2f}" for k in agree)
+    if not but:
+        return f"on every joint judged ({listed})"
+    told = []
+    for k in but:
+        if k in closer:
+            why = (
+                f"{closer[k][0]:.3g} N m RMS from the negated model's torques against "
+                f"{closer[k][1]:.3g} from the model's (means included)"
+            )
+        elif k in pushing:
+            why = (
+                f"as read its friction would push the arm (Coulomb {pushing[k]:.3g} N m), "
+                "while negated its torques are the model's plus friction"
+            )
+        else:
+            why = "its torques are told opposite with the others'"
+        told.append(f"{names[k]}: correlation {corr[k]:+.2f}, but {why}")
+    return (
+        f"on every joint judged but {', '.join(names[k] for k in but)}"
+        + (f" ({listed})" if listed else "")
+        + f"; {'; '.join(told)}"
+    )
 
 
 def _opposite(

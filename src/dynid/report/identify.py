@@ -747,6 +747,7 @@ def answer(run: RunFiles) -> Answer | None:
         facts += spring_facts(held)  # where the verdict names a spring: its stiffness
         facts[:0] = delay_facts(doc)  # a named lag first: the hints after it may be the lag
         facts[:0] = _gravity_facts(doc)  # the gravity every number above was fitted with
+        facts[:0] = cut_facts(doc)  # data the fit left out of a recording: beside the verdict
     rank, p = _rank_fact(doc)
     facts.append(rank)
     problems += p
@@ -780,6 +781,36 @@ def answer(run: RunFiles) -> Answer | None:
 _DATA_WARNINGS = ("anti-correlated", "look like degrees", "times the model's gravity torques")
 
 
+def cut_facts(doc: dict) -> list[str]:
+    """One fact per recording the fit cut spans out of (``metadata.recordings[].cut_out``):
+    which recording, which span and why (outlying among the recordings,
+    ``metadata.selection.outlying_recordings``, or a burst in the fit's own residual): the
+    cut changes the data the model was fitted on, so it is said beside the verdict, not
+    only among the warnings."""
+    recs = _get(doc, "metadata", "recordings") or ()
+    odd = set(_get(doc, "metadata", "selection", "outlying_recordings") or ())
+    odd |= set(_get(doc, "metadata", "outlying_recordings") or ())
+    out = []
+    for r in recs:
+        if not isinstance(r, dict) or not r.get("cut_out"):
+            continue
+        spans = ", ".join(
+            f"t = {a:.4g} to {b:.4g} s" for a, b in r["cut_out"] if is_number(a) and is_number(b)
+        )
+        n = r.get("cut_samples")
+        held = f" ({n} recorded samples)" if isinstance(n, int) else ""
+        why = (
+            "its held-out error there far above the other recordings'"
+            if r.get("file") in odd
+            else "a burst in the fit's own residual (a contact or a logging fault, not the model)"
+        )
+        out.append(
+            f"<b>Cut out of the fit</b>: {esc(str(r.get('file', 'a recording')))}, "
+            f"{esc(spans)}{held}: {esc(why)}; --keep-outlying fits it whole"
+        )
+    return out
+
+
 def _warning_facts(run: RunFiles, problems: list[str]) -> list[str]:
     """Facts (and an unusable verdict in ``problems``) from the run's warnings: torques of the
     opposite sign or positions in degrees fit as well as the right ones, and a model fitted
@@ -799,6 +830,7 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
         noise = held.get("noise_rms") or [None] * len(names)
         sensor = held.get("sensor_noise_rms") or noise  # an older file: the sensors' alone
         states = held.get("input_noise_rms")  # the held-out states' noise through the model
+        folds = held.get("fit_noise_rms")  # the folds' own coefficients' (each recording's)
         rel = held.get("relative_error_percent_per_joint") or [None] * len(names)
         rows = []
         weighed = held.get("joint_ratios")  # the verdict's, each sample against its noise
@@ -809,12 +841,14 @@ def _torques_section(run: RunFiles, held: dict | None) -> str:
             ratio = weighed[j] if weighed is not None and is_number(weighed[j]) else ratio
             row = [esc(name), cell(e), cell(sensor[j] if j < len(sensor) else None)]
             row += [cell(states[j] if j < len(states) else None)] if states else []
+            row += [cell(folds[j] if j < len(folds) else None)] if folds else []
             rows.append([*row, cell(ratio), cell(rel[j])])
         headers = [
             "joint",
             f"held-out RMS error [{(u := file_unit(held, 'rms'))}]",
             f"sensor noise RMS [{u}]",
             *([f"states' noise through the model RMS [{u}]"] if states else []),
+            *([f"noise of the coefficients fitted without them RMS [{u}]"] if folds else []),
             "error / noise" + (" (each sample against its own)" if weighed else ""),
             "held-out relative error [%]",
         ]

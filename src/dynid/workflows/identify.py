@@ -53,6 +53,7 @@ from ..feasibility.payload_arm import model_structure
 from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
+from ..identification.core import model_loose
 from ..identification.dissipation import ReversedSignError
 from ..identification.estimators import ESTIMATORS, EstimatorName
 from ..identification.gravity_scale import (
@@ -61,7 +62,7 @@ from ..identification.gravity_scale import (
     gravity_scale_factor,
     gravity_scale_words,
 )
-from ..identification.least_squares import STD_METHODS, StdMethod
+from ..identification.least_squares import LOOSE_ADVICE, STD_METHODS, StdMethod, loose_note
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.motor_constants import shared_gear_ratio
@@ -638,8 +639,9 @@ def _fit_logs(
 
     separate = heldout.get("validate_on")
     kept = refit_gravity(robot, search)
-    _say_once(kept.said)  # the kept search's, each once as the default filter says them
     robot, (model, held, first), gravity = kept.robot, kept.searched, kept.gravity
+    said, model = _loose_at_floor(kept.said, model, held)
+    _say_once(said)  # the kept search's, each once as the default filter says them
     if gravity is not None:
         note = gravity.note()
         info = dataclasses.replace(
@@ -846,6 +848,26 @@ def _searched(
         gains = None if first.gains is None else dataclasses.replace(first.gains, applied=True)
         held = dataclasses.replace(held, gains=gains, springs=None, tilt=None)
     return model, held, first
+
+
+def _loose_at_floor(
+    said: Sequence[warnings.WarningMessage], model: IdentifiedModel, held: HeldOutTorques | None
+) -> tuple[list[warnings.WarningMessage], IdentifiedModel]:
+    """The warnings ``said`` and ``model``; where the held-out verdict is at the noise
+    floor, without the warning on coefficients above 1000 % std
+    (:data:`~dynid.identification.least_squares.LOOSE_ADVICE`), said instead in one note
+    (:func:`~dynid.identification.least_squares.loose_note`, in the model's notes): they
+    do not change its predictions (a UR5's runs warned one to three of them, each time)."""
+    if held is None or held.verdict.level != "good":
+        return list(said), model
+    kept = [w for w in said if LOOSE_ADVICE not in str(w.message)]
+    loose = model_loose(model)
+    if not loose:
+        return kept, model
+    note = loose_note(loose)
+    _log.log(NOTE, "%s", note)
+    info = dataclasses.replace(model.info, notes=(*model.info.notes, note))
+    return kept, dataclasses.replace(model, info=info)
 
 
 def _say_once(said: Sequence[warnings.WarningMessage]) -> None:
