@@ -226,7 +226,10 @@ class DriveGains:
         description's scale (:attr:`scaled`), at least two determined, not :attr:`uneven`,
         their common factor farther from 1 than :data:`MASSES` and :data:`AGREE` times
         farther than any of them from it (logarithms; an SO-100's currents through
-        constants 2.45 times the true ones: 0.405 to 0.419); None otherwise."""
+        constants 2.45 times the true ones: 0.405 to 0.419); None otherwise. A load the
+        description lacks gives such a factor too (the gains see the efforts' scale
+        against the model's, not where it comes from): the gravity torques tell them
+        apart (:mod:`~dynid.identification.gravity_scale`)."""
         js = np.flatnonzero(self.determined)
         if not self.scaled or js.size < 2 or self.uneven or np.any(self.factor[js] <= 0):
             return None
@@ -571,9 +574,10 @@ def _common_words(gains: DriveGains, common: float) -> str:
     return (
         f"{gains.per}(s) {_ids(js)} share one factor, {common:.3g} ({lo:.3g} to {hi:.3g}), "
         f"beyond the description's masses' error (over {100 * MASSES:g} % from 1, "
-        f"{AGREE:g} or more times the motors' spread about it): the drive file's "
-        f"torque_constant looks {1 / common:.3g} times the true one: multiply it by "
-        f"{common:.3g}, if the description's masses are right"
+        f"{AGREE:g} or more times the {gains.per}s' spread about it): their torque_constant "
+        f"{1 / common:.3g} times the true one (multiply it by {common:.3g}) or a load the "
+        "description lacks, which the identified gravity torques tell apart (identify's "
+        "note of them)"
     )
 
 
