@@ -32,8 +32,8 @@ both hold: the masses' error, small, and a scale of the torques, large, which th
 names first (:func:`beyond_masses_words`; an SO-100 servo arm of link masses 15 % off its
 description, its currents read through constants 2.45 times the true ones: factors 2.33
 to 2.42, a spread of 2.1 % beyond their 0.05 % uncertainty, once called the masses' with
-a 0.41 kg mass at its gripper; a 0.1 kg load at the gripper instead gives 1.5 to 2.8, a
-spread as large as the factor, and stays the masses' note, naming the load).
+a 0.41 kg mass at its gripper; a 0.1 kg load at the gripper instead gives 1.44 to 2.04,
+as far apart as they are from 1, and stays the masses' note, naming the load).
 """
 
 from __future__ import annotations
