@@ -155,3 +155,22 @@ def test_units_without_columns_get_the_whole_map_with_the_units_given(tmp_path, 
     np.testing.assert_allclose(log.q, np.deg2rad(body[:, 1 : 1 + N]), rtol=1e-15)
     np.testing.assert_allclose(log.dq, np.deg2rad(body[:, 1 + N : 1 + 2 * N]), rtol=1e-15)
     np.testing.assert_array_equal(log.tau, -body[:, 1 + 2 * N :])
+
+
+def test_the_naming_hint_counts_the_chains_joints_not_the_servos(tmp_path, capsys):
+    """Regression (an SO-100 trial: five arm joints, the gripper's servo a sixth column):
+    the hint offered "name them q1..q6" for a 5-joint chain; now the chain's joints are
+    named (the Panda's 7 beside 8 servo columns), and the map still reads the file."""
+    header = [
+        "timestamp",
+        *(f"present_position_{j}" for j in range(1, N + 2)),
+        *(f"present_current_{j}" for j in range(1, N + 2)),
+    ]
+    rng = np.random.default_rng(6)
+    body = np.column_stack([np.arange(300) / 1000.0, rng.normal(0.0, 0.3, (300, 2 * N + 2))])
+    path = tmp_path / "rec.csv"
+    np.savetxt(path, body, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+    argv = ["identify", "--robot", "panda", "--data", str(path), "--out", str(tmp_path / "o")]
+    line = _error(argv, capsys)
+    assert line.endswith("or name them q1..q7, tau1..tau7"), line
+    assert "t=timestamp,q=present_position_{i},tau=present_current_{i}" in line, line

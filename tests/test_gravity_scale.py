@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,7 +28,9 @@ from dynid.identification.gravity_scale import (
     gravity_scale_factor,
     gravity_scale_finding,
 )
+from dynid.identification.motor_constants import SharedGearRatio
 from dynid.identification.selection import identify_recordings
+from dynid.io.robot.urdf import load_urdf
 from dynid.model.drive import Drive
 from dynid.simulation.measurement import SensorNoise
 from dynid.workflows.identify import IdentifyOptions, identify_logs, parsed_terms
@@ -195,3 +198,94 @@ def test_a_hand_the_description_lacks_is_named_as_a_mass_at_the_flange():
     other = gravity_scale_factor(robot, _fitted(robot, off), [off.q])
     assert other is not None and not other.one_factor and other.flange is None
     assert "mass of" not in gravity_masses_words(robot, other)
+
+
+#: The SO-101 arm of the test data (five joints, 0.47 kg of links) and each link's
+#: inertials in the simulated truth over its description's: 15 % off at most, a factor
+#: per link.
+SO101 = Path(__file__).parent / "data" / "so101_arm.urdf"
+SO_MASSES = np.array([1.07, 0.86, 1.14, 1.07, 1.01])
+#: The truth's torque constant [N m/A at the joint] of its servo currents.
+SO_KT = 0.704
+
+
+@pytest.fixture(scope="module")
+def so101():
+    """The SO-101 description and the truth: its links :data:`SO_MASSES` off."""
+    robot = load_urdf(SO101, tip_link="gripper_frame_link", snap_angles=True)
+    return robot, robot.with_params(robot.phi * SO_MASSES[:, None])
+
+
+def _so_identified(robot, arm, kt, scale=1.0):
+    """identify of an exact 2 s log of ``arm``'s currents (its torques over
+    :data:`SO_KT`, times ``scale``) read through the torque constant ``kt`` on every
+    joint: the result, its warnings, the held-out gains' line of the torque constants and
+    the log's positions."""
+    (log,) = recordings(arm, [1], friction=None, duration=2.0)
+    currents = dataclasses.replace(log, tau=scale * log.tau / SO_KT)
+    drive = Drive(np.eye(5), np.zeros(5), effort="current", torque_constant=np.full(5, kt))
+    options = IdentifyOptions(terms="offset", drive=drive)
+    got, said = said_warnings(identify_logs, robot, currents, options)
+    gains = got.heldout.gains if got.heldout is not None else None
+    return got, said, None if gains is None else gains.constants_words(), log.q
+
+
+def test_a_wrong_torque_constant_beside_masses_off_is_named_first_with_its_fix(so101):
+    """Regression (an SO-100 trial): currents read through a torque constant 2.45 times
+    the true one, the description's link masses up to 15 % off: the joints' factors
+    differ by the masses' error beyond their tiny uncertainty, and the whole factor was
+    called the masses' (the model "right as it is and needs no change", a 0.54 kg mass at
+    the gripper of a 0.47 kg arm; the torque constants' line "no change to the drive
+    file"). Now it is the torque constants', named first: 2.45 times the masses' own
+    factors (the truth's gravity torques over the description's, from both arms), the fix
+    the constants times its inverse, within the masses' error of the true constant, and no
+    mass named."""
+    robot, truth = so101
+    got, said, line, q = _so_identified(robot, truth, 2.45 * SO_KT)
+    masses = _true_ratios(robot, truth, q)[gravity_ratios(robot, got.model, q)[2]]
+    factor = got.model.info.extra["gravity_scale"]["factor"]
+    assert 2.45 * masses.min() <= factor <= 2.45 * masses.max()
+    kt = 2.45 * SO_KT / factor
+    assert abs(kt / SO_KT - 1) <= np.max(np.abs(1 - 1 / masses))
+    (found,) = [w for w in said if "gravity torques" in w]
+    assert found.startswith(
+        f"the torque constants the currents were read through look {factor:.3g} times the "
+        f"true ones on every motor: torque_constant = [{', '.join([f'{kt:.4g}'] * 5)}]"
+    )
+    assert "needs no change" not in found and "a mass of about" not in found
+    assert not any("needs no change" in n for n in got.model.info.notes)
+    assert line is not None and "no change to the drive file" not in line
+    assert "share one factor" in line and "or a load the description lacks" in line
+
+
+def test_currents_in_ma_read_as_amperes_name_the_unit(so101):
+    """The same arm's currents logged in mA and read as A through the true constant: the
+    factor 1000 times the masses' is named as the unit, with --units tau=mA."""
+    robot, truth = so101
+    said = _so_identified(robot, truth, SO_KT, scale=1000.0)[1]
+    (found,) = [w for w in said if "identified gravity torques" in w]
+    assert found.startswith("the currents read") and "currents in mA read as A" in found
+    assert "--units tau=mA" in found and "needs no change" not in found
+
+
+def test_a_load_the_description_lacks_is_still_named_as_a_mass(so101):
+    """The arm carrying 0.1 kg at its gripper, its currents read through the true
+    constant: its factors differ by the load's levers (1.9 to 2.3), and the note names a
+    mass at the flange within the masses' error of 0.1 kg, no torque constant."""
+    robot, truth = so101
+    arm = truth.with_tool(np.eye(4), mass=0.1, com=(0.0, 0.0, 0.03))
+    got, said, _, _ = _so_identified(robot, arm, SO_KT)
+    assert not any("gravity torques" in w for w in said), said
+    assert "gravity_scale" not in got.model.info.extra
+    (note,) = [n for n in got.model.info.notes if "link masses look off" in n]
+    m = float(note.split("a mass of about ")[1].split(" kg")[0])
+    assert 0.085 <= m <= 0.115
+
+
+def test_a_shared_gear_ratio_names_a_remaining_factor_beyond_the_masses():
+    """Constants given at the motors over gear ratio 345: a remaining factor within 20 %
+    of 1 is the masses' error, one of 2.34 to 2.47 is not called so."""
+    far = SharedGearRatio(345.0, np.array([2.34, 2.47])).sentence()
+    assert "times 2.34 to 2.47 (beyond the description's masses' error" in far
+    near = SharedGearRatio(345.0, np.array([0.95, 1.05])).sentence()
+    assert "times 0.95 to 1.05 (the masses' error)" in near

@@ -50,7 +50,11 @@ The verdict weighs the relative error against the sensor-noise floor read from t
 measured torques (the smallest error a model can reach on them): "at the noise floor"
 (at most 1.5 x the floor), "usable" (at most 3 x, or below 15 %), "poor" (below 50 %: the
 model misses effects the data show), "unusable" (50 % or more, or torques anti-correlated
-with the model's: a log of another robot, in other units or of the other sign). A
+with the model's: a log of another robot, in other units or of the other sign). Each
+joint is judged against its own noise too (at the floor within 1.25 x it, usable within 3
+x or below 25 % relative error, poor otherwise) and the verdict is the worst joint's where
+that is worse (never worse than poor), naming those joints: a pooled error within 1.5 x
+the floor is "poor" when a joint errs over 3 x its noise and 25 % of its torque. A
 recording whose torques read with the opposite sign on some joints or on all (the check
 identify and observe refuse it by) is named at the start of the verdict with those joints
 and the --units entries that read them (of that file alone, --units rec2.csv:tau4=-1, when

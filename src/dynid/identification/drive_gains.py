@@ -50,10 +50,12 @@ from numpy.typing import ArrayLike, NDArray
 from .solvers import tall_r
 
 __all__ = [
+    "AGREE",
     "CONSTANTS_DOC",
     "DETERMINED",
     "EXPLAINED",
     "LINKED",
+    "MASSES",
     "OFF",
     "RAISE",
     "SIGNIFICANT",
@@ -64,6 +66,15 @@ __all__ = [
 
 #: Relative distance from 1 of a gain the finding names.
 OFF = 0.10
+#: Largest relative distance from 1 of a factor a robot description's masses make on
+#: every joint together (links 15 % off each: the joints' factors within 5 % of 1): a
+#: common factor beyond it is the efforts' scale (a torque constant's, a unit's).
+MASSES = 0.20
+#: Smallest ratio of a common factor's distance from 1 to the largest distance of the
+#: joints' (motors') factors from it, both of logarithms, for it to be the efforts' scale
+#: beside the masses' error: masses off joint by joint move each joint's factor about as
+#: much as they move the common one; a torque constant moves every joint alike.
+AGREE = 5.0
 #: Smallest ratio of a gain's distance from 1 to its standard deviation.
 SIGNIFICANT = 5.0
 #: Largest relative standard deviation of a determined gain.
@@ -207,6 +218,26 @@ class DriveGains:
         return gap >= OFF * float(self.factor[lo]) and gap >= SIGNIFICANT * self.ratio_std(
             int(hi), int(lo)
         )
+
+    @property
+    def common(self) -> float | None:
+        """The determined motors' common factor [-] (geometric mean) where it is the
+        efforts' scale beyond the description's masses' error: the gains at the
+        description's scale (:attr:`scaled`), at least two determined, not :attr:`uneven`,
+        their common factor farther from 1 than :data:`MASSES` and :data:`AGREE` times
+        farther than any of them from it (logarithms; an SO-100's currents through
+        constants 2.45 times the true ones: 0.405 to 0.419); None otherwise. A load the
+        description lacks gives such a factor too (the gains see the efforts' scale
+        against the model's, not where it comes from): the gravity torques tell them
+        apart (:mod:`~dynid.identification.gravity_scale`)."""
+        js = np.flatnonzero(self.determined)
+        if not self.scaled or js.size < 2 or self.uneven or np.any(self.factor[js] <= 0):
+            return None
+        logs = np.log(self.factor[js])
+        mid = float(np.mean(logs))
+        if abs(mid) < max(np.log1p(MASSES), AGREE * float(np.max(np.abs(logs - mid)))):
+            return None
+        return float(np.exp(mid))
 
     @property
     def explains(self) -> bool:
@@ -380,8 +411,11 @@ class DriveGains:
         if self.named:
             parts.append(f"{unit}(s) {_ids(self.named)} named above, with the fix")
         why: dict[str, list[int]] = {}
+        common = self.common
+        if common is not None:
+            parts.append(_common_words(self, common))
         for k in checked:
-            if k not in self.named:
+            if k not in self.named and common is None:
                 why.setdefault(self.unnamed_reason(int(k)), []).append(int(k))
         parts += [
             f"no change to the drive file for {unit}(s) {_ids(ks)}: {reason}"
@@ -393,6 +427,7 @@ class DriveGains:
                 f"not checked by these data: {unit}(s) {_ids(unchecked)}, whose "
                 "torques are as right as the drive file's constants (a known payload or a "
                 "torque sensor checks them)"
+                + ("; a constant guessed as the others' is off alike" if common else "")
             )
         return f"torque constants: {'; '.join(parts)} ({CONSTANTS_DOC})"
 
@@ -528,6 +563,22 @@ class DriveGains:
             f': a scale per {unit} is a drive file with effort = "current" and these factors '
             "as torque_constant (--units tau=... scales every joint alike)"
         )
+
+
+def _common_words(gains: DriveGains, common: float) -> str:
+    """The part of :meth:`DriveGains.constants_words` naming the determined motors' common
+    factor ``common`` [-] (:attr:`DriveGains.common`) as their torque constants' with its
+    fix."""
+    js = np.flatnonzero(gains.determined)
+    lo, hi = float(gains.factor[js].min()), float(gains.factor[js].max())
+    return (
+        f"{gains.per}(s) {_ids(js)} share one factor, {common:.3g} ({lo:.3g} to {hi:.3g}), "
+        f"beyond the description's masses' error (over {100 * MASSES:g} % from 1, "
+        f"{AGREE:g} or more times the {gains.per}s' spread about it): their torque_constant "
+        f"{1 / common:.3g} times the true one (multiply it by {common:.3g}) or a load the "
+        "description lacks, which the identified gravity torques tell apart (identify's "
+        "note of them)"
+    )
 
 
 def _read(factor: float, std: float, spread: NDArray[np.float64] | None, k: int) -> str:

@@ -21,11 +21,24 @@ the user to judge (the description may be uniformly off instead). Factors that d
 more are the description's masses, off joint by joint (a cable, a motor left out of the
 CAD, a URDF's inertials not its arm's), where a torque scale is one factor on every joint:
 the model, fitted to the torques as logged, is right as it is, and a note says so
-(:func:`gravity_masses_words`), offering no scale.
+(:func:`gravity_masses_words`), offering no scale. Unless their common factor lies far
+beyond what those masses make (:attr:`GravityRatios.beyond_masses`): farther from 1 than
+a description's masses are off together (:data:`~.drive_gains.MASSES`) and
+:data:`~.drive_gains.AGREE` times farther than the joints spread about it (masses off
+joint by joint move each joint's factor about as much as they move the common one; a
+torque constant moves every joint alike), and one factor leaves no more of the gravity
+torques than a mass at the flange does (a load's levers make the factors differ). Then
+both hold: the masses' error, small, and a scale of the torques, large, which the finding
+names first (:func:`beyond_masses_words`; an SO-100 servo arm of link masses 15 % off its
+description, its currents read through constants 2.45 times the true ones: factors 2.33
+to 2.42, a spread of 2.1 % beyond their 0.05 % uncertainty, once called the masses' with
+a 0.41 kg mass at its gripper; a 0.1 kg load at the gripper instead gives 1.44 to 2.04,
+as far apart as they are from 1, and stays the masses' note, naming the load).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -36,10 +49,12 @@ from ..dynamics.terms import gravity_torques
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.torque import torque_regressor
+from .drive_gains import AGREE, MASSES
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded
 
 __all__ = [
+    "AGREE",
     "DESCRIBED",
     "GRAVITY_SCALE",
     "GravityRatios",
@@ -48,6 +63,7 @@ __all__ = [
     "SHAPE",
     "UNIFORM",
     "at_the_motors",
+    "beyond_masses_words",
     "gravity_masses_words",
     "flange_mass",
     "flange_mass_of",
@@ -136,6 +152,16 @@ class GravityRatios:
     one_factor : bool
         Whether they are one factor: chi-square within :data:`LEVEL`, spread within
         :data:`UNIFORM`.
+    flange : tuple of (float, ndarray), optional
+        The mass [kg] at the last link and its position (3,) [m] that make up the
+        difference (:func:`flange_mass`), for factors that differ and are no scale.
+    beyond_masses : bool
+        Factors that differ (not :attr:`one_factor`) whose common factor is a scale all the
+        same: farther from 1 than :data:`~.drive_gains.MASSES` and
+        :data:`~.drive_gains.AGREE` times
+        farther than the joints' largest distance from it (:attr:`spread`), both of
+        logarithms, and explaining the gravity torques as well as a mass at the flange
+        (module docstring).
     """
 
     factor: float
@@ -146,6 +172,20 @@ class GravityRatios:
     chi2: float
     one_factor: bool
     flange: tuple[float, NDArray[np.float64]] | None = None
+    beyond_masses: bool = False
+
+    @property
+    def spread(self) -> float:
+        """The loaded joints' largest relative distance [-] from the common factor
+        (``exp(max |log r_j - log factor|) - 1``)."""
+        d = np.abs(np.log(self.ratios[self.joints] / self.factor))
+        return float(np.expm1(np.max(d)))
+
+    @property
+    def scale(self) -> bool:
+        """Whether the factor is the torques' scale: :attr:`one_factor` or
+        :attr:`beyond_masses`."""
+        return self.one_factor or self.beyond_masses
 
 
 def flange_mass(
@@ -257,8 +297,34 @@ def gravity_scale_factor(
     se = np.full(robot.n, np.nan)
     if C is not None:
         se[js] = np.sqrt(np.clip(np.diag(C), 0.0, None))
-    flange = None if agree else flange_mass(robot, model, qs)
-    return GravityRatios(factor, std, r, se, js, chi2, agree, flange)
+    found = GravityRatios(factor, std, r, se, js, chi2, agree)
+    if agree:
+        return found
+    far = abs(np.log(factor)) >= max(np.log1p(MASSES), AGREE * np.log1p(found.spread))
+    if far and _scale_explains(robot, qs, model.gravity_torques(qs)):
+        return dataclasses.replace(found, beyond_masses=True)
+    return dataclasses.replace(found, flange=flange_mass(robot, model, qs))
+
+
+def _scale_explains(robot: Robot, q: NDArray[np.float64], g: NDArray[np.float64]) -> bool:
+    """Whether one factor on the description's gravity torques explains the gravity
+    torques ``g`` (N, n) [N m] at the configurations ``q`` (N, n) [rad] at least as well
+    as the description's plus a point mass at the last link (its mass and first moments,
+    :func:`flange_mass_of`'s fit), on the joints gravity loads: a load the description
+    lacks makes the joints' factors differ by its levers (an SO-101 of link masses 15 %
+    off carrying 0.1 kg: 12 % of the torques left by a factor, 0.2 % by the mass), a
+    torque constant by the masses' error (2.45 times: 1.4 % by the factor, 1.6 % by a
+    mass, 0.54 kg on a 0.47 kg arm)."""
+    loaded = gravity_loaded(robot, q)
+    gd = gravity_torques(robot, q)[:, loaded].ravel()
+    gm = np.asarray(g, dtype=np.float64)[:, loaded].ravel()
+    by_factor = gm - (gd @ gm / (gd @ gd)) * gd
+    last = 10 * (robot.n - 1)
+    zero = np.zeros_like(q)
+    Y = torque_regressor(robot, q, zero, zero)[:, loaded, last : last + 4].reshape(-1, 4)
+    x, *_ = np.linalg.lstsq(Y, gm - gd, rcond=None)
+    by_mass = gm - gd - Y @ x
+    return float(by_factor @ by_factor) <= float(by_mass @ by_mass)
 
 
 def gravity_scale_finding(
@@ -270,11 +336,12 @@ def gravity_scale_finding(
     """The finding (module docstring) of ``model`` identified from logs at the
     configurations ``q`` (one (N, n) array per log) of ``robot``, or None: no inertial
     parameters in the description, fewer than 2 loaded joints, factors that differ between
-    joints (:func:`gravity_masses_words` says those) or lie within :data:`OFF` of 1.
+    joints within what the description's masses make (:func:`gravity_masses_words` says
+    those: not :attr:`GravityRatios.scale`) or lie within :data:`OFF` of 1.
     ``drive``: the drive the log was read through (a log of currents: its torque constant
     is named)."""
     found = gravity_scale_factor(robot, model, q)
-    if found is None or not found.one_factor:
+    if found is None or not found.scale:
         return None
     return gravity_scale_words(robot, found, drive)
 
@@ -286,7 +353,10 @@ def _std(x: float) -> str:
 
 def gravity_scale_words(robot: Robot, found: GravityRatios, drive: Drive | None = None) -> str:
     """:func:`gravity_scale_finding`'s sentence of the factor :func:`gravity_scale_factor`
-    ``found`` (one factor on every loaded joint) of ``robot``."""
+    ``found`` (one factor on every loaded joint, or beyond the masses' error: then
+    :func:`beyond_masses_words`) of ``robot``."""
+    if found.beyond_masses:
+        return beyond_masses_words(robot, found, drive)
     mean, r, js = found.factor, found.ratios, found.joints
     names = ", ".join(robot.joint_names[j] for j in js)
     said = (
@@ -311,6 +381,63 @@ def gravity_scale_words(robot: Robot, found: GravityRatios, drive: Drive | None 
     return (
         f"{said}; if the description's masses are right, the torques are {1 / mean:.3g} "
         f"times too small (a sensor scale: --units tau={1 / mean:.3g}){currents}"
+    )
+
+
+#: A factor [-] within this relative distance of 1000 is an effort unit's (mA read as A,
+#: mN m as N m).
+_UNIT_TOL = 0.15
+
+
+def beyond_masses_words(robot: Robot, found: GravityRatios, drive: Drive | None = None) -> str:
+    """The finding of factors :func:`gravity_scale_factor` ``found`` that differ between
+    the loaded joints of ``robot`` and share a common factor beyond the masses' error
+    (:attr:`GravityRatios.beyond_masses`): the torques' scale first, with its fix
+    (``drive``'s torque constants times its inverse, each given; an effort unit's near
+    1000), then why the masses do not make it."""
+    mean, r, js = found.factor, found.ratios, found.joints
+    fix = 1.0 / mean
+    unit = abs(np.log(mean / 1000.0)) < np.log1p(_UNIT_TOL)
+    current = drive is not None and drive.effort == "current"
+    if current and unit:
+        lead = (
+            f"the currents read {mean:.3g} times the description's gravity torques on every "
+            "joint: currents in mA read as A (--units tau=mA reads them, the drive file as "
+            "it is)"
+        )
+    elif current:
+        assert drive is not None and drive.torque_constant is not None  # a drive of currents
+        kt = np.asarray(drive.torque_constant, dtype=np.float64) * fix
+        lead = (
+            f"the torque constants the currents were read through look {mean:.3g} times the "
+            f"true ones on every motor: torque_constant = [{', '.join(f'{v:.4g}' for v in kt)}]"
+            f" in the drive file (theirs times {fix:.3g}){at_the_motors(drive, fix)}, and "
+            "identify again"
+        )
+    else:
+        which = " (mN m read as N m: --units tau=mNm)" if unit else ""
+        lead = (
+            f"the torques look {mean:.3g} times the true ones on every joint{which}: scale "
+            f"them by {fix:.3g} (--units tau={fix:.3g}) and identify again"
+            + (
+                '; or the log holds motor currents: a drive file with effort = "current" '
+                "and each motor's torque_constant"
+                if not unit and not 0.5 <= mean <= 2.0
+                else ""
+            )
+        )
+    each = ", ".join(f"{robot.joint_names[j]} {r[j]:.4g}" for j in js)
+    times = abs(np.log(mean)) / max(np.log1p(found.spread), 1e-300)
+    return (
+        f"{lead}: the identified gravity torques are {r[js].min():.3g} to {r[js].max():.3g} "
+        f"times the robot description's on the joints gravity loads ({each}), one common "
+        f"factor {mean:.3g}{_std(found.factor_std)} with the joints within "
+        f"{100 * found.spread:.2g} % of it (beyond their uncertainty: the description's "
+        "masses' own error, joint by joint), far beyond what those masses make (its distance "
+        f"from 1 {times:.2g} times that spread, at least {AGREE:g}, and over "
+        f"{100 * MASSES:g} %): a scale the fit cannot see (it predicts the log as well with "
+        "it; its masses and inertias carry it), if the description's masses are right; no "
+        "mass at the flange is read from it"
     )
 
 

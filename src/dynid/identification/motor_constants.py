@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 
 from ..model.drive import Drive
 from ..model.robot import Robot
-from .drive_gains import DriveGains
+from .drive_gains import MASSES, DriveGains
 from .log import TorqueLog, joint_side_log
 from .sanity import gravity_torque_scale
 
@@ -161,10 +161,17 @@ class SharedGearRatio:
         lo, hi = float(self.common.min()), float(self.common.max())
         span = f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g} to {hi:.3g}"
         g = f"{self.gear_ratio:.4g}"
+        mid = abs(float(np.mean(np.log(self.common))))
+        why = (
+            "the masses' error"
+            if mid < np.log1p(MASSES)
+            else f"beyond the description's masses' error ({100 * MASSES:g} %): a factor of "
+            "the constants' own besides, which the gravity torques of the fitted model name"
+        )
         return (
             f"torque_constant looks given at the motors: the currents read through it are "
             f"1/{g} (the gear ratio every joint shares) times the description's gravity "
-            f"torques, times {span} (the masses' error); on a joint-side log (side = "
+            f"torques, times {span} ({why}); on a joint-side log (side = "
             "\"joint\") torque_constant is each joint's torque per A, the motor's constant "
             f"times its gear ratio: the currents are read through torque_constant x {g} "
             "(identification.json's drive holds them: put them in the drive file)"

@@ -294,7 +294,19 @@ def judge_prediction(
     if p is not None and any(p[j] >= 100.0 for j in bad):  # worse than no torque at all
         what += "; at 100 % or more: a log of another robot, or other kinematics?"
     label = "usable" if level == "fair" else "poor"
-    return Verdict(level, label, f"{v.reason.split(':')[0]}; joint(s) {which}: {what}", v.ratio)
+    pooled = v.reason.split(":")[0]
+    if LEVELS.index(level) > LEVELS.index(v.level):  # the help's pooled rule alone says better
+        pooled += f", {_POOLED_WORDS[v.level]} pooled and judged by its worst joint"
+    return Verdict(level, label, f"{pooled}; joint(s) {which}: {what}", v.ratio)
+
+
+#: The pooled level in the words of a verdict judged by its worst joint instead.
+_POOLED_WORDS = {
+    "good": f"within {FLOOR_GOOD:g} x the floor",
+    "fair": "usable",
+    "poor": "poor",
+    "unusable": "unusable",
+}
 
 
 def _named_joints(

@@ -130,6 +130,8 @@ def column_hint(
     missing: Sequence[str],
     used: set[str],
     optional: Sequence[str] = (),
+    *,
+    named: int | None = None,
 ) -> str:
     """``; present but unused: ...; hint: ...`` for a header that lacks the columns of the
     signals ``missing`` (``"tau"``, ``"dq"``) of an ``n``-joint log.
@@ -147,6 +149,10 @@ def column_hint(
     optional : sequence of str
         Signals the log may lack (the velocities of a positions-only log), mapped too when
         a family of their names is there.
+    named : int, optional
+        The joints the columns to name count (the chain's, where a servo log holds a
+        gripper's column beyond its joints: ``q1..q5`` beside ``position_1..6``); None:
+        ``n``.
 
     Returns
     -------
@@ -185,9 +191,11 @@ def column_hint(
             if "tau" in found
             else ""
         )
-        spans = ", ".join(f"{s}1..{s}{n}" for s in ("q", "dq", "tau") if s in found)
+        k = n if named is None else named
+        spans = ", ".join(f"{s}1..{s}{k}" for s in ("q", "dq", "tau") if s in found)
         return f"{text}; hint: --columns '{spec}' reads them{caveat}, or name them {spans}"
-    spans = ", ".join(f"{s}1..{s}{n}" for s in missing)
+    k = n if named is None else named
+    spans = ", ".join(f"{s}1..{s}{k}" for s in missing)
     return (
         f"{text}; hint: name the columns {spans} (the torque-log format of the docs), or "
         f"map yours with --columns ('tau=effort{{i}}': {{i}} counts joints from 1, {{i0}} "

@@ -252,7 +252,11 @@ def _check_written(path: Path, rows: int, n_rows: int) -> None:
 
 
 def load_torque_log(
-    path: str | Path, *, gap_factor: float = 1.5, drop_invalid: bool = False
+    path: str | Path,
+    *,
+    gap_factor: float = 1.5,
+    drop_invalid: bool = False,
+    joints: int | None = None,
 ) -> TorqueLog:
     """Read a torque log from a ``.csv`` or ``.npz`` file, strictly.
 
@@ -264,6 +268,10 @@ def load_torque_log(
     drop_invalid : bool
         Drop rows holding NaN or inf and rows repeating the previous timestamp (a warning
         gives the count and the first rows) instead of raising.
+    joints : int, optional
+        The joint count of the chain the log is read for: the columns a header's hint
+        names (``q1..q5`` for a 5-joint chain whose servo log holds a sixth, the
+        gripper's); None: the header's own count.
 
     Returns
     -------
@@ -286,7 +294,7 @@ def load_torque_log(
     if suffix == ".npz":
         arrays, lines = _read_npz(path), None
     elif suffix == ".csv":
-        arrays, lines = _read_csv(path)
+        arrays, lines = _read_csv(path, joints)
     else:
         raise DataError(f"torque log must be a .csv or .npz file{bag_hint(path)}", file=path.name)
     _check_rows(path, arrays, lines, drop_invalid)
@@ -445,8 +453,11 @@ def _annotated_hint(names: list[str]) -> str:
     return f"; hint: names with units are read by --columns '{spec}' (and --units if not SI)"
 
 
-def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
-    """Check the header; return the joint count n and whether ddq columns are present."""
+def _columns(
+    path: Path, names: list[str], line: int, joints: int | None = None
+) -> tuple[int, bool]:
+    """Check the header; return the joint count n and whether ddq columns are present
+    (``joints``: the chain's joint count, the columns a hint names; None: the header's)."""
     at = f"line {line}"
     dup = sorted({c for c in names if names.count(c) > 1})
     if dup:
@@ -465,7 +476,8 @@ def _columns(path: Path, names: list[str], line: int) -> tuple[int, bool]:
             signals = [s for s in ("q", "tau") if not named[s]]  # q0..q6 counts from 0
             optional = ["dq"] if not named["dq"] else []
             unit = re.search(r"(ms|us|ns)$", time.lower())
-            hint = column_hint(names, k, signals, {time}, optional).split("; hint: ", 1)[-1]
+            hint = column_hint(names, k, signals, {time}, optional, named=joints)
+            hint = hint.split("; hint: ", 1)[-1]
             if not signals and time != "t":  # the joints' columns named right, not the time
                 hint = (
                     f"--columns 't={time}'"
@@ -574,11 +586,14 @@ def _say_unread(name: str, kind: str, extra: list[str]) -> None:
         )
 
 
-def _read_csv(path: Path) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:
-    """The arrays of a CSV log, and (line of the first data row, rows) for messages."""
+def _read_csv(
+    path: Path, joints: int | None = None
+) -> tuple[dict[str, NDArray[np.float64]], tuple[int, int] | None]:
+    """The arrays of a CSV log, and (line of the first data row, rows) for messages
+    (``joints``: the chain's joint count, for a header's hint)."""
 
     def layout(names: list[str], line: int) -> dict[str, list[int]]:
-        n, with_ddq = _columns(path, names, line)
+        n, with_ddq = _columns(path, names, line, joints)
         index = {c: k for k, c in enumerate(names)}
         out = {"t": [index["t"]]}
         for k in _SIGNALS if with_ddq else _SIGNALS[:3]:

@@ -365,7 +365,7 @@ def _read_torque_log(
 ) -> TorqueLog:
     """:func:`read_torque_log`'s reading."""
     if columns is None:
-        log = load_torque_log(path, drop_invalid=drop_invalid)
+        log = load_torque_log(path, drop_invalid=drop_invalid, joints=n)
     else:
         if robot is not None and n in (None, robot.n):  # each unit for its joints' kind
             columns = columns.for_robot(robot.prismatic)

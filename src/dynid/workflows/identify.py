@@ -736,7 +736,8 @@ def _say_gravity_scale(
     (:func:`~dynid.identification.gravity_scale.gravity_scale_finding`: a warning, and
     ``gravity_scale`` in its metadata, ``factor`` and ``finding``, which ``payload`` reads:
     a load weighed through the model carries the factor); with a note in its notes when the
-    joints' factors differ beyond their uncertainty
+    joints' factors differ beyond their uncertainty, their common factor within what the
+    description's masses make
     (:func:`~dynid.identification.gravity_scale.gravity_masses_words`: the description's
     masses, not the torques, are off; nothing to change); not when the held-out verdict
     names a factor per motor (``held.gains``, which holds the common one too): one
@@ -747,7 +748,7 @@ def _say_gravity_scale(
     factor = gravity_scale_factor(robot, model, q)
     if factor is None:
         return model
-    if not factor.one_factor:
+    if not factor.scale:
         said = gravity_masses_words(robot, factor)
         _log.log(NOTE, "%s", said)
         info = dataclasses.replace(model.info, notes=(*model.info.notes, said))
