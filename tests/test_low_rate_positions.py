@@ -1,11 +1,15 @@
-"""The observer on a log of positions only sampled at 30 Hz (hobby servos over USB): its
-fixed 20 Hz velocity cut-off lay above half the rate, every piece's derived velocities
-were NaN and ``observe`` stopped with "dq must be finite", a column the log does not have.
+"""Logs of positions only sampled at 30 Hz (hobby servos over USB). The observer's fixed
+20 Hz velocity cut-off lay above half the rate: every piece's derived velocities were NaN
+and ``observe`` stopped with "dq must be finite", a column the log does not have. A
+cut-off given or recorded at or above half the rate (``--cutoff 20``, a model identified
+at 20 Hz on a faster log) was refused by ``validate``, ``friction``, ``identify`` and
+``payload``, and the reader's 5 Hz refused a 10 Hz log. Every cut-off not below half the
+rate now runs at a quarter of it, with a note.
 
 Reference: a planar 2R arm (Spong's closed form, written out here) moving along sines,
 sampled at 30 Hz with jittered stamps and quantised positions; its velocities are the
-sines' closed-form derivatives, and a step contact of known size is taken from the
-torques the motors supply.
+sines' closed-form derivatives, its torques the closed form's, and a step contact of
+known size is taken from the torques the motors supply.
 """
 
 from __future__ import annotations
@@ -51,9 +55,16 @@ def _closed_form(t: np.ndarray, phase: float) -> tuple[np.ndarray, ...]:
     return q, dq, np.column_stack([tau1 + g1, tau2 + g2])
 
 
-def _log(seed: int, contact: bool) -> tuple[TorqueLog, np.ndarray]:
+def _phase(seed: int) -> float:
+    """The sines' phase of :func:`_log`'s ``seed``."""
+    rng = np.random.default_rng(seed)
+    rng.normal(0.0, 0.003, int(24 * RATE))
+    return float(rng.uniform(0, 2 * np.pi))
+
+
+def _log(seed: int, contact: bool, counts: int = 4096) -> tuple[TorqueLog, np.ndarray]:
     """A 24 s log at 30 Hz of positions only (stamps jittered by 3 ms, positions
-    quantised to 4096 counts a turn, torque noise 0.01 N m) and its true velocities."""
+    quantised to ``counts`` a turn, torque noise 0.01 N m) and its true velocities."""
     rng = np.random.default_rng(seed)
     t = np.arange(int(24 * RATE)) / RATE + rng.normal(0.0, 0.003, int(24 * RATE))
     t = np.sort(t - t[0])
@@ -61,7 +72,7 @@ def _log(seed: int, contact: bool) -> tuple[TorqueLog, np.ndarray]:
     if contact:
         a, b, j, size = HIT
         tau[(t >= a) & (t < b), j] -= size  # the motors supply the model's less the push
-    step = 2 * np.pi / 4096
+    step = 2 * np.pi / counts
     q = np.round(q / step) * step
     tau = tau + 0.01 * rng.standard_normal(tau.shape)
     return TorqueLog(t, q, np.zeros_like(q), tau, dq_derived=True), dq
@@ -115,3 +126,59 @@ def test_the_observers_cut_off_stays_at_20_hz_where_the_rate_allows_it():
 
     assert derived_cutoff(np.arange(200) / 50.0) == DERIVED_CUTOFF_HZ == 20.0
     assert derived_cutoff(np.arange(200) / 40.0) == pytest.approx(10.0)
+
+
+def test_a_cut_off_above_half_the_rate_prepares_a_30_hz_log_at_a_quarter_of_it(caplog):
+    """Regression (``identify --cutoff 20`` on a 30 Hz log: "20 Hz: must be below half the
+    sample rate"): the recordings are prepared at 7.5 Hz with a note, their velocities the
+    sines' closed-form derivatives to 2 % of their peak; a cut-off at or above the rate
+    itself (no cut-off for these samples: another unit, another log) is still refused."""
+    from dynid.exceptions import OptionError
+    from dynid.identification.recordings import prepare_recordings
+
+    log, _ = _log(5, contact=False)
+    with caplog.at_level(NOTE), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rec = prepare_recordings(planar_2r(), [log], ["servo.csv"], cutoff_hz=20.0)
+    assert rec.cutoff_hz == pytest.approx(RATE / 4, rel=1e-3)
+    said = [r.getMessage() for r in caplog.records if r.levelno == NOTE]
+    assert any("20 Hz is not below half the sample rate" in n and "7.5 Hz" in n for n in said)
+    (piece,) = rec.pieces
+    t = piece.log.t
+    true = _closed_form(t, phase=_phase(5))[1]
+    assert np.all(np.abs(piece.log.dq - true).max(axis=0) < 0.02 * np.abs(true).max(axis=0))
+    with pytest.raises(OptionError, match="must be below half the sample rate"):
+        prepare_recordings(planar_2r(), [log], ["servo.csv"], cutoff_hz=30.0)
+
+
+def test_a_30_hz_log_is_validated_at_a_quarter_of_its_rate_against_the_closed_form():
+    """Regression (``validate --cutoff 20`` refused a 30 Hz log of positions only): the
+    model that made the log (the 2R arm's closed form) predicts its torques at 7.5 Hz
+    within three times their noise's relative error (positions read to 2^24 counts a
+    turn; the states interpolated between stamps jittered by 3 ms add about as much as
+    the noise again: 0.26 % for 0.13 %)."""
+    from dynid.friction.recordings import validate_recordings
+
+    log, _ = _log(6, contact=False, counts=1 << 24)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        val = validate_recordings(planar_2r(), [log], ["servo.csv"], cutoff_hz=20.0)
+    assert val.pieces.cutoff_hz == pytest.approx(RATE / 4, rel=1e-3)
+    tau = _closed_form(log.t, phase=_phase(6))[2]
+    noise = 100 * 0.01 * np.sqrt(tau.size) / np.linalg.norm(tau)  # [%]
+    assert val.without_friction.relative_error_percent < 3.0 * noise
+
+
+def test_a_10_hz_log_of_positions_is_read_at_a_quarter_of_its_rate():
+    """Regression (``identify`` on 10 Hz servo logs: "cutoff_hz must lie in (0, fs/2) =
+    (0, 4.99824) Hz; got 5 Hz", the reader's default against jittered stamps): the
+    reader derives the velocities at a quarter of the rate, the sines' closed-form
+    derivatives to 5 % of their peak inside the filter's edges (0.8 s)."""
+    from dynid.identification.log import DEFAULT_CUTOFF_HZ, with_derived_velocities
+
+    log, true = _log(7, contact=False, counts=1 << 24)
+    slow = log.select(slice(None, None, 3))  # every third sample: 10 Hz, jittered
+    dq = with_derived_velocities(slow, DEFAULT_CUTOFF_HZ).dq
+    inner = (slow.t > slow.t[0] + 0.8) & (slow.t < slow.t[-1] - 0.8)
+    err = np.abs(dq[inner] - true[::3][inner]).max(axis=0)
+    assert np.all(err < 0.05 * np.abs(true).max(axis=0))
