@@ -431,3 +431,20 @@ def test_a_smooth_laws_width_is_written_as_width_not_as_the_standstill_band(tmp_
         np.testing.assert_array_equal(law_friction(rec, None, 2, "f", "k").band, width)
     classical = LAWS["classical"].model([[0.5, 0.8, 0.0]], [0.005])
     assert law_record(classical)["standstill_band"] == [0.005]
+
+
+def test_a_stribeck_fit_with_a_band_wider_than_its_largest_velocity_is_made():
+    """Regression (``dynid friction`` on a 30 Hz servo log of positions only stopped with
+    "The lower bound exceeds the upper bound": motors behind gears of 345 had derived
+    velocities whose noise band, 12.7 rad/s, lay past the largest Stribeck velocity, 10
+    rad/s, and the search's interval ran backwards): the fit is made at that velocity and
+    recovers a viscous and Coulomb friction written out (no bump)."""
+    rng = np.random.default_rng(5)
+    band = 12.7
+    dq = rng.uniform(-200.0, 200.0, 4000)
+    fv, fc = 2e-4, 0.02
+    r = fv * dq + fc * _s(dq, band) + 1e-4 * rng.standard_normal(dq.shape)
+    fit = LAWS["stribeck"].fit(dq, r, band)
+    p = fit.params
+    assert np.all(np.isfinite(p)) and p[3] == pytest.approx(10.0)
+    np.testing.assert_allclose(p[:2], [fv, fc], rtol=0.05)

@@ -46,6 +46,7 @@ __all__ = [
     "EDGE_PERIODS",
     "EXACT_DERIVATIVE_ORDER",
     "MOTION_EDGE_PERIODS",
+    "below_nyquist",
     "derivative",
     "exact_derivative",
     "derivative_noise_gain",
@@ -740,6 +741,16 @@ def derivative_noise_gain(dt: float, cutoff_hz: float, *, lowpassed: bool = Fals
     if lowpassed:
         h = lowpass(h, 1.0 / dt, cutoff_hz)
     return float(np.sqrt(np.sum(h**2)))
+
+
+def below_nyquist(cutoff_hz: float, fs: float) -> float:
+    """The cut-off [Hz] a low-pass of samples at ``fs`` [Hz] runs at: ``cutoff_hz`` where
+    it lies below half the rate, else a quarter of the rate (the highest cut-off
+    identification reads from a log's motion, and the one a slow log's default is moved
+    to): a 20 Hz cut-off on a 30 Hz log filters at 7.5 Hz. Callers say so where the value
+    was the user's."""
+    fc, fs = float(cutoff_hz), float(fs)
+    return fc if fc < 0.5 * fs else 0.25 * fs
 
 
 def edge_seconds(cutoff_hz: float, motion_hz: float | None = None) -> float:

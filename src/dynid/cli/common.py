@@ -212,7 +212,9 @@ def cutoff_type(text: str) -> float | str:
 cutoff_type.__name__ = "cutoff"
 #: The end of every ``--cutoff`` help: how to turn the filter off.
 CUTOFF_NONE_HELP = (
-    "; 'none': no low-pass, every sample as recorded (exact or already filtered data)"
+    "; 'none': no low-pass, every sample as recorded (exact or already filtered data); a "
+    "cut-off, given or the model's, not below half a log's rate runs at a quarter of the "
+    "rate, with a note (one at or above the rate itself is refused)"
 )
 
 

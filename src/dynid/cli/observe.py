@@ -40,7 +40,10 @@ Two steps:
   more than 20 % away from it warns (the velocities' noise in the residual, and the
   thresholds, change with the rate; calibrate at the log's rate), and so does a log whose
   velocities are derived from its positions where the calibration's were measured, or the
-  reverse. Whether the observer is
+  reverse. A log without velocity columns has them derived from its positions (a
+  zero-phase low-pass at 20 Hz, then differences), at a quarter of its rate when it is
+  sampled at 40 Hz or less (a note says so; calibrate and detect at the same rate).
+  Whether the observer is
   good enough is printed below the table, kept in thresholds.json's calibration and put
   first in the report: the false alarms the thresholds raise on the calibration logs (the
   events --thresholds would find there, and per minute) and the smallest external torque

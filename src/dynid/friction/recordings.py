@@ -40,12 +40,13 @@ from .. import _checks
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.cut_loss import left_out_finding
 from ..identification.input_noise import StateNoise, state_noise
-from ..identification.log import TorqueLog, joint_side_log
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
 from ..identification.metrics import TorqueErrors
 from ..identification.model import IdentifiedModel
 from ..identification.pieces import (
     check_below_nyquist,
     gaps_between,
+    nyquist_cutoff,
     recording_line,
     recording_pieces,
     skipped_piece,
@@ -287,8 +288,10 @@ def _raw_pieces(
     drive: Drive | None,
     trim_s: float | None = None,
 ) -> _Raw:
-    """Every recording at the joints, unwrapped, cut at its gaps; the one cut-off and the
-    seconds trimmed at each piece's ends (``trim_s``, else identification's rule,
+    """Every recording at the joints, unwrapped, cut at its gaps; the one cut-off (lowered
+    to a quarter of the rate where it is not below half of it, with a note:
+    :func:`~dynid.identification.pieces.nyquist_cutoff`) and the seconds trimmed at each
+    piece's ends (``trim_s``, else identification's rule,
     :func:`~dynid.identification.trim.edge_seconds`)."""
     if not logs:
         raise DataError("no recording given")
@@ -319,9 +322,12 @@ def _raw_pieces(
     from_motion = cut is not None
     if cut is None:
         cut = recorded_cutoff(model, jpieces, labels) if isinstance(cutoff_hz, str) else cutoff_hz
+    check_below_nyquist(jpieces, None if isinstance(cutoff_hz, str) else cut)  # as given
+    given = not isinstance(cutoff_hz, str)
+    if given or cut != DEFAULT_CUTOFF_HZ:  # the default: moved by the preparation, warned
+        cut = nyquist_cutoff(jpieces, cut, "--cutoff" if given else "the model's cut-off")
     if trim_s is None:
         trim_s = edge_seconds(jpieces, labels, cut, from_motion=from_motion, turns=jturns)
-    check_below_nyquist(jpieces, None if isinstance(cutoff_hz, str) else cut)  # as given
     return _Raw(raw, names, cut, trim_s, tuple(sorted(turned)), d, tuple(timing))
 
 

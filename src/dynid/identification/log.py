@@ -407,23 +407,31 @@ MILLISECONDS_HINT = "hint: --units t=ms"
 
 def with_derived_velocities(log: TorqueLog, cutoff_hz: float = DEFAULT_CUTOFF_HZ) -> TorqueLog:
     """The log with ``dq`` from the zero-phase filtered derivative of ``q``
-    (:func:`dynid.signals.filtered_derivative`, low-pass at ``cutoff_hz`` [Hz]); for logs that
-    record positions only (whatever ``log.dq`` holds is replaced). ``ddq`` is kept.
+    (:func:`dynid.signals.filtered_derivative`, low-pass at ``cutoff_hz`` [Hz], or at a
+    quarter of the rate where ``cutoff_hz`` is not below half of it:
+    :func:`dynid.signals.below_nyquist`; the 5 Hz default refused a 10 Hz servo log); for
+    logs that record positions only (whatever ``log.dq`` holds is replaced). ``ddq`` is
+    kept.
 
     Raises
     ------
     DataError
-        A log sampled at less than twice ``cutoff_hz``: its rate, and where its time steps
-        look like milliseconds (0.5 to 100 units), the hint ``--units t=ms``.
+        A log sampled at less than twice ``cutoff_hz`` whose time steps look like another
+        unit (0.5 to 100 units: milliseconds, the hint ``--units t=ms``; microseconds,
+        nanoseconds): its rate and the hint.
     """
+    fc = cutoff_hz
     if log.t.shape[0] > 1:
         dt = float(np.median(np.diff(log.t)))
-        if dt > 0 and cutoff_hz >= 0.5 / dt:
+        hint = _time_unit_hint(dt)
+        if dt > 0 and cutoff_hz >= 0.5 / dt and hint:
             raise DataError(
                 f"positions only, sampled at {1 / dt:.3g} Hz: velocities cannot be derived at "
-                f"{cutoff_hz:g} Hz (above half the rate){_time_unit_hint(dt)}"
+                f"{cutoff_hz:g} Hz (above half the rate){hint}"
             )
-    dq = signals.filtered_derivative(log.t, log.q, cutoff_hz)
+        if dt > 0:
+            fc = signals.below_nyquist(cutoff_hz, signals.sample_rate(log.t))
+    dq = signals.filtered_derivative(log.t, log.q, fc)
     return TorqueLog(log.t, log.q, dq, log.tau, log.ddq, log.cleaning, dq_derived=True)
 
 
@@ -444,13 +452,15 @@ def _time_unit_hint(dt: float) -> str:
 def velocity_note(cutoff_hz: float) -> str:
     """The note said when :func:`with_derived_velocities` derives a log's velocities at
     ``cutoff_hz`` [Hz] (the reader's): each step derives them again at its own cut-off, the
-    observer at :data:`OBSERVER_CUTOFF_HZ`."""
+    observer at :data:`OBSERVER_CUTOFF_HZ`; a cut-off not below half the log's rate at a
+    quarter of the rate (:func:`dynid.signals.below_nyquist`)."""
     return (
         "no velocity columns: velocities derived from the positions (zero-phase low-pass, "
         "then central differences) at the cut-off of the step that prepares the log "
         "(identification, validation and friction at theirs, "
         f"{cutoff_hz:g} Hz when the log is read alone; the observer at "
-        f"{OBSERVER_CUTOFF_HZ:g} Hz)"
+        f"{OBSERVER_CUTOFF_HZ:g} Hz; a cut-off not below half the log's rate at a quarter "
+        "of the rate)"
     )
 
 

@@ -23,6 +23,7 @@ friction fit (:mod:`dynid.friction.recordings`) and the payload.
 from __future__ import annotations
 
 import itertools
+import logging
 import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -34,6 +35,8 @@ from .._times import longest_gaps, offset_text, said_times, stamp_text
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..progress import NOTE
+from ..signals import below_nyquist
 from .angle_time_units import time_unit_finding
 from .log import (
     DEFAULT_CUTOFF_HZ,
@@ -44,6 +47,8 @@ from .log import (
     with_derived_velocities,
 )
 from .sanity import too_few_samples
+
+_log = logging.getLogger(__name__)
 
 __all__ = [
     "wrapped_finding",
@@ -58,6 +63,7 @@ __all__ = [
     "timing_record",
     "joined",
     "nearest_turns",
+    "nyquist_cutoff",
     "recording_pieces",
     "skipped_piece",
     "split_at_gaps",
@@ -75,8 +81,10 @@ WRAP_SPAN = 1.05
 
 
 def check_below_nyquist(pieces: list[TorqueLog], cutoff_hz: float | None) -> None:
-    """Refuse a cut-off [Hz] at or above half the sample rate of every piece: no piece can
-    be filtered at it, whatever its length (the cut-off is at fault, not the recording).
+    """Refuse a cut-off [Hz] given at or above the sample rate of every piece: no cut-off
+    for these samples at all (a value for another log, or in another unit), the option at
+    fault, not the recording. One between half the rate and the rate is lowered
+    (:func:`nyquist_cutoff`).
 
     Raises
     ------
@@ -84,7 +92,7 @@ def check_below_nyquist(pieces: list[TorqueLog], cutoff_hz: float | None) -> Non
         ``cutoff_hz`` (``field``), with the sample rate.
     """
     rates = [p.sample_rate for p in pieces if p.n_samples >= 2]
-    if cutoff_hz is None or not rates or any(cutoff_hz < 0.5 * fs for fs in rates):
+    if cutoff_hz is None or not rates or any(cutoff_hz < fs for fs in rates):
         return
     fs = max(rates)
     raise OptionError(
@@ -92,6 +100,29 @@ def check_below_nyquist(pieces: list[TorqueLog], cutoff_hz: float | None) -> Non
         f"recording is sampled at {fs:.4g} Hz)",
         field="cutoff_hz",
     )
+
+
+def nyquist_cutoff(
+    pieces: Sequence[TorqueLog], cutoff_hz: float | None, whose: str = "--cutoff"
+) -> float | None:
+    """The cut-off [Hz] the pieces are filtered at: ``cutoff_hz`` where it lies below half
+    the rate of the slowest piece, else a quarter of that rate
+    (:func:`~dynid.signals.below_nyquist`), with a note naming ``whose`` value it was
+    (``--cutoff``, the model's): a model identified on a 1 kHz log at 20 Hz, or
+    ``--cutoff 20``, on a 30 Hz servo log was refused, its velocities underived."""
+    rates = [p.sample_rate for p in pieces if p.n_samples >= 2]
+    if cutoff_hz is None or not rates:
+        return cutoff_hz
+    fs = min(rates)
+    fc = below_nyquist(cutoff_hz, fs)
+    if fc != cutoff_hz:
+        _log.log(
+            NOTE,
+            f"{whose} {cutoff_hz:g} Hz is not below half the sample rate, {0.5 * fs:.4g} Hz "
+            f"(the recording is sampled at {fs:.4g} Hz): filtered at a quarter of the rate, "
+            f"{fc:.4g} Hz",
+        )
+    return fc
 
 
 def split_at_gaps(

@@ -63,6 +63,7 @@ from .pieces import (
     check_samples_and_time,
     gaps_between,
     joined,
+    nyquist_cutoff,
     recording_pieces,
     skipped_piece,
     split_at_gaps,
@@ -637,7 +638,8 @@ def _cutoff_and_edge(
     trim_s: float | None,
 ) -> tuple[float | None, float | None]:
     """The cut-off [Hz] of every piece (read from the motion with ``"auto"``, else as
-    given and below the Nyquist frequency) and the seconds trimmed at the pieces' ends
+    given, lowered to a quarter of the rate where it is not below half of it:
+    :func:`~.pieces.nyquist_cutoff`) and the seconds trimmed at the pieces' ends
     (``trim_s``, else the filter's edge transient)."""
     cutoff: float | None = None if cutoff_hz == "auto" else cutoff_hz
     # joint-side pieces of a motor-side log differ by turns of the motors, not joints
@@ -655,6 +657,7 @@ def _cutoff_and_edge(
             )
     else:
         check_below_nyquist(logs, cutoff)
+        cutoff = nyquist_cutoff(logs, cutoff, "the cut-off")
     if trim_s is not None:
         return cutoff, trim_s
     edge = edge_seconds(

@@ -58,7 +58,7 @@ from .. import _checks
 from ..exceptions import DataError, OptionError, ShapeError
 from .events import ContactEvent, EventDetector, detect
 from .friction import (
-    DERIVED_CUTOFF_HZ,
+    derived_cutoff,
     derived_velocity_bands,
     standstill_margin,
     velocity_bands,
@@ -197,7 +197,7 @@ def standstill_series(
     options: ObserverOptions = DEFAULT_OPTIONS,
     *,
     q: ArrayLike | None = None,
-    cutoff_hz: float = DERIVED_CUTOFF_HZ,
+    cutoff_hz: float | None = None,
 ) -> NDArray[np.float64]:
     """The standstill margin (N, n) [N m] of the model's friction at the velocities ``dq``
     (N, n) [rad/s], through the observer's lag ``K_O/(s + K_O)`` over the times ``t`` (N,)
@@ -205,7 +205,8 @@ def standstill_series(
     (inside its standstill band, within the velocity noise band of its smooth Coulomb
     steps: :func:`~dynid.observer.friction.standstill_margin`) leaves; zeros for a friction
     without either. The noise band is estimated on ``dq`` (one piece of a log), or, for
-    velocities derived from the positions ``q`` (N, n) [rad] at ``cutoff_hz`` [Hz], it is
+    velocities derived from the positions ``q`` (N, n) [rad] at ``cutoff_hz`` [Hz] (default
+    the observer's, :func:`~dynid.observer.friction.derived_cutoff` of ``t``), it is
     their noise through the derivative filter
     (:func:`~dynid.observer.friction.derived_velocity_bands`).
 
@@ -221,7 +222,8 @@ def standstill_series(
     kw: dict[str, Any] = {}
     if q is not None and model.friction is not None:
         qa = _checks.as_exact("q", q, dqa.shape)
-        kw = {"bands": derived_velocity_bands(model.friction, ta, qa, cutoff_hz), "derived": True}
+        fc = derived_cutoff(ta) if cutoff_hz is None else cutoff_hz
+        kw = {"bands": derived_velocity_bands(model.friction, ta, qa, fc), "derived": True}
     for a, m in standstill_blocks(model, ta, dqa, options, **kw):
         out[a : a + m.shape[0]] = m
     return out

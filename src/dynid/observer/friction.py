@@ -76,6 +76,7 @@ from numpy.typing import NDArray
 from ..friction.laws.base import CANONICAL_COLUMNS
 from ..friction.model import FrictionModel, FrictionSum, friction_parts
 from ..identification.log import OBSERVER_CUTOFF_HZ
+from ..signals import below_nyquist, sample_rate
 
 __all__ = [
     "DERIVED_CUTOFF_HZ",
@@ -84,6 +85,7 @@ __all__ = [
     "banded_if_narrow",
     "banding_note",
     "canonical_friction",
+    "derived_cutoff",
     "derived_velocity_bands",
     "noise_bands",
     "standstill_margin",
@@ -103,6 +105,17 @@ FRICTION_COLUMNS = CANONICAL_COLUMNS
 #: 20 Hz, where the position noise through the derivative (bounded by
 #: :func:`derived_velocity_bands`) raises the calibrated thresholds by 20-30 %.
 DERIVED_CUTOFF_HZ = OBSERVER_CUTOFF_HZ
+
+
+def derived_cutoff(t: NDArray[np.float64]) -> float:
+    """The cut-off [Hz] the observer derives the velocities of a log of positions at, its
+    samples at the times ``t`` (N,) [s]: :data:`DERIVED_CUTOFF_HZ`, or a quarter of the
+    rate where that is not below half of it (:func:`~dynid.signals.below_nyquist`; the
+    observer's 20 Hz crashed every log sampled at 40 Hz or less: a 30 Hz servo log is
+    observed at 7.5 Hz)."""
+    if t.shape[0] < 2:
+        return DERIVED_CUTOFF_HZ
+    return below_nyquist(DERIVED_CUTOFF_HZ, sample_rate(t))
 
 
 def canonical_friction(

@@ -39,7 +39,6 @@ from ..observer.carried_load import (
     load_events,
 )
 from ..observer.events import ContactEvent, EventDetector, time_slack
-from ..observer.friction import DERIVED_CUTOFF_HZ
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
 from ..observer.results import FigureSeries, LogObservation
@@ -375,14 +374,14 @@ def _said_again(said: list[warnings.WarningMessage]) -> None:
 def _load_motion(prep: PreparedLog) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """The log's times [s], positions [rad], the observer's velocities [rad/s] and their
     accelerations [rad/s^2] for a carried load's inertia: each piece's velocities
-    low-passed at the observer's cut-off (:data:`~dynid.observer.friction.DERIVED_CUTOFF_HZ`,
-    as a log without velocities has them derived) and differentiated, on its own (NaN
+    low-passed at the observer's cut-off (:attr:`PreparedLog.cutoff_hz`, as a log without
+    velocities has them derived) and differentiated, on its own (NaN
     where a piece is too short to filter: none of its samples is fitted)."""
     log = prep.log
     ddq = np.full_like(prep.dq, np.nan)
     for a, b in prep.spans:
         try:
-            ddq[a:b] = filtered_derivative(log.t[a:b], prep.dq[a:b], DERIVED_CUTOFF_HZ)
+            ddq[a:b] = filtered_derivative(log.t[a:b], prep.dq[a:b], prep.cutoff_hz)
         except DataError:
             pass
     return log.t, log.q, prep.dq, np.nan_to_num(ddq)

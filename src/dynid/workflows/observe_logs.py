@@ -13,6 +13,7 @@ is observed with one block's temporaries (a calibration keeps only running stati
 
 from __future__ import annotations
 
+import logging
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -44,6 +45,7 @@ from ..observer.detection import (
 from ..observer.friction import (
     DERIVED_CUTOFF_HZ,
     banded_if_narrow,
+    derived_cutoff,
     derived_velocity_bands,
     velocity_bands,
 )
@@ -51,8 +53,10 @@ from ..observer.model import ObserverModel
 from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import MomentumObserver, ObserverOptions
 from ..observer.thresholds import RestMargin
-from ..progress import report
+from ..progress import NOTE, report
 from ..signals import edge_seconds, filtered_derivative
+
+_log = logging.getLogger(__name__)
 
 __all__ = [
     "OBSERVE_BLOCK",
@@ -69,12 +73,14 @@ __all__ = [
 @dataclass(frozen=True, slots=True)
 class PreparedLog:
     """A log brought to the joints, with the velocities and the spans the observer runs
-    on (:func:`_prepared`)."""
+    on (:func:`prepared_log`), and the cut-off [Hz] velocities derived from its positions
+    are low-passed at (:func:`~dynid.observer.friction.derived_cutoff`)."""
 
     path: Path
     log: TorqueLog
     dq: NDArray[np.float64]
     spans: list[tuple[int, int]]
+    cutoff_hz: float = DERIVED_CUTOFF_HZ
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,14 +150,40 @@ def prepared_log(
         said = wrapped_finding(sorted(turned), robot=model.robot, log=side)
         warnings.warn(f"{path.name}: {said}", DynidWarning, stacklevel=4)
     starts = _pieces(path, log, max_gap)
-    dq = _piece_velocities(log, starts)  # of a log of positions: from the unwrapped ones
+    fc = _derived_cutoff(path, log)
+    dq = _piece_velocities(log, starts, fc)  # of a log of positions: from the unwrapped ones
     cut = _cut_at_jumps(path, log, dq, starts)  # jumps of the log as recorded
     if torque_delay_s:  # the torques paired with their states (its extrapolated ends
         log = states_in_step(log, torque_delay_s)  # are left unobserved)
-        dq = _piece_velocities(log, cut)
+        dq = _piece_velocities(log, cut, fc)
     elif cut != starts and log.dq_derived:  # derived again, never across a jump
-        dq = _piece_velocities(log, cut)
-    return PreparedLog(path, log, dq, _observed_spans(path, log, cut, abs(torque_delay_s)))
+        dq = _piece_velocities(log, cut, fc)
+    spans = _observed_spans(path, log, cut, abs(torque_delay_s), fc)
+    return PreparedLog(path, log, dq, _finite(spans, dq), fc)
+
+
+def _derived_cutoff(path: Path, log: TorqueLog) -> float:
+    """The cut-off [Hz] the velocities of a log of positions are derived at
+    (:func:`~dynid.observer.friction.derived_cutoff`), with a note where the log's rate
+    lowers it; :data:`~dynid.observer.friction.DERIVED_CUTOFF_HZ` for a log with
+    velocities (unused)."""
+    if not log.dq_derived:
+        return DERIVED_CUTOFF_HZ
+    fc = derived_cutoff(log.t)
+    if fc < DERIVED_CUTOFF_HZ:
+        _log.log(
+            NOTE,
+            f"{path.name}: velocities derived from the positions at {fc:.4g} Hz, a quarter "
+            f"of the rate ({4 * fc:.4g} Hz): the observer's {DERIVED_CUTOFF_HZ:g} Hz is not "
+            "below half of it",
+        )
+    return fc
+
+
+def _finite(spans: list[tuple[int, int]], dq: NDArray[np.float64]) -> list[tuple[int, int]]:
+    """The spans whose velocities are finite throughout (a piece too short to filter has
+    NaN derived velocities: it is not observed, never an error about a velocity column)."""
+    return [(a, b) for a, b in spans if np.isfinite(dq[a:b]).all()]
 
 
 def recording_note(prep: PreparedLog) -> str | None:
@@ -277,7 +309,7 @@ def _bands(prep: PreparedLog, model: ObserverModel, a: int, b: int) -> dict[str,
         return {}
     t, q = prep.log.t[a:b], prep.log.q[a:b]
     return {
-        "bands": derived_velocity_bands(model.friction, t, q, DERIVED_CUTOFF_HZ),
+        "bands": derived_velocity_bands(model.friction, t, q, prep.cutoff_hz),
         "derived": True,
     }
 
@@ -304,22 +336,27 @@ def _rechunked(
 OBSERVE_BLOCK = 1 << 16
 
 
-def _piece_velocities(log: TorqueLog, starts: list[int]) -> NDArray[np.float64]:
+def _piece_velocities(log: TorqueLog, starts: list[int], cutoff_hz: float) -> NDArray[np.float64]:
     """The velocities the observer runs on: the log's, or, for a log of positions only,
-    derived from the positions of each piece on its own (never across a gap)."""
+    derived from the positions of each piece on its own (never across a gap) at
+    ``cutoff_hz`` [Hz]."""
     if not log.dq_derived:
         return np.asarray(log.dq)
     dq = np.array(log.dq)
     for a, b in zip(starts, [*starts[1:], log.t.shape[0]], strict=True):
         try:
-            dq[a:b] = filtered_derivative(log.t[a:b], log.q[a:b], DERIVED_CUTOFF_HZ)
+            dq[a:b] = filtered_derivative(log.t[a:b], log.q[a:b], cutoff_hz)
         except DataError:  # too short to filter: its span is not observed
             dq[a:b] = np.nan
     return dq
 
 
 def _observed_spans(
-    path: Path, log: TorqueLog, starts: list[int], trim_s: float = 0.0
+    path: Path,
+    log: TorqueLog,
+    starts: list[int],
+    trim_s: float = 0.0,
+    cutoff_hz: float = DERIVED_CUTOFF_HZ,
 ) -> list[tuple[int, int]]:
     """The samples ``[a, b)`` the observer runs on: every piece without its first and
     last ``trim_s`` seconds (the torques' delay: states read that much earlier there are
@@ -329,7 +366,7 @@ def _observed_spans(
     ends = [*starts[1:], log.t.shape[0]]
     if not log.dq_derived and trim_s == 0.0:
         return list(zip(starts, ends, strict=True))
-    edge = trim_s + (edge_seconds(DERIVED_CUTOFF_HZ) if log.dq_derived else 0.0)
+    edge = trim_s + (edge_seconds(cutoff_hz) if log.dq_derived else 0.0)
     spans = []
     for a, b in zip(starts, ends, strict=True):
         t = log.t[a:b]

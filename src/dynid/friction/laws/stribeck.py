@@ -85,10 +85,15 @@ def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float, sign: Sig
         return x, float(np.sum((A @ x - rr) ** 2))
 
     top = min(_UPPER[3], max(float(np.max(np.abs(dq))), 2 * _LOWER[3]))
-    grid = np.linspace(np.log(max(_LOWER[3], band)), np.log(top), 24)
+    # a band wider than the largest vst (a motor behind a gear of 345, its velocities
+    # derived from 30 Hz positions: 12.7 rad/s) leaves the one vst at the top
+    grid = np.linspace(np.log(min(max(_LOWER[3], band), top)), np.log(top), 24)
     costs = [solve(g, sub)[1] for g in grid]
     k = int(np.argmin(costs))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    if not b > a:
+        x, _ = solve(float(grid[k]), full)
+        return JointFit(np.array([x[0], x[1], x[2], np.exp(grid[k]), x[3]]), True, grid.size)
     import scipy.optimize  # here: a robot holding the law loads no solver
 
     res = scipy.optimize.minimize_scalar(
