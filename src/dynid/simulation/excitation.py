@@ -99,6 +99,11 @@ _log = logging.getLogger(__name__)
 #: The statuses a design ends with (:attr:`ExcitationResult.status`).
 STATUSES = ("ok", "reduced", "infeasible")
 #: Rate [Hz] of the samples the result and its start are compared on (and reported).
+#: The optimiser's absolute finite-difference step in its variables (scipy's ``eps``).
+_FD_STEP = 1e-4
+#: Samples of the limits' grid evaluated together in one batch (about 25 MB of states and
+#: torques; the Panda's 20 s design: 31 evaluations a batch).
+_BATCH_SAMPLES = 2**16
 _FS_REPORTED = 200.0
 #: Fractions of their amplitudes the random starts are also tried at when none at full
 #: amplitude keeps the torques and clearances (:func:`_start`).
@@ -427,21 +432,21 @@ class ExcitationResult:
         return tuple(a for a in m.get("closest", ()) if a.margin < -1e-9)
 
 
-def _first_max(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``a.max(axis=0)`` of a batch-first array (N, ...) reduced along a contiguous copy:
-    several times faster for N samples of a few columns, the same values."""
+def _max_over_samples(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The largest of ``a`` (..., N, k) over its N samples: (..., k), reduced along a
+    contiguous copy with the samples last (several times faster than ``max(axis=-2)`` for
+    N samples of a few columns; the same values)."""
     return _samples_last(a).max(axis=-1)
 
 
-def _first_min(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``a.min(axis=0)``, as :func:`_first_max`."""
+def _min_over_samples(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The smallest of ``a`` (..., N, k) over its N samples, as :func:`_max_over_samples`."""
     return _samples_last(a).min(axis=-1)
 
 
 def _samples_last(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    """A contiguous copy of ``a`` (N, ...) with the samples' axis last (a transpose of the
-    usual (N, k) without ``moveaxis``'s checks, called thousands of times)."""
-    return np.ascontiguousarray(a.T if a.ndim == 2 else np.moveaxis(a, 0, -1))
+    """A contiguous copy of ``a`` (..., N, k) as (..., k, N)."""
+    return np.ascontiguousarray(np.swapaxes(a, -1, -2))
 
 
 def _classical_regressor(
@@ -458,20 +463,28 @@ def _regressor_of(
     dq: NDArray[np.float64],
     ddq: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """:func:`_classical_regressor` of validated (N, n) samples [rad, rad/s, rad/s^2]: the
-    base columns written by the regressor straight into the first ``r`` of a contiguous
-    (N, n, r + 3 n) array (no gather into a strided slice), the friction columns after."""
+    """:func:`_classical_regressor` of validated (..., N, n) samples [rad, rad/s, rad/s^2]:
+    (..., N n, r + 3 n), one stacked regressor per leading index. The base columns are
+    written by the regressor straight into the first ``r`` of a contiguous array (no
+    gather into a strided slice), the friction columns after."""
     r, n = len(base.independent), q.shape[-1]
+    flat = [np.reshape(x, (-1, n)) for x in (q, dq, ddq)]
     W = torque_regressor_prepared(
-        robot, q, dq, ddq, robot.gravity, columns=base.independent, width=r + 3 * n
+        robot, *flat, robot.gravity, columns=base.independent, width=r + 3 * n
     )
-    W[..., r:] = friction_regressor(dq)
-    return W.reshape(-1, W.shape[-1])
+    W[..., r:] = friction_regressor(flat[1])
+    return W.reshape(q.shape[:-2] + (-1, W.shape[-1]))
 
 
 def _criterion(W: NDArray[np.float64], criterion: str) -> float:
-    """The optimised criterion of ``[Y_b, F]`` (lower is better): ``log cond`` (unscaled) or
-    ``-mean log s`` of the column-scaled singular values (``logdet``).
+    """The optimised criterion of one ``[Y_b, F]`` (N n, r + 3 n) (:func:`_criteria`)."""
+    return float(_criteria(W[None], criterion)[0])
+
+
+def _criteria(W: NDArray[np.float64], criterion: str) -> NDArray[np.float64]:
+    """The optimised criterion of each ``[Y_b, F]`` of a stack (B, N n, r + 3 n) (lower is
+    better): ``log cond`` (unscaled) or ``-mean log s`` of the column-scaled singular
+    values (``logdet``): (B,).
 
     ``log cond`` is ``log(lambda_max / lambda_min) / 2`` of the Gram matrix ``W^T W`` (its
     eigenvalues are the squared singular values): a ninth of the SVD's time on the
@@ -479,11 +492,13 @@ def _criterion(W: NDArray[np.float64], criterion: str) -> float:
     squared 1e8) its relative error stays near 1e-8, far below the finite-difference step.
     The reported numbers (:func:`_conds`) come from the SVD."""
     if criterion == "cond":
-        lam = np.linalg.eigvalsh(W.T @ W)
-        return float(0.5 * np.log(lam[-1] / max(lam[0], 1e-300)))
-    nrm = np.linalg.norm(W, axis=0)
-    s = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0), compute_uv=False)
-    return -float(np.mean(np.log(np.maximum(s, 1e-300))))
+        # each Gram matrix on its own: numpy's product of a matrix with its own transpose
+        # (one triangle, half the work of a batched product)
+        lam = np.linalg.eigvalsh(np.stack([w.T @ w for w in W]))
+        return 0.5 * np.log(lam[:, -1] / np.maximum(lam[:, 0], 1e-300))
+    nrm = np.linalg.norm(W, axis=-2)
+    s = np.linalg.svd(W / np.where(nrm > 0, nrm, 1.0)[:, None, :], compute_uv=False)
+    return -np.mean(np.log(np.maximum(s, 1e-300)), axis=-1)
 
 
 def _conds(W: NDArray[np.float64]) -> tuple[float, float]:
@@ -633,32 +648,43 @@ class _Problem:
         self.iteration, self.cond = 0, float("nan")
         #: The drive whose known rotor inertias the torques include (None: none).
         self.drive: Drive | None = None
+        #: Evaluations computed together (:meth:`objectives`): about
+        #: :data:`_BATCH_SAMPLES` samples of the limits' grid.
+        self.chunk = max(1, _BATCH_SAMPLES // len(self.t_lim))
 
     def coefficients(self, x: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
-        """Coefficients (n, 2L) within the limits and start position (n,) of ``x``: each
-        joint's raw coefficients (n 2L) scaled down to fit the limits when they exceed
-        them, and its rest position's offset from ``q_start`` (n) [rad], clipped to where
-        the motion fits."""
+        """Coefficients (n, 2L) within the limits and start position (n,) of ``x``
+        (:meth:`coefficients_of` of one)."""
+        c, q0 = self.coefficients_of(np.asarray(x)[None])
+        return c[0], q0[0]
+
+    def coefficients_of(self, X: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+        """Coefficients (B, n, 2L) within the limits and start positions (B, n) of the
+        variables ``X`` (B, n 2L + n): each joint's raw coefficients (n 2L) scaled down to
+        fit the limits when they exceed them, and its rest position's offset from
+        ``q_start`` (n) [rad], clipped to where the motion fits."""
         n, k = self.n, self.n * 2 * self.L
-        c, lo, hi = self._fitted(x[:k].reshape(n, 2 * self.L) @ self.Pi.T)
-        return c, np.clip(self.q_start + x[k:], lo, hi)
+        c, lo, hi = self._fitted(X[:, :k].reshape(-1, n, 2 * self.L) @ self.Pi.T)
+        return c, np.clip(self.q_start + X[:, k:], lo, hi)
 
     def _fitted(self, c: NDArray[np.float64], fraction: float = 1.0) -> tuple[NDArray, ...]:
-        """Coefficients ``c`` (n, 2L) scaled to ``fraction`` of the largest motion within
-        the position, velocity and acceleration limits (never up), and the lowest and
-        highest rest positions (n each) [rad] that keep that motion within the position
-        limits and their margins."""
-        Pq, Pd, Pa = self.B_lim
-        q, dq, ddq = Pq @ c.T, Pd @ c.T, Pa @ c.T
-        q_lo, q_hi = _first_min(q), _first_max(q)
+        """Coefficients ``c`` (..., n, 2L) scaled to ``fraction`` of the largest motion
+        within the position, velocity and acceleration limits (never up), and the lowest
+        and highest rest positions (..., n each) [rad] that keep that motion within the
+        position limits and their margins."""
+        flat = c.reshape(-1, c.shape[-1])
+        q, dq, ddq = (
+            (flat @ P.T).reshape(c.shape[:-1] + (len(P),)) for P in self.B_lim
+        )  # (..., n, N): the samples last, reduced along contiguous rows
+        q_lo, q_hi = q.min(axis=-1), q.max(axis=-1)
         span = q_hi - q_lo
         with np.errstate(divide="ignore", invalid="ignore"):
             s = np.minimum.reduce(
                 [
-                    np.ones(self.n),
+                    np.ones(span.shape),
                     (self.hi - self.lo) / span,
-                    self.vmax / _first_max(np.abs(dq)),
-                    self.amax / _first_max(np.abs(ddq)),
+                    self.vmax / np.abs(dq).max(axis=-1),
+                    self.amax / np.abs(ddq).max(axis=-1),
                 ]
             )
         # 1e-3 to spare: the peaks between the 100 Hz samples are higher by < 5e-4
@@ -667,7 +693,7 @@ class _Problem:
             s = s * fraction
         tol = 2.5e-4 * (self.hi - self.lo)  # inside the 1e-3 spared by the scaling
         qmin, qmax = q_lo * s, q_hi * s
-        return c * s[:, None], self.lo - qmin + tol, self.hi - qmax - tol
+        return c * s[..., None], self.lo - qmin + tol, self.hi - qmax - tol
 
     def initial(
         self, raw: NDArray[np.float64], offset: NDArray[np.float64], fraction: float = 1.0
@@ -693,14 +719,17 @@ class _Problem:
         )
 
     def _samples(self, B: tuple, c: NDArray, q0: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-        """Positions, velocities and accelerations (N, n each) [rad, rad/s, rad/s^2] on the
-        grid of basis ``B``: finite by construction, so no :class:`Trajectory` checks them
+        """Positions, velocities and accelerations (..., N, n each) [rad, rad/s, rad/s^2]
+        of coefficients ``c`` (..., n, 2L) and rest positions ``q0`` (..., n) on the grid
+        of basis ``B``: finite by construction, so no :class:`Trajectory` checks them
         (thousands of evaluations)."""
         Pq, Pd, Pa = B
-        return q0 + Pq @ c.T, Pd @ c.T, Pa @ c.T
+        cT = np.swapaxes(c, -1, -2)
+        return q0[..., None, :] + Pq @ cT, Pd @ cT, Pa @ cT
 
     def regressor(self, c: NDArray, q0: NDArray) -> NDArray[np.float64]:
-        """``[Y_b, F]`` on the regressor's grid (:func:`_classical_regressor`)."""
+        """``[Y_b, F]`` on the regressor's grid (:func:`_classical_regressor`): (..., N n,
+        r + 3 n) of coefficients (..., n, 2L) and rest positions (..., n)."""
         return _regressor_of(self.robot, self.base, *self._samples(self.B_reg, c, q0))
 
     def criterion(self, c: NDArray, q0: NDArray) -> float:
@@ -708,7 +737,35 @@ class _Problem:
         return _criterion(self.regressor(c, q0), self.opts.criterion)
 
     def objective(self, x: NDArray[np.float64]) -> float:
-        self.evaluations += 1
+        """The criterion plus the penalties of the variables ``x`` (one evaluation)."""
+        return float(self.objectives(np.asarray(x)[None])[0])
+
+    def objectives(self, X: NDArray[np.float64]) -> NDArray[np.float64]:
+        """:meth:`objective` of each row of ``X`` (B, n 2L + n): (B,), computed
+        :attr:`chunk` rows at a time through the batch-first kinematics, regressors and
+        dynamics (each row one evaluation, told as the optimiser's progress)."""
+        out = np.empty(len(X))
+        for i in range(0, len(X), self.chunk):
+            c, q0 = self.coefficients_of(X[i : i + self.chunk])
+            out[i : i + len(c)] = _criteria(
+                self.regressor(c, q0), self.opts.criterion
+            ) + self.penalties(c, q0)
+            self._told(len(c))
+        return out
+
+    def value_and_gradient(self, x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        """The objective at ``x`` and its forward-difference gradient: the steps
+        ``(x + h e_i) - x`` of :data:`_FD_STEP` scipy's L-BFGS-B takes with ``eps`` (its
+        ``2-point`` differences), all ``x + h e_i`` evaluated in one batch (:meth:`objectives`)."""
+        h = _fd_steps(x)
+        X = np.repeat(x[None], len(x) + 1, axis=0)
+        X[1:][np.diag_indices(len(x))] += h
+        f = self.objectives(X)
+        return float(f[0]), (f[1:] - f[0]) / ((x + h) - x)
+
+    def _told(self, k: int) -> None:
+        """``k`` evaluations done: counted, told to ``evaluated`` and :mod:`dynid.progress`."""
+        self.evaluations += k
         if self.evaluated is not None:
             self.evaluated(self.evaluations, self.budget)
         cond = f" (condition number {self.cond:.4g})" if self.iteration else ""
@@ -716,28 +773,43 @@ class _Problem:
             f"iteration {self.iteration} of {self.opts.max_iter}{cond}, "
             f"{self.evaluations:,} of {self.budget:,} evaluations"
         )
-        c, q0 = self.coefficients(x)
-        return self.criterion(c, q0) + self.penalty(c, q0)
 
     def penalty(self, c: NDArray, q0: NDArray) -> float:
-        pen = 0.0
+        """The penalty of coefficients (n, 2L) and a rest position (n,) (:meth:`penalties`)."""
+        return float(self.penalties(c[None], q0[None])[0])
+
+    def penalties(self, c: NDArray, q0: NDArray) -> NDArray[np.float64]:
+        """The quadratic penalties of torques and clearances beyond their limits, of
+        coefficients (B, n, 2L) and rest positions (B, n): (B,)."""
+        pen = np.zeros(len(c))
         if np.any(np.isfinite(self.tmax)):
-            samples = self._samples(self.B_lim, c, q0)
-            tau = _first_max(np.abs(_torques_of(self.robot, *samples, self.drive)))
+            q, dq, ddq = (x.reshape(-1, self.n) for x in self._samples(self.B_lim, c, q0))
+            tau = np.abs(_torques_of(self.robot, q, dq, ddq, self.drive))
+            tau = _max_over_samples(tau.reshape(len(c), -1, self.n))
             with np.errstate(invalid="ignore"):
                 v = np.where(np.isfinite(self.tmax), (tau - self.tmax) / self.tmax, 0.0)
-            pen += float(np.sum(np.maximum(v, 0.0) ** 2))
-        qc = q0 + self.B_col @ c.T
+            pen += np.sum(np.maximum(v, 0.0) ** 2, axis=-1)
+        qc = q0[:, None, :] + self.B_col @ np.swapaxes(c, -1, -2)
         seg = capsule_segments(self.robot, qc)
         c_self, c_obstacle = _clearances(self.opts)
         if self.caps.pairs.size:
-            d = _first_min(self_distances(self.robot, qc, self.caps, segments=seg))
-            pen += float(np.sum(np.maximum(c_self + 0.01 - d, 0.0) ** 2)) / 0.05**2
+            d = _min_over_samples(self_distances(self.robot, qc, self.caps, segments=seg))
+            pen += np.sum(np.maximum(c_self + 0.01 - d, 0.0) ** 2, axis=-1) / 0.05**2
         if len(self.obstacles):
             d = obstacle_distances(self.robot, qc, self.obstacles, self.caps, segments=seg)
-            d = _first_min(d)
-            pen += float(np.sum(np.maximum(c_obstacle + 0.01 - d, 0.0) ** 2)) / 0.05**2
+            d = _min_over_samples(d)
+            pen += np.sum(np.maximum(c_obstacle + 0.01 - d, 0.0) ** 2, axis=-1) / 0.05**2
         return 100.0 * pen
+
+
+def _fd_steps(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The forward-difference steps of ``x`` scipy takes with an absolute step
+    :data:`_FD_STEP` (``approx_derivative``'s ``2-point``): :data:`_FD_STEP`, or where it
+    is lost to rounding, the square root of the float64 epsilon times ``max(1, |x|)``
+    with ``x``'s sign."""
+    sign = np.where(x >= 0, 1.0, -1.0)
+    fallback = np.sqrt(np.finfo(np.float64).eps) * sign * np.maximum(1.0, np.abs(x))
+    return np.where((x + _FD_STEP) - x == 0, fallback, _FD_STEP)
 
 
 def _check(
@@ -893,12 +965,15 @@ def optimise_excitation(
         best.offer(xk)
         _tell_iteration(prob, len(history), cond, progress)
 
+    # the gradient's len(x) + 1 evaluations counted as one by scipy: the same stop as
+    # its own finite differences under max_evaluations
     res = _minimize(
-        prob.objective,
+        prob.value_and_gradient,
         x0,
+        jac=True,
         method="L-BFGS-B",
         callback=callback,
-        options={"maxiter": options.max_iter, "maxfun": options.max_evaluations, "eps": 1e-4},
+        options={"maxiter": options.max_iter, "maxfun": options.max_evaluations // (len(x0) + 1)},
     )
     best.offer(res.x)
     # the best penalty-free iterate; without one, the optimiser's (the least violation)
