@@ -76,6 +76,7 @@ from .collision import (
     obstacle_distances,
     self_distances,
 )
+from .excitation_gradient import objective_gradient
 from .exciting_trajectory import ExcitingTrajectory, _basis
 from .trajectories import Trajectory, uniform_times
 
@@ -667,11 +668,31 @@ class _Problem:
         c, lo, hi = self._fitted(X[:, :k].reshape(-1, n, 2 * self.L) @ self.Pi.T)
         return c, np.clip(self.q_start + X[:, k:], lo, hi)
 
-    def _fitted(self, c: NDArray[np.float64], fraction: float = 1.0) -> tuple[NDArray, ...]:
+    def joint_coefficients(
+        self, X: NDArray[np.float64], joint: NDArray[np.intp]
+    ) -> tuple[NDArray, NDArray]:
+        """Of each row of ``X`` (B, n 2L + n), only joint ``joint[b]``'s coefficients
+        (B, 2L) and rest position (B,) [rad] (:meth:`coefficients_of`'s row ``joint[b]``)."""
+        n, L2 = self.n, 2 * self.L
+        raw = X[:, : n * L2].reshape(-1, n, L2)[np.arange(len(X)), joint]
+        c, lo, hi = self._fitted(raw @ self.Pi.T, joint=joint)
+        return c, np.clip(self.q_start[joint] + X[np.arange(len(X)), n * L2 + joint], lo, hi)
+
+    def steps(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The forward-difference steps of the variables ``x`` (:func:`_fd_steps`)."""
+        return _fd_steps(x)
+
+    def _fitted(
+        self,
+        c: NDArray[np.float64],
+        fraction: float = 1.0,
+        joint: NDArray[np.intp] | slice = slice(None),
+    ) -> tuple[NDArray, ...]:
         """Coefficients ``c`` (..., n, 2L) scaled to ``fraction`` of the largest motion
         within the position, velocity and acceleration limits (never up), and the lowest
         and highest rest positions (..., n each) [rad] that keep that motion within the
-        position limits and their margins."""
+        position limits and their margins; with ``joint`` (B,), ``c`` (B, 2L) is one row
+        each of those joints."""
         flat = c.reshape(-1, c.shape[-1])
         q, dq, ddq = (
             (flat @ P.T).reshape(c.shape[:-1] + (len(P),)) for P in self.B_lim
@@ -682,18 +703,19 @@ class _Problem:
             s = np.minimum.reduce(
                 [
                     np.ones(span.shape),
-                    (self.hi - self.lo) / span,
-                    self.vmax / np.abs(dq).max(axis=-1),
-                    self.amax / np.abs(ddq).max(axis=-1),
+                    (self.hi - self.lo)[joint] / span,
+                    self.vmax[joint] / np.abs(dq).max(axis=-1),
+                    self.amax[joint] / np.abs(ddq).max(axis=-1),
                 ]
             )
         # 1e-3 to spare: the peaks between the 100 Hz samples are higher by < 5e-4
         s = np.where(np.isfinite(s), s, 1.0) * (1 - 1e-3)
         if fraction != 1:
             s = s * fraction
-        tol = 2.5e-4 * (self.hi - self.lo)  # inside the 1e-3 spared by the scaling
+        lo, hi = self.lo[joint], self.hi[joint]
+        tol = 2.5e-4 * (hi - lo)  # inside the 1e-3 spared by the scaling
         qmin, qmax = q_lo * s, q_hi * s
-        return c * s[..., None], self.lo - qmin + tol, self.hi - qmax - tol
+        return c * s[..., None], lo - qmin + tol, hi - qmax - tol
 
     def initial(
         self, raw: NDArray[np.float64], offset: NDArray[np.float64], fraction: float = 1.0
@@ -732,6 +754,48 @@ class _Problem:
         r + 3 n) of coefficients (..., n, 2L) and rest positions (..., n)."""
         return _regressor_of(self.robot, self.base, *self._samples(self.B_reg, c, q0))
 
+    def regressor_of(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """``[Y_b, F]`` (..., N n, r + 3 n) of samples (..., N, n) [rad, rad/s, rad/s^2]."""
+        return _regressor_of(self.robot, self.base, q, dq, ddq)
+
+    def base_regressor_of(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """``Y_b`` (..., N n, r), without the friction columns, of samples (..., N, n)."""
+        n = q.shape[-1]
+        flat = [np.reshape(x, (-1, n)) for x in (q, dq, ddq)]
+        cols = self.base.independent
+        Y = torque_regressor_prepared(self.robot, *flat, self.robot.gravity, columns=cols)
+        return Y.reshape(q.shape[:-2] + (-1, len(cols)))
+
+    def torques(
+        self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """The torques checked [N m] (S, n) of samples (S, n) (:func:`_torques_of`)."""
+        return _torques_of(self.robot, q, dq, ddq, self.drive)
+
+    def distances(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The clearances penalised [m] (S, p) of positions (S, n) [rad]: of the
+        self-collision pairs, then of each obstacle (its closest capsule)."""
+        seg = capsule_segments(self.robot, q)
+        out = [np.zeros((len(q), 0))]
+        if self.caps.pairs.size:
+            out.append(self_distances(self.robot, q, self.caps, segments=seg))
+        if len(self.obstacles):
+            out.append(obstacle_distances(self.robot, q, self.obstacles, self.caps, segments=seg))
+        return np.concatenate(out, axis=-1)
+
+    def required_distances(self) -> NDArray[np.float64]:
+        """The distances (p,) [m] below which :meth:`distances` are penalised: each
+        clearance with 1 cm to spare."""
+        c_self, c_obstacle = _clearances(self.opts)
+        pairs = len(self.caps.pairs) if self.caps.pairs.size else 0
+        return np.concatenate(
+            [np.full(pairs, c_self + 0.01), np.full(len(self.obstacles), c_obstacle + 0.01)]
+        )
+
     def criterion(self, c: NDArray, q0: NDArray) -> float:
         """The criterion on the regressor's grid (:func:`_criterion`)."""
         return _criterion(self.regressor(c, q0), self.opts.criterion)
@@ -754,6 +818,19 @@ class _Problem:
         return out
 
     def value_and_gradient(self, x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        """The objective at ``x`` and its gradient: by the chain rule through the samples
+        for the ``cond`` criterion (:func:`~dynid.simulation.excitation_gradient.
+        objective_gradient`), told as the ``len(x) + 1`` evaluations of the finite
+        differences it replaces; else :meth:`finite_difference_gradient`."""
+        if self.opts.criterion != "cond":
+            return self.finite_difference_gradient(x)
+        value, grad = objective_gradient(self, x)
+        self._told(1)
+        return value, grad
+
+    def finite_difference_gradient(
+        self, x: NDArray[np.float64]
+    ) -> tuple[float, NDArray[np.float64]]:
         """The objective at ``x`` and its forward-difference gradient: the steps
         ``(x + h e_i) - x`` of :data:`_FD_STEP` scipy's L-BFGS-B takes with ``eps`` (its
         ``2-point`` differences), all ``x + h e_i`` evaluated in one batch (:meth:`objectives`)."""
@@ -965,15 +1042,14 @@ def optimise_excitation(
         best.offer(xk)
         _tell_iteration(prob, len(history), cond, progress)
 
-    # the gradient's len(x) + 1 evaluations counted as one by scipy: the same stop as
-    # its own finite differences under max_evaluations
+    # scipy counts an evaluation with its gradient as one: finite differences, len(x) + 1
     res = _minimize(
         prob.value_and_gradient,
         x0,
         jac=True,
         method="L-BFGS-B",
         callback=callback,
-        options={"maxiter": options.max_iter, "maxfun": options.max_evaluations // (len(x0) + 1)},
+        options={"maxiter": options.max_iter, "maxfun": _gradients_allowed(options, len(x0))},
     )
     best.offer(res.x)
     # the best penalty-free iterate; without one, the optimiser's (the least violation)
@@ -1014,6 +1090,15 @@ def optimise_excitation(
         rest_clearances=_rest_clearances(robot, centre, options, obstacles, caps),
         n_base=len(base.independent),
     )
+
+
+def _gradients_allowed(options: ExcitationOptions, variables: int) -> int:
+    """The evaluations with their gradients L-BFGS-B may make within
+    ``options.max_evaluations``: each one evaluation with the ``cond`` criterion's gradient
+    (:mod:`~dynid.simulation.excitation_gradient`), ``variables + 1`` with the finite
+    differences of ``logdet``'s."""
+    per = 1 if options.criterion == "cond" else variables + 1
+    return options.max_evaluations // per
 
 
 def _tell_iteration(
