@@ -30,7 +30,10 @@ maximise ``log det`` of its column-scaled Gram matrix (D-optimality). Constraint
   (``improved`` is then False). The closest pair of links and the closest link to each
   obstacle are named with their distances (:mod:`dynid.simulation.clearance`).
 
-scipy's L-BFGS-B with finite-difference gradients; the start is the best of ``n_starts``
+scipy's L-BFGS-B; the ``cond`` criterion's gradient by the chain rule through the
+samples (:mod:`dynid.simulation.excitation_gradient`: about 16 times cheaper than the
+finite differences it replaced), ``logdet``'s by forward differences of scipy's steps,
+evaluated in one batch. The start is the best of ``n_starts``
 seeded random candidates, each as large as its joints' limits allow; when the best
 violates a torque or a clearance (a small arm's elbow folded into its shoulder at the top
 of its range), the candidates at 80, 60, 40 and 20 % of that amplitude too, the best of
@@ -39,9 +42,9 @@ the floor and itself at most of those amplitudes), from which the optimiser can 
 grow a motion (at the largest that fits, the scaling undoes either, and a start in
 collision was never left). Seeded and reproducible; ``progress(iteration, max_iter,
 cond)`` is called after each iteration and ``evaluated(evaluations, budget)`` after each
-evaluation of the objective (an iteration can take thousands when its line search
-struggles); both are also told to :mod:`dynid.progress` (the command line's progress
-lines) and each iteration logged at ``INFO`` (``-v``).
+evaluation of the objective (a batch of them with finite differences; an iteration can
+take dozens when its line search struggles); both are also told to :mod:`dynid.progress`
+(the command line's progress lines) and each iteration logged at ``INFO`` (``-v``).
 """
 
 from __future__ import annotations
@@ -167,7 +170,10 @@ class ExcitationOptions:
     max_iter : int
         L-BFGS-B iterations (60).
     max_evaluations : int
-        Objective evaluations allowed to L-BFGS-B (6000; about 2 ms each for the Panda).
+        Objective evaluations allowed to L-BFGS-B (6000): each with its gradient one
+        (``cond``; about 20 ms for the Panda's 20 s design, so that ``max_iter`` ends the
+        optimisation first), each with its finite differences ``n (2 L + 1) + 1``
+        (``logdet``; about 2 ms each).
     n_starts : int
         Random candidates the start is chosen from (16).
     fs_regressor, fs_limits, fs_collision : float
@@ -469,11 +475,11 @@ def _regressor_of(
     written by the regressor straight into the first ``r`` of a contiguous array (no
     gather into a strided slice), the friction columns after."""
     r, n = len(base.independent), q.shape[-1]
-    flat = [np.reshape(x, (-1, n)) for x in (q, dq, ddq)]
+    q2, dq2, ddq2 = (np.reshape(x, (-1, n)) for x in (q, dq, ddq))
     W = torque_regressor_prepared(
-        robot, *flat, robot.gravity, columns=base.independent, width=r + 3 * n
+        robot, q2, dq2, ddq2, robot.gravity, columns=base.independent, width=r + 3 * n
     )
-    W[..., r:] = friction_regressor(flat[1])
+    W[..., r:] = friction_regressor(dq2)
     return W.reshape(q.shape[:-2] + (-1, W.shape[-1]))
 
 
@@ -765,9 +771,9 @@ class _Problem:
     ) -> NDArray[np.float64]:
         """``Y_b`` (..., N n, r), without the friction columns, of samples (..., N, n)."""
         n = q.shape[-1]
-        flat = [np.reshape(x, (-1, n)) for x in (q, dq, ddq)]
+        q2, dq2, ddq2 = (np.reshape(x, (-1, n)) for x in (q, dq, ddq))
         cols = self.base.independent
-        Y = torque_regressor_prepared(self.robot, *flat, self.robot.gravity, columns=cols)
+        Y = torque_regressor_prepared(self.robot, q2, dq2, ddq2, self.robot.gravity, columns=cols)
         return Y.reshape(q.shape[:-2] + (-1, len(cols)))
 
     def torques(
@@ -1001,7 +1007,7 @@ def optimise_excitation(
     progress : callable, optional
         ``progress(iteration, max_iter, condition_number)`` after each iteration.
     evaluated : callable, optional
-        ``evaluated(evaluations, budget)`` after each evaluation (up to several per ms);
+        ``evaluated(evaluations, budget)`` after each evaluation (or batch of them);
         ``budget``: ``options.max_evaluations`` and those of the start (L-BFGS-B may overrun).
     drive : Drive, optional
         The drive train: the torques checked include its known rotor inertias' reflected
