@@ -746,7 +746,7 @@ class _Problem:
             self.w_f, c[:, : self.L], c[:, self.L :], q0, self.opts.duration, self.opts.ramp
         )
 
-    def _samples(self, B: tuple, c: NDArray, q0: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    def samples(self, B: tuple, c: NDArray, q0: NDArray) -> tuple[NDArray, NDArray, NDArray]:
         """Positions, velocities and accelerations (..., N, n each) [rad, rad/s, rad/s^2]
         of coefficients ``c`` (..., n, 2L) and rest positions ``q0`` (..., n) on the grid
         of basis ``B``: finite by construction, so no :class:`Trajectory` checks them
@@ -758,7 +758,7 @@ class _Problem:
     def regressor(self, c: NDArray, q0: NDArray) -> NDArray[np.float64]:
         """``[Y_b, F]`` on the regressor's grid (:func:`_classical_regressor`): (..., N n,
         r + 3 n) of coefficients (..., n, 2L) and rest positions (..., n)."""
-        return _regressor_of(self.robot, self.base, *self._samples(self.B_reg, c, q0))
+        return _regressor_of(self.robot, self.base, *self.samples(self.B_reg, c, q0))
 
     def regressor_of(
         self, q: NDArray[np.float64], dq: NDArray[np.float64], ddq: NDArray[np.float64]
@@ -866,7 +866,7 @@ class _Problem:
         coefficients (B, n, 2L) and rest positions (B, n): (B,)."""
         pen = np.zeros(len(c))
         if np.any(np.isfinite(self.tmax)):
-            q, dq, ddq = (x.reshape(-1, self.n) for x in self._samples(self.B_lim, c, q0))
+            q, dq, ddq = (x.reshape(-1, self.n) for x in self.samples(self.B_lim, c, q0))
             tau = np.abs(_torques_of(self.robot, q, dq, ddq, self.drive))
             tau = _max_over_samples(tau.reshape(len(c), -1, self.n))
             with np.errstate(invalid="ignore"):

@@ -9,8 +9,10 @@ projected onto the continuous accelerations, scaled to fit its limits, its rest 
 clipped to where the motion fits). :func:`objective_gradient` differentiates each link of
 that chain:
 
-* the scaling and the clipping: in closed form, through the limit that binds (the
-  sample of the largest span, velocity or acceleration);
+* the coefficients and the rest position of the variables (each joint's scaling to its
+  limits and the clipping, piecewise smooth): by forward differences of the steps scipy's
+  finite differences take, one joint's row at a time (:func:`coefficient_steps`; the
+  kinks of the scaling weigh in as they did in those differences);
 * the criterion ``log cond = (log lambda_max - log lambda_min) / 2`` of the Gram matrix
   ``W^T W``: ``d lambda = 2 (W v)^T (dW v)`` with ``v`` the eigenvector (Magnus and
   Neudecker, *Matrix Differential Calculus*, 2019, ch. 8); ``dW`` of each joint's
@@ -21,9 +23,10 @@ that chain:
   clearance smallest (a maximum's derivative is its largest element's), by forward
   differences of :data:`STATE_STEP` in that sample's states.
 
-A gradient costs about as much as a tenth of the ``len(x) + 1`` evaluations of the
-finite differences it replaces (the Panda's 20 s design: 22 regressors of the same
-samples in place of 78). ``logdet`` keeps the finite differences
+A gradient costs about a sixteenth of the ``len(x) + 1`` evaluations of the finite
+differences it replaces (the Panda's 20 s design: 22 regressors of the same samples in
+place of 78 evaluations; ``benchmarks/bench_excitation.py``). ``logdet`` keeps the finite
+differences
 (:meth:`~dynid.simulation.excitation._Problem.value_and_gradient`).
 """
 
@@ -95,7 +98,7 @@ def _criterion_part(
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
     """``log cond`` of the regressor and its gradient in ``c`` and ``q0``."""
     n = prob.n
-    z = prob._samples(prob.B_reg, c, q0)  # (N, n) each
+    z = prob.samples(prob.B_reg, c, q0)  # (N, n) each
     W = prob.regressor(c, q0)  # (N n, m)
     lam, V = np.linalg.eigh(W.T @ W)
     lam_min = max(lam[0], 1e-300)
@@ -143,7 +146,7 @@ def _torque_part(
     zero = (0.0, np.zeros((n, 2 * prob.L)), np.zeros(n))
     if not np.any(np.isfinite(prob.tmax)):
         return zero
-    z = prob._samples(prob.B_lim, c, q0)
+    z = prob.samples(prob.B_lim, c, q0)
     tau = prob.torques(*z)
     at = np.abs(tau).argmax(axis=0)
     peak = tau[at, np.arange(n)]
