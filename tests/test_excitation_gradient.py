@@ -17,6 +17,7 @@ from dynid import _kernels
 from dynid.regressors.base import base_parameters
 from dynid.simulation import excitation_gradient as G
 from dynid.simulation.collision import (
+    Box,
     Obstacles,
     _segment_distance,
     capsule_model,
@@ -160,3 +161,22 @@ def test_self_distances_of_a_batch_match_dense_sampling_of_the_capsules():
     P = np.stack([seg[:, i, 0], seg[:, i, 1], seg[:, j, 0], seg[:, j, 1]], axis=2).reshape(-1, 4, 3)
     ref = _brute_segment_distance(P, 201).reshape(d.shape) - caps.radii[i] - caps.radii[j]
     assert np.all(d <= ref + 1e-12) and np.all(ref - d < 5e-3)
+
+
+def test_a_rank_deficient_regressor_gives_a_finite_gradient():
+    """Regression: one harmonic leaves no motion once the accelerations are made
+    continuous (a static regressor, lambda_min at the criterion's floor of 1e-300); the
+    chain rule divided by that floor (a gradient of 4e288, then NaN states, where
+    ``excite`` was to say "no admissible trajectory"). Now finite and the central
+    differences' (the floored term is constant)."""
+    opts = ExcitationOptions(duration=2.0, harmonics=1).sized_for(dynid.panda())
+    robot = dynid.panda()
+    caps = capsule_model(robot, opts.radii, clearance=opts.self_clearance)
+    room = Obstacles(boxes=(Box((0.0, 0.0, 0.5), (10.0, 10.0, 10.0)),))
+    base = base_parameters(robot, kind="torque")
+    prob = _Problem(robot, opts, room, caps, base, _preferred_rest(robot, None))
+    x = _variables(prob, 0)
+    _, grad = G.objective_gradient(prob, x)
+    ref = _central(prob, x)
+    assert np.all(np.isfinite(grad))
+    assert np.linalg.norm(grad - ref) <= 1e-4 * np.linalg.norm(ref)

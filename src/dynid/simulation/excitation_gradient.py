@@ -119,7 +119,9 @@ def _criterion_part(
         dWv[n + j, j::n] += V2[r + 3 * j]
     u = W @ V2  # (N n, 2)
     # d crit = u_max . dW v_max / lambda_max - u_min . dW v_min / lambda_min, per sample
-    per_row = dWv[..., 0] * (u[:, 0] / lam[-1]) - dWv[..., 1] * (u[:, 1] / lam_min)
+    # (a rank-deficient regressor, lambda_min held at its floor: that term constant)
+    floor = 0.0 if lam[0] <= 1e-300 else 1.0 / lam_min
+    per_row = dWv[..., 0] * (u[:, 0] / lam[-1]) - dWv[..., 1] * (u[:, 1] * floor)
     g = per_row.reshape(3, n, -1, n).sum(axis=-1)  # (kind, joint, sample)
     return value, *_to_coefficients(prob.B_reg, tuple(np.swapaxes(g, 1, 2)))
 
