@@ -21,7 +21,9 @@ Modules:
 * the kernel modules, imported on first use: :mod:`~dynid._kernels.kinematics` (poses,
   Jacobians), :mod:`~dynid._kernels.dynamics` (RNEA, gravity, mass matrix, forward
   dynamics), :mod:`~dynid._kernels.regressors` (torque and static regressors),
-  :mod:`~dynid._kernels.ik` (inverse kinematics).
+  :mod:`~dynid._kernels.ik` (inverse kinematics), :mod:`~dynid._kernels.collision` (the
+  distances of capsule segments, called by :func:`dynid.simulation.collision.self_distances`
+  with its numpy path beside it, as :mod:`~dynid._kernels.filters` by the low-pass filter).
 
 ``import dynid._kernels`` does not import numba.
 """

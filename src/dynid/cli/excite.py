@@ -22,8 +22,8 @@ base frame by default, or planes and boxes from --obstacles FILE (JSON):
 Writes DIR/trajectory.csv (t, q, dq, ddq at 1 kHz, for a position or velocity
 controller), DIR/trajectory.json (coefficients, limits, margins, obstacles, condition
 numbers, the smallest margin to every limit and obstacle at 1 kHz) and
-DIR/excitation.png (joint motion and swept workspace). Seeded; about a minute for the
-Panda: on a terminal, progress lines tell the iterations (-v logs each one), and the
+DIR/excitation.png (joint motion and swept workspace). Seeded; about ten seconds for
+the Panda: on a terminal, progress lines tell the iterations (-v logs each one), and the
 summary's first line ends with the time the design took.
 `dynid simulate --trajectory DIR/trajectory.csv` records a torque log along it.
 The result is the best admissible iterate, never worse than an admissible start (the

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
+from .. import _checks, _kernels
 from ..exceptions import OptionError, ShapeError
 from ..kinematics.forward import link_poses
 from ..model.robot import Robot
@@ -338,19 +338,45 @@ def self_distances(
 ) -> NDArray[np.float64]:
     """Signed distances of the self-collision pairs: (..., n) -> (..., k) [m].
 
-    ``segments`` (from :func:`capsule_segments`) skips the kinematics when given.
+    ``segments`` (from :func:`capsule_segments`) skips the kinematics when given. The
+    compiled kernel (:mod:`dynid._kernels.collision`) computes the distances of a batch
+    of samples, the numpy path (the same numbers) a single sample before numba is loaded
+    and when it is missing or turned off.
     """
     seg = capsule_segments(robot, q) if segments is None else segments
     i, j = model.pairs[:, 0], model.pairs[:, 1]
     k = len(i)
-    # end points end-major (2 (n + 1), 3, M), gathered a whole row (one coordinate of one
-    # end over the M samples) at a time, then held component-first (3, 4 k, M)
+    flat = seg.reshape(-1, seg.shape[-3], 2, 3)
+    mod = _kernels.load("collision") if _uses_kernel(len(flat)) else None
+    if mod is not None:
+        out = np.empty((len(flat), k))
+        mod.segment_pair_distances(np.ascontiguousarray(flat), model.pairs, out)
+        d = out.reshape(seg.shape[:-3] + (k,))
+    else:
+        d = _pair_distances_numpy(seg, i, j)
+    return d - model.radii[i] - model.radii[j]
+
+
+def _uses_kernel(samples: int) -> bool:
+    """Whether the distances of ``samples`` samples take the compiled kernel: a batch
+    always (numba missing or turned off aside), a single sample once numba is loaded or
+    after a few (:func:`dynid._kernels.small_call_uses_kernels`)."""
+    return samples > 1 or _kernels.small_call_uses_kernels()
+
+
+def _pair_distances_numpy(
+    seg: NDArray[np.float64], i: NDArray[np.intp], j: NDArray[np.intp]
+) -> NDArray[np.float64]:
+    """Distances [m] of the segments ``i`` and ``j`` (k each) of ``seg`` (..., c, 2, 3):
+    (..., k), the numpy path of :func:`self_distances`."""
+    k = len(i)
+    # end points end-major (2 c, 3, M), gathered a whole row (one coordinate of one end
+    # over the M samples) at a time, then held component-first (3, 4 k, M)
     ends = np.ascontiguousarray(seg.reshape(-1, 2 * seg.shape[-3], 3).transpose(1, 2, 0))
     g = np.take(ends, np.concatenate([2 * i, 2 * i + 1, 2 * j, 2 * j + 1]), axis=0)
     g = g.transpose(1, 0, 2)
     d = _segment_distance_xyz(g[:, :k], g[:, k : 2 * k], g[:, 2 * k : 3 * k], g[:, 3 * k :])
-    d = np.ascontiguousarray(d.T).reshape(seg.shape[:-3] + (k,))
-    return d - model.radii[i] - model.radii[j]
+    return np.ascontiguousarray(d.T).reshape(seg.shape[:-3] + (k,))
 
 
 def obstacle_capsule_distances(
