@@ -40,8 +40,8 @@ PYTEST_WORKERS ?= auto
 PYTEST_XDIST := -n $(PYTEST_WORKERS) --dist loadscope --no-loadscope-reorder
 # one BLAS thread per worker: each worker already has a core, and threaded BLAS on the small
 # matrices of these tests spins against the other worker (the excitation optimisation of
-# tests/test_excitation.py takes 41 s single-threaded, 56 s alone with two threads, and about
-# 220 s with two threads beside another worker)
+# tests/test_excitation.py, then a finite-difference gradient, took 41 s single-threaded, 56 s
+# alone with two threads, and about 220 s with two threads beside another worker)
 # Compiled modules are written (PYTHONDONTWRITEBYTECODE emptied: set, each test worker rewrote
 # the asserts of every test file, 10.5 s CPU against 4.1 s from the cache, and each command the
 # tests start as a process compiled dynid again, about 0.5 s; tests/test_processes.py,
