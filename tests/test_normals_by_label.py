@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from dynid.identification.holdout import block_normals, rows_labelled
 from dynid.identification.streaming import normals_by_label_scaled
 
 
@@ -38,3 +39,18 @@ def test_plain_and_noise_scaled_normals_are_those_of_the_rows(shuffled):
             assert got.c == pytest.approx(c, rel=1e-12)
             assert got.sse0 == pytest.approx(e, rel=1e-12)
             assert got.rows == sel.sum()
+
+
+def test_block_normals_of_contiguous_and_scattered_folds_are_those_of_the_rows():
+    """Folds of contiguous rows (read as slices) and folds of scattered rows give each
+    fold's normal equations as the rows selected by a mask do."""
+    rng = np.random.default_rng(8)
+    W, y, origin = rng.normal(size=(90, 6)), rng.normal(size=90), rng.normal(size=6)
+    for labels in (np.repeat(np.arange(3), 30), rng.permutation(np.repeat(np.arange(3), 30))):
+        assert isinstance(rows_labelled(labels, 1), slice) == (labels[30:60] == 1).all()
+        for j, got in enumerate(block_normals(W, y, labels, origin)):
+            G, b, c, e = _direct(W[labels == j], y[labels == j], np.ones(30), origin)
+            np.testing.assert_allclose(got.G, G, rtol=1e-12, atol=1e-10)
+            np.testing.assert_allclose(got.b, b, rtol=1e-12, atol=1e-10)
+            assert (got.c, got.rows) == (pytest.approx(c, rel=1e-12), 30)
+            assert got.sse0 == pytest.approx(e, rel=1e-12)

@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 from .. import _checks
 from ..exceptions import OptionError, ShapeError
 from ..progress import rows_read
-from .holdout import Normals
+from .holdout import Normals, rows_labelled
 
 __all__ = [
     "BLOCK_ROWS",
@@ -403,17 +403,6 @@ def normals_by_label(
     return normals_by_label_scaled(source, labels, weights)[0]
 
 
-def _rows_of(lab: NDArray[np.intp], j: int) -> slice | NDArray[np.bool_]:
-    """The rows labelled ``j``: a slice when they are contiguous (a fold of contiguous
-    rows: no copy of them made to select them), else a mask."""
-    sel = lab == j
-    first = int(np.argmax(sel))
-    count = int(np.count_nonzero(sel))
-    if sel[first : first + count].all():
-        return slice(first, first + count)
-    return sel
-
-
 def _sample_major(g: NDArray[np.intp]) -> int:
     """``n`` when the rows' noise groups ``g`` are ``0 .. n-1`` repeated sample by sample
     (a torque log's rows: row ``k n + j`` is joint ``j``), else 0."""
@@ -495,7 +484,7 @@ def normals_by_label_scaled(
             raise ShapeError(f"labels hold {labels.size} rows; the blocks more")
         for j in np.unique(lab):
             whole = W.flags.c_contiguous and y.flags.c_contiguous  # a view is alike a copy
-            sel = _rows_of(lab, j) if whole else lab == j
+            sel = rows_labelled(lab, j) if whole else lab == j
             Ws, ys = W[sel], y[sel]
             n = _sample_major(np.asarray(g)[sel]) if sets == 2 and weights is None else 0
             if n:  # plain and scaled sets from one Gram per noise group
