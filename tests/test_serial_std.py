@@ -51,6 +51,21 @@ def test_meat_is_bartlett_sum_within_pieces() -> None:
     np.testing.assert_allclose(acc.result(), _bartlett(scores, serial), rtol=1e-12, atol=1e-12)
 
 
+def test_products_fed_in_blocks_are_bartlett_sum_within_pieces() -> None:
+    """Rows and residuals fed as products (whole samples summed without the scores written
+    out, blocks cut inside samples and across pieces, leading columns zero) give Newey-West's
+    lag sum per piece, at a window and without one."""
+    rng = np.random.default_rng(2)
+    W, e = rng.normal(size=(150, 5)), rng.normal(size=150)
+    W[:40, :2] = 0.0  # the rows of the first blocks start at column 2
+    for lag in (0, 4):
+        serial = Serial(rows_per_sample=3, lag=lag, starts=(0, 30, 96))
+        blk = np.array([[0, 7, 2], [7, 40, 2], [40, 41, 0], [41, 150, 0]])
+        got = serial_meat(W, blk, e, serial)
+        ref = _bartlett(W * e[:, None], serial)
+        np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-12)
+
+
 def test_lag_zero_one_row_is_hc1() -> None:
     """Window 0, one row a sample: the meat is White's ``W^T diag(e^2) W``."""
     rng = np.random.default_rng(1)

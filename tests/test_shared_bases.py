@@ -58,3 +58,32 @@ def test_friction_labels_follow_parts_mask_and_prefix():
     )
     assert term.labels == ("jfv1", "jfo1", "jfv2", "jfc2")
     assert LinearFriction(Drive.identity(2)).labels == ("fv1", "fc1", "fo1", "fv2", "fc2", "fo2")
+
+
+def test_static_identify_and_retrieve_compute_the_base_once(tmp_path, monkeypatch):
+    """Regression: identify on static data computed the structural base twice (the
+    outlier search's fit and the fit itself: 4.6 s of 9 s for a 50-joint arm), retrieve
+    --static too; now once each, and the fit still predicts Pinocchio's M and g."""
+    import dynid
+    import dynid.identification.core as core
+    from dynid.identification.data import StaticDataset
+    from dynid.io.static_data import save_static_csv
+    from dynid.workflows.identify import identify_files
+    from dynid.workflows.retrieve import RetrieveOptions, retrieve_files
+
+    from conftest import pinocchio_panda_static
+
+    q, M, g = pinocchio_panda_static(21, 40)
+    save_static_csv(tmp_path / "s.csv", StaticDataset(q, M, g))
+    calls = []
+    monkeypatch.setattr(
+        core, "base_parameters", lambda *a, **k: calls.append(1) or base_parameters(*a, **k)
+    )
+    robot = dynid.panda()
+    model = identify_files(robot, tmp_path / "s.csv").model
+    assert len(calls) == 1
+    q2, M2, g2 = pinocchio_panda_static(22, 5)
+    np.testing.assert_allclose(model.gravity_torques(q2), g2, atol=1e-8)
+    np.testing.assert_allclose(model.mass_matrix(q2), M2, atol=1e-8)
+    retrieve_files(tmp_path / "s.csv", RetrieveOptions(method="sdp"), kind="static", robot=robot)
+    assert len(calls) == 2

@@ -45,6 +45,7 @@ __all__ = [
     "block_normals",
     "cross_validate",
     "fold_errors_percent",
+    "rows_labelled",
     "shared_eigen",
 ]
 
@@ -310,6 +311,17 @@ def block_labels(n_samples: int, folds: int = DEFAULT_FOLDS) -> NDArray[np.intp]
     return np.minimum((np.arange(n_samples) * folds) // n_samples, folds - 1).astype(np.intp)
 
 
+def rows_labelled(labels: NDArray[np.intp], j: int) -> slice | NDArray[np.bool_]:
+    """The rows labelled ``j`` in ``labels`` (m,): a slice when they are contiguous (a
+    fold of contiguous rows: no copy of them made to select them), else a mask."""
+    sel = labels == j
+    first = int(np.argmax(sel))
+    count = int(np.count_nonzero(sel))
+    if sel[first : first + count].all():
+        return slice(first, first + count)
+    return sel
+
+
 def block_normals(
     W: NDArray[np.float64],
     y: NDArray[np.float64],
@@ -340,10 +352,11 @@ def block_normals(
         )
     k = int(labels.max()) + 1 if labels.size else 0
     out = []
+    whole = W.flags.c_contiguous and y.flags.c_contiguous  # a view is alike a copy
     for j in range(k):
-        sel = labels == j
+        sel = rows_labelled(labels, j) if whole else labels == j
         Wj, yj = W[sel], y[sel]
-        n = Normals(Wj.T @ Wj, Wj.T @ yj, float(yj @ yj), int(sel.sum()))
+        n = Normals(Wj.T @ Wj, Wj.T @ yj, float(yj @ yj), yj.size)
         if origin is not None:
             r = yj - Wj @ origin
             n = replace(n, origin=np.asarray(origin, dtype=np.float64), sse0=float(r @ r))

@@ -78,7 +78,9 @@ def heldout_judge(
         else:
             W = stack.W if cols.all() else stack.W[:, cols]
             rw = row_weights(estimator, W, stack.y, stack.groups, b)
-            Ww, yw, m = W * rw[:, None], stack.y * rw, stack.y.size
+            m = stack.y.size
+            ones = bool((rw == 1.0).all())  # OLS: the rows as they are, not a copy
+            Ww, yw = (W, stack.y) if ones else (W * rw[:, None], stack.y * rw)
             normals = lambda lab: block_normals(Ww, yw, lab, b)  # noqa: E731
             fitted = lambda: iter([(W, stack.y, stack.groups)])  # noqa: E731
         if validation is not None:

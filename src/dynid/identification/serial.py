@@ -136,6 +136,31 @@ class SerialMeat:
                 self._close()
                 self._piece += 1
 
+    def add_products(self, W: NDArray[np.float64], e: NDArray[np.float64], first: int = 0) -> None:
+        """Add the scores ``W_i e_i`` of the next ``m_b`` rows ``W`` (m_b, r) with their
+        residual ``e`` (m_b,), the columns before ``first`` zero: as :meth:`add` of those
+        scores, whole samples summed in one pass without the scores written out."""
+        starts, n = self.serial.starts, self.serial.rows_per_sample
+        while e.size:
+            nxt = starts[self._piece + 1] if self._piece + 1 < len(starts) else None
+            take = e.size if nxt is None else min(e.size, nxt - self._row)
+            whole = 0 if self._rest.size else take - take % n
+            if whole:
+                k = whole // n
+                S = np.zeros((k, self.r))
+                Wk = W[:whole, first:].reshape(k, n, self.r - first)
+                S[:, first:] = np.einsum("kjr,kj->kr", Wk, e[:whole].reshape(k, n))
+                self._row += whole
+                self._samples(S)
+            if take > whole:
+                sc = np.zeros((take - whole, self.r))
+                sc[:, first:] = W[whole:take, first:] * e[whole:take, None]
+                self._rows(sc)
+            W, e = W[take:], e[take:]
+            if nxt is not None and self._row == nxt:
+                self._close()
+                self._piece += 1
+
     def _rows(self, scores: NDArray[np.float64]) -> None:
         """Rows of the current piece: whole samples summed, the rest kept."""
         self._row += scores.shape[0]
@@ -149,6 +174,9 @@ class SerialMeat:
     def _samples(self, S: NDArray[np.float64]) -> None:
         """The windows ending at each of the sample scores ``S`` (k, r)."""
         L = self.serial.lag
+        if L == 0:  # each window one sample's score
+            self.meat += S.T @ S
+            return
         T = np.concatenate([self._tail, S])
         C = np.concatenate([np.zeros((1, self.r)), np.cumsum(T, axis=0)])
         B = C[L + 1 :] - C[: -L - 1]
@@ -186,8 +214,6 @@ def serial_meat(
     acc = SerialMeat(serial, r)
     o = 0
     for a, b, c in blk:
-        sc = np.zeros((b - a, r))
-        sc[:, c:] = W[a:b, c:] * e[o : o + b - a, None]
-        acc.add(sc)
+        acc.add_products(W[a:b], e[o : o + b - a], c)
         o += b - a
     return acc.result()

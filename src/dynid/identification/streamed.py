@@ -145,11 +145,11 @@ def _meat(
         if weights is not None:
             w = weights(o, g)
             Wk, e = Wk * w[:, None], e * w
-        We = Wk * e[:, None]
         if acc is None:
+            We = Wk * e[:, None]
             meat += We.T @ We
         else:
-            acc.add(We)
+            acc.add_products(Wk, e)
         o += y.size
     return meat if acc is None else acc.result()
 

@@ -62,6 +62,11 @@ ROUND_OFF_SHARE = 1e-12
 ROUND_OFF_BLOCK = 64
 
 
+#: Elements of the differences :func:`velocity_noise_std` takes the medians of at once
+#: (joints together up to this, one joint of a longer log at a time: 8 MB of temporaries).
+_MEDIAN_ELEMENTS = 1 << 20
+
+
 def velocity_noise_std(dq: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.float64]:
     """Std [rad/s] (n,) of the white noise on velocity samples ``dq`` (N, n), robustly.
 
@@ -115,10 +120,11 @@ def velocity_noise_std(dq: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.
         if a.shape[0] <= order:  # three samples: no third difference
             continue
         mad = np.empty(a.shape[1])
-        for j in range(a.shape[1]):  # one joint at a time: temporaries of one column
-            d = np.diff(a[:, j], n=order)
-            d -= np.median(d)
-            mad[j] = np.median(np.abs(d, out=d))
+        w = max(1, _MEDIAN_ELEMENTS // a.shape[0])  # joints at a time: bounded temporaries
+        for j in range(0, a.shape[1], w):
+            d = np.diff(a[:, j : j + w], n=order, axis=0)
+            d -= np.median(d, axis=0)
+            mad[j : j + w] = np.median(np.abs(d, out=d), axis=0)
         est.append(1.4826 * mad / np.sqrt(var))
     out: NDArray[np.float64] = np.minimum.reduce(est)
     return out

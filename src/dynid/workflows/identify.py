@@ -53,7 +53,8 @@ from ..feasibility.payload_arm import model_structure
 from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.consistency import fit_mismatch, limit_violations
-from ..identification.core import model_loose
+from ..identification.core import model_loose, shared_bases
+from ..identification.data import StaticDataset
 from ..identification.dissipation import ReversedSignError
 from ..identification.estimators import ESTIMATORS, EstimatorName
 from ..identification.gravity_scale import (
@@ -474,15 +475,8 @@ def identify_files(
     if kind != "torque_log":
         _one_static_file(paths, opt)
         static = read_static_file(path, robot, columns=cmap, drop_invalid=opt.drop_invalid)
-        static = without_outlying(robot, path, static, keep=opt.keep_outlying, drive=opt.drive)
-        hand = _flange_note(robot, path, static, prior)
-        if not opt.consistent:
-            model = _noted(_static(robot, path, static, opt), hand)
-            return IdentifyResult(model, None, tuple(paths))
-        consistent, unconstrained = _consistent_static(robot, path, static, opt, prior)
-        unconstrained = _noted(unconstrained, hand)
-        consistent = dataclasses.replace(consistent, identified=unconstrained)
-        return IdentifyResult(unconstrained, consistent, tuple(paths))
+        with shared_bases():  # the outlier search's base parameters are the fit's
+            return _static_files(robot, paths, static, opt, prior)
     separate = heldout.get("validate_on")
     logs = _read_logs(robot, paths, cmap, opt, separate)
     read = dataclasses.replace(  # the logs read with the file options; the prior loaded
@@ -780,6 +774,28 @@ def _noted(model: IdentifiedModel, said: str | None) -> IdentifiedModel:
     return dataclasses.replace(
         model, info=dataclasses.replace(model.info, notes=(*model.info.notes, said))
     )
+
+
+def _static_files(
+    robot: Robot,
+    paths: Sequence[Path],
+    static: StaticDataset,
+    opt: IdentifyOptions,
+    prior: Robot | None,
+) -> IdentifyResult:
+    """:func:`identify_files` of the static data ``static`` read from ``paths[0]``: its
+    outlying configurations left out, fitted unconstrained and, with
+    ``opt.consistent``, consistent."""
+    path = paths[0]
+    static = without_outlying(robot, path, static, keep=opt.keep_outlying, drive=opt.drive)
+    hand = _flange_note(robot, path, static, prior)
+    if not opt.consistent:
+        model = _noted(_static(robot, path, static, opt), hand)
+        return IdentifyResult(model, None, tuple(paths))
+    consistent, unconstrained = _consistent_static(robot, path, static, opt, prior)
+    unconstrained = _noted(unconstrained, hand)
+    consistent = dataclasses.replace(consistent, identified=unconstrained)
+    return IdentifyResult(unconstrained, consistent, tuple(paths))
 
 
 def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> IdentifiedModel:

@@ -25,6 +25,7 @@ from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
 from ..friction.model import FrictionModel, combined, through_drive
+from ..identification.core import shared_bases
 from ..identification.model import IdentifiedModel
 from ..identification.static_flange import data_flange_note, model_flange_note
 from ..io.bounds_file import load_bounds
@@ -277,6 +278,7 @@ class Retrieval:
     column_map: Mapping[str, str | None] | None = None
 
 
+@shared_bases()  # static data: the outlier search's base parameters are the fit's
 def retrieve_files(
     source: str | Path,
     options: RetrieveOptions | None = None,
