@@ -149,3 +149,23 @@ def test_limit_text_reads_one_value_for_every_joint_or_per_joint(so101):
 
 def _nine() -> ExcitationOptions:
     return ExcitationOptions(max_acceleration=((8, 1.0),))
+
+
+def test_the_trajectory_csv_is_written_at_the_rate_given(tmp_path):
+    """Regression (an SO-100 trial: a servo bus takes goal positions at 30-50 Hz, and
+    trajectory.csv came at 1 kHz with no word on another rate): --rate 50 writes the rows
+    at k / 50 s over the whole motion, ramps included, each equal to the 1 kHz file's row
+    at the same instant (the samples the limits were checked on)."""
+    args = ["excite", "--robot", str(SO101), "--tip", "gripper_frame_link", *TINY, "--seed", "2"]
+    rows = {}
+    for rate in ("1000", "50"):
+        out = tmp_path / rate
+        assert main([*args, "--rate", rate, "--no-figures", "-q", "--out", str(out)]) == 0
+        rows[rate] = _csv(out / "trajectory.csv", 5)
+    t, q, dq, ddq = rows["50"]
+    total = rows["1000"][0][-1]
+    np.testing.assert_allclose(t, np.arange(round(total * 50) + 1) / 50, atol=1e-12)
+    at = np.searchsorted(rows["1000"][0], t - 1e-9)
+    for got, checked in zip((q, dq, ddq), rows["1000"][1:], strict=True):
+        np.testing.assert_allclose(got, checked[at], rtol=1e-9, atol=1e-12)
+    assert main([*args, "--rate", "0", "--out", str(tmp_path / "z")]) == 2

@@ -19,8 +19,8 @@ base frame by default, or planes and boxes from --obstacles FILE (JSON):
    "planes": [{"name": "table", "point": [0, 0, 0], "normal": [0, 0, 1]}],
    "boxes": [{"name": "fixture", "center": [0.5, 0, 0.1], "size": [0.2, 0.3, 0.2]}]}
 
-Writes DIR/trajectory.csv (t, q, dq, ddq at 1 kHz, for a position or velocity
-controller), DIR/trajectory.json (coefficients, limits, margins, obstacles, condition
+Writes DIR/trajectory.csv (t, q, dq, ddq at 1 kHz, or at --rate HZ, for a position or
+velocity controller), DIR/trajectory.json (coefficients, limits, margins, obstacles, condition
 numbers, the smallest margin to every limit and obstacle at 1 kHz) and
 DIR/excitation.png (joint motion and swept workspace). Seeded; about ten seconds for
 the Panda: on a terminal, progress lines tell the iterations (-v logs each one), and the
@@ -90,6 +90,7 @@ from ..io.excitation import save_excitation_json, save_trajectory_csv
 from ..model.robot import Robot
 from ..simulation.excitation import ExcitationOptions
 from ..workflows.excite import (
+    EXCITE_RATE_HZ,
     ExcitationDesign,
     design_excitation,
     loosened_note,
@@ -104,6 +105,7 @@ from .common import (
     load_drive_arg,
     load_robot,
     output_path,
+    positive_type,
     save_figure,
 )
 from .console import Console
@@ -197,6 +199,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--criterion", choices=("cond", "logdet"), default=d.criterion)
     p.add_argument("--max-iter", type=int, default=d.max_iter, help="optimiser iterations (60)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument(
+        "--rate",
+        type=positive_type,
+        default=EXCITE_RATE_HZ,
+        metavar="HZ",
+        help="sample rate of trajectory.csv [Hz] (1000): the rate the controller takes "
+        "set points at (a servo bus's goal positions at 50 Hz: --rate 50); the limits are "
+        "checked at 1 kHz whatever it is",
+    )
     p.add_argument(
         "--no-figures",
         "--no-figure",
@@ -351,8 +362,8 @@ def _joint(name: str, joints: tuple[str, ...], flag: str, symbol: str) -> int:
 
 def _save(args: argparse.Namespace, robot: Robot, design: ExcitationDesign) -> list[Path]:
     """trajectory.csv, trajectory.json and (unless --no-figure) excitation.png."""
-    res, samples = design.result, design.samples
-    written = [save_trajectory_csv(args.out / "trajectory.csv", samples)]
+    res = design.result
+    written = [save_trajectory_csv(args.out / "trajectory.csv", design.sampled(args.rate))]
     written.append(save_excitation_json(args.out / "trajectory.json", res, robot, seed=args.seed))
     if not args.no_figure:
         written += save_excitation_figure(args.out, robot, design)

@@ -105,6 +105,15 @@ class ExcitationDesign:
     obstacles_file: str | None = None
     elapsed_s: float = float("nan")
 
+    def sampled(self, fs: float = EXCITE_RATE_HZ) -> Any:
+        """The trajectory (``t, q, dq, ddq``) sampled at ``fs`` [Hz] over its whole
+        duration, ramps included: :attr:`samples` at :data:`EXCITE_RATE_HZ`, the rate of
+        the checks; another rate (a servo bus's 50 Hz goal positions) from the same series,
+        so every sample keeps the limits the checks found kept between them."""
+        if fs == EXCITE_RATE_HZ:
+            return self.samples
+        return self.result.trajectory.sample(fs)
+
     @property
     def admissible(self) -> bool:
         """Whether the trajectory keeps every limit and clearance."""
