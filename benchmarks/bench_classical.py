@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
         pinocchio_torque_regressor(pin, model, data, q[:500], dq[:500], ddq[:500]),
         atol=1e-9,
     )
-    ident = identify_from_log(robot, log)
+    ident = identify_from_log(robot, log, structure="classical", estimator="ols")
     held = random_fourier(robot, np.random.default_rng(2))(sample_times(10.0, args.rate))
     meas = simulate_measurement(robot, held, rng=np.random.default_rng(3), friction=None)
     pred = ident.torques(held.q, held.dq, held.ddq)
@@ -112,16 +112,21 @@ def main(argv: list[str] | None = None) -> int:
     N = log.n_samples
     kw = dict(min_time=args.min_time, repeats=args.repeats)
     ref = measure(lambda: pinocchio_torque_regressor(pin, model, data, q, dq, ddq), **kw)
-    end_to_end = measure(lambda: identify_from_log(robot, log), **kw)
-    every = measure(lambda: identify_from_log(robot, log, decimate=1), **kw)
-    every_model = identify_from_log(robot, log, decimate=1)
+    end_to_end = measure(
+        lambda: identify_from_log(robot, log, structure="classical", estimator="ols"), **kw
+    )
+    every = measure(
+        lambda: identify_from_log(robot, log, decimate=1, structure="classical", estimator="ols"),
+        **kw,
+    )
+    every_model = identify_from_log(robot, log, decimate=1, structure="classical", estimator="ols")
     regressor = measure(lambda: torque_regressor(robot, q, dq, ddq), **kw)
 
     def in_blocks() -> Any:
         old = os.environ.get("DYNID_MAX_STACK_BYTES")
         os.environ["DYNID_MAX_STACK_BYTES"] = "0"
         try:
-            return identify_from_log(robot, log, decimate=1)
+            return identify_from_log(robot, log, decimate=1, structure="classical", estimator="ols")
         finally:
             if old is None:
                 del os.environ["DYNID_MAX_STACK_BYTES"]
@@ -139,7 +144,12 @@ def main(argv: list[str] | None = None) -> int:
     motor_log = simulate_measurement(
         robot, traj, rng=np.random.default_rng(1), friction=None, drive=truth
     )
-    with_drive = measure(lambda: identify_from_log(robot, motor_log, drive=drive), **kw)
+    with_drive = measure(
+        lambda: identify_from_log(
+            robot, motor_log, drive=drive, structure="classical", estimator="ols"
+        ),
+        **kw,
+    )
     note = f"reference: Pinocchio regressor only, Python loop over the {len(q)} prepared samples"
     cases = [
         Case(f"identify_from_log, {args.duration:g} s log", N, end_to_end, ref, note=note),

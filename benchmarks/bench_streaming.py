@@ -69,7 +69,10 @@ def _timed(robot: dynid.Robot, log: object, limit: str | None, repeats: int) -> 
     try:
         if limit is not None:
             os.environ[_ENV] = limit
-        runs = [_cpu(lambda: identify_from_log(robot, log)) for _ in range(repeats)]
+        runs = [
+            _cpu(lambda: identify_from_log(robot, log, structure="classical", estimator="ols"))
+            for _ in range(repeats)
+        ]
     finally:
         os.environ.pop(_ENV, None)
         if old is not None:

@@ -62,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     ours, ref = measure_pair(
         lambda: identify_recordings(robot, [log]),
-        lambda: identify_from_log(robot, log),
+        lambda: identify_from_log(robot, log, structure="classical", estimator="ols"),
         min_time=args.min_time,
         repeats=args.repeats,
     )

@@ -41,7 +41,9 @@ def test_noise_free_identification_recovers_base_parameters_and_friction(panda, 
         friction=truth,
         with_ddq=True,
     )
-    model = identify_from_log(panda, log, cutoff_hz=None, base=torque_base)
+    model = identify_from_log(
+        panda, log, cutoff_hz=None, base=torque_base, structure="classical", estimator="ols"
+    )
     beta = torque_base.beta_from_phi(panda.phi)
     np.testing.assert_allclose(model.beta, beta, rtol=1e-6, atol=1e-9 * np.max(np.abs(beta)))
     np.testing.assert_allclose(model.friction.params, truth.as_array(), atol=1e-9)
@@ -61,7 +63,15 @@ def test_noise_free_identification_from_filtered_velocities(panda, torque_base):
         noise=SensorNoise.none(),
         friction=None,
     )
-    model = identify_from_log(panda, log, cutoff_hz=20.0, friction=False, base=torque_base)
+    model = identify_from_log(
+        panda,
+        log,
+        cutoff_hz=20.0,
+        friction=False,
+        base=torque_base,
+        structure="classical",
+        estimator="ols",
+    )
     beta = torque_base.beta_from_phi(panda.phi)
     # filtering bias only: relative error of the fit tiny, parameters within 1e-3 of scale
     assert model.fit.relative_error_percent < 0.01
@@ -78,7 +88,9 @@ def test_noisy_identification_predicts_held_out_torques_to_the_noise_level(panda
         rng=np.random.default_rng(36),
         friction=None,
     )
-    model = identify_from_log(panda, train, friction=True, base=torque_base)
+    model = identify_from_log(
+        panda, train, friction=True, base=torque_base, structure="classical", estimator="ols"
+    )
     held = random_fourier(panda, np.random.default_rng(37))(t)
     test = simulate_measurement(panda, held, rng=np.random.default_rng(38), friction=None)
     pred = model.torques(held.q, held.dq, held.ddq)
@@ -102,7 +114,9 @@ def test_identification_rejects_a_trajectory_that_does_not_excite(panda, torque_
         panda, traj, rng=np.random.default_rng(39), noise=SensorNoise.none(), with_ddq=True
     )
     with pytest.raises(RankDeficientError, match="rank"):
-        identify_from_log(panda, log, cutoff_hz=None, base=torque_base)
+        identify_from_log(
+            panda, log, cutoff_hz=None, base=torque_base, structure="classical", estimator="ols"
+        )
 
 
 def test_identification_rejects_a_log_of_another_robot(panda, torque_base):
@@ -110,7 +124,9 @@ def test_identification_rejects_a_log_of_another_robot(panda, torque_base):
     t = np.arange(10) * 0.01
     z = np.zeros((10, 3))
     with pytest.raises(ShapeError, match="log has 3 joints"):
-        identify_from_log(panda, TorqueLog(t, z, z, z), base=torque_base)
+        identify_from_log(
+            panda, TorqueLog(t, z, z, z), base=torque_base, structure="classical", estimator="ols"
+        )
 
 
 def test_friction_regressor_layout():

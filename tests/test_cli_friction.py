@@ -46,7 +46,9 @@ def workdir(tmp_path_factory, panda):
         )
         == 0
     )
-    model = identify_from_log(panda, load_torque_log(d / "fourier.npz"))
+    model = identify_from_log(
+        panda, load_torque_log(d / "fourier.npz"), structure="classical", estimator="ols"
+    )
     save_model_json(d / "identification.json", model, seed=1)
     assert (
         main(
@@ -268,7 +270,7 @@ def friction_demo():
     log = simulate_measurement(
         panda, series(sample_times(15.0)), rng=np.random.default_rng(52), friction=None
     )
-    model = identify_from_log(panda, log, friction=False)
+    model = identify_from_log(panda, log, friction=False, structure="classical", estimator="ols")
     return panda, friction_stage(model, seed=3)
 
 

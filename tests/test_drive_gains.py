@@ -156,7 +156,9 @@ def _heldout(panda, logs, drive):
     train, held = logs
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        model = identify_from_log(panda, train, drive=drive, validate_on=held)
+        model = identify_from_log(
+            panda, train, drive=drive, validate_on=held, structure="classical", estimator="ols"
+        )
         return heldout_torques(model, train, separate=held)
 
 
@@ -211,7 +213,7 @@ def test_validate_names_the_factor_of_a_model_identified_through_a_guess(
     save_torque_log(tmp_path / "held.csv", held)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        model = identify_from_log(panda, train, drive=guess)
+        model = identify_from_log(panda, train, drive=guess, structure="classical", estimator="ols")
         said = validate_files(model, tmp_path / "held.csv", ValidateOptions()).verdict.reason
     m = re.search(
         r"torque_constant of motor 2 looks [0-9.]+ times the true one: multiply it by ([0-9.]+)",

@@ -95,7 +95,9 @@ def test_classical_route_with_outliers_and_a_noisy_joint():
     spiky = TorqueLog(log.t, log.q, log.dq, tau, log.ddq)
     truth = base_parameters(robot, kind="torque").beta_from_phi(robot.phi)
     fits = {
-        name: identify_from_log(robot, spiky, cutoff_hz=None, decimate=1, estimator=name)
+        name: identify_from_log(
+            robot, spiky, cutoff_hz=None, decimate=1, estimator=name, structure="classical"
+        )
         for name in ("ols", "wls", "irls")
     }
     err = {k: np.linalg.norm(m.beta - truth) / np.linalg.norm(truth) for k, m in fits.items()}

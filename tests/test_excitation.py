@@ -171,7 +171,7 @@ def test_identification_along_the_optimised_trajectory_beats_a_random_fourier_on
         log = simulate_measurement(robot, tr, rng=np.random.default_rng(seed))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DynidWarning)
-            m = identify_from_log(robot, log, base=base)
+            m = identify_from_log(robot, log, base=base, structure="classical", estimator="ols")
         return np.sqrt(np.mean(((m.beta - truth) / np.maximum(np.abs(truth), 1e-3)) ** 2))
 
     for seed in (91, 92, 93):

@@ -100,9 +100,9 @@ def test_classical_route_streamed_equals_stacked(monkeypatch, estimator):
     log = simulate_measurement(
         robot, series(sample_times(40.0, 1000.0)), rng=np.random.default_rng(8)
     )
-    ref = identify_from_log(robot, log, estimator=estimator)
+    ref = identify_from_log(robot, log, estimator=estimator, structure="classical")
     monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")
-    got = identify_from_log(robot, log, estimator=estimator)
+    got = identify_from_log(robot, log, estimator=estimator, structure="classical")
     np.testing.assert_allclose(got.fit.beta, ref.fit.beta, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(got.fit.std, ref.fit.std, rtol=1e-9, atol=1e-14)
     np.testing.assert_allclose(got.friction.params, ref.friction.params, rtol=1e-9, atol=1e-12)

@@ -313,7 +313,9 @@ def test_no_event_on_collision_free_noisy_logs_with_an_identified_model():
         traj = series(uniform_times(duration, 1000.0))
         return simulate_measurement(robot, traj, rng=rng, noise=noise, contacts=contacts)
 
-    model = from_identified(identify_from_log(robot, log_of(10, 16.0)))
+    model = from_identified(
+        identify_from_log(robot, log_of(10, 16.0), structure="classical", estimator="ols")
+    )
     model = model.with_friction(from_robot(robot).friction)  # the simulated friction
     opts = ObserverOptions(gain=30.0)
     cal = log_of(11)

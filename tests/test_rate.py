@@ -99,8 +99,15 @@ def test_a_5_khz_log_uses_more_samples_and_predicts_better_than_the_fixed_5_hz()
         pred = model.torques(q, dq, ddq) + fr.torques(dq)
         return float(np.linalg.norm(pred - tau) / np.linalg.norm(tau))
 
-    fixed = identify_from_log(robot, log, cutoff_hz=5.0, decimate=auto_decimation(5000.0, 5.0))
-    auto = identify_from_log(robot, log)
+    fixed = identify_from_log(
+        robot,
+        log,
+        cutoff_hz=5.0,
+        decimate=auto_decimation(5000.0, 5.0),
+        structure="classical",
+        estimator="ols",
+    )
+    auto = identify_from_log(robot, log, structure="classical", estimator="ols")
     la, lf = auto.info.log, fixed.info.log
     assert la is not None and lf is not None
     assert la.cutoff_source == "motion" and la.cutoff_hz is not None and 10 <= la.cutoff_hz <= 20

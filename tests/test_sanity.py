@@ -133,7 +133,7 @@ def test_identification_refuses_a_flipped_sign_before_fitting(panda_log):
     itself would succeed, with negated masses (it warned and returned that model)."""
     flipped = TorqueLog(panda_log.t, panda_log.q, panda_log.dq, -panda_log.tau)
     with pytest.raises(DataError, match=r"anti-correlated.*--units tau=-1"):
-        identify_from_log(dynid.panda(), flipped)
+        identify_from_log(dynid.panda(), flipped, structure="classical", estimator="ols")
 
 
 @pytest.mark.filterwarnings("ignore:.*indistinguishable from zero")  # expected: weak coefficients
@@ -154,7 +154,7 @@ def test_a_frozen_joint_gets_no_friction_fitted_from_noise():
     )
     log = simulate_measurement(robot, frozen, rng=np.random.default_rng(5))
     with pytest.warns(DynidWarning, match="never leave their velocity noise band"):
-        m = identify_from_log(robot, log)
+        m = identify_from_log(robot, log, structure="classical", estimator="ols")
     r = m.base.rank
     kept = np.asarray(m.joint_fit.kept[r:]).reshape(7, 3)
     assert not kept[3, 0] and not kept[3, 1] and kept[3, 2]

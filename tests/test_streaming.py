@@ -173,7 +173,7 @@ def test_a_filtered_log_read_in_blocks_equals_the_log_stacked(monkeypatch, decim
     robot = dynid.panda()
     traj = random_fourier(robot, np.random.default_rng(3))(sample_times(12.0, 1000.0))
     log = simulate_measurement(robot, traj, rng=np.random.default_rng(4))
-    kw = {"decimate": decimate, "cutoff_hz": 20.0}
+    kw = {"decimate": decimate, "cutoff_hz": 20.0, "structure": "classical", "estimator": "ols"}
     ref = identify_from_log(robot, log, **kw)
     monkeypatch.setenv("DYNID_MAX_STACK_BYTES", "0")  # 12 000 samples: 3 blocks of rows
     monkeypatch.setattr(log_rows, "STEP_SPAN", 700)  # a span of stepping columns per block

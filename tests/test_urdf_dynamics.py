@@ -189,8 +189,10 @@ def test_identify_does_not_read_the_robots_friction(tmp_path):
         noise=SensorNoise.none(),
         with_ddq=True,
     )
-    a = identify_from_log(robot, log, cutoff_hz=None)
-    b = identify_from_log(robot.with_friction(None), log, cutoff_hz=None)
+    a = identify_from_log(robot, log, cutoff_hz=None, structure="classical", estimator="ols")
+    b = identify_from_log(
+        robot.with_friction(None), log, cutoff_hz=None, structure="classical", estimator="ols"
+    )
     np.testing.assert_array_equal(a.fit.beta, b.fit.beta)
     np.testing.assert_allclose(a.frictions[0].params[:, :2], np.c_[FV, FC], atol=1e-6)
 

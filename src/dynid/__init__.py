@@ -9,7 +9,8 @@ The pipeline, in the order data flows (each name is re-exported here):
 * regressors: :func:`torque_regressor`, :func:`static_regressor`, :func:`base_parameters`,
   :func:`identifiability`
 * identification: :func:`identify_static` (Gaz et al. 2019, Sec. IV-A),
-  :func:`identify_from_log` (classical route), :class:`IdentifiedModel`
+  :func:`identify_from_log` (a torque log: its terms chosen on held-out data, as ``dynid
+  identify`` chooses them), :class:`IdentifiedModel`
 * friction: :func:`fit_friction`, :func:`sigmoid_friction`, :func:`validate_torques`
 * simulation: trajectories (:func:`sinusoid_trajectory`, :func:`random_fourier`,
   :func:`check_limits`), :class:`SimulatedController`, :func:`acquire_static`,

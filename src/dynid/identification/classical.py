@@ -28,8 +28,9 @@ on the real Panda.
 
 A single log is one recording of :func:`~dynid.identification.selection.identify_recordings`
 (:func:`identify_from_log`): prepared, judged on held-out data (the torques as measured)
-and, with ``structure="auto"``, its terms chosen exactly as ``dynid identify`` does on the
-log's file; by default with the terms above (:func:`classical_structure`).
+and, by default (``structure="auto"``, ``estimator="auto"``), its terms and its estimator
+chosen exactly as ``dynid identify`` chooses them on the log's file; with
+``structure="classical"`` the terms above (:func:`classical_structure`).
 """
 
 from __future__ import annotations
@@ -99,7 +100,7 @@ def identify_from_log(
     robot: Robot,
     log: TorqueLog,
     *,
-    structure: Structure | Literal["auto"] | None = None,
+    structure: Structure | Literal["auto", "classical"] = "auto",
     cutoff_hz: float | Literal["auto"] | None = "auto",
     trim_s: float | None = None,
     max_gap_s: float | None = None,
@@ -109,7 +110,7 @@ def identify_from_log(
     base: BaseParameters | None = None,
     rtol: float | None = None,
     drive: Drive | None = None,
-    estimator: EstimatorName | Estimator = "ols",
+    estimator: EstimatorName | Estimator | Literal["auto"] = "auto",
     std: StdMethod = "hac",
     folds: int = DEFAULT_FOLDS,
     validate_on: TorqueLog | None = None,
@@ -124,24 +125,29 @@ def identify_from_log(
         Kinematics and gravity; its inertial parameters are not used.
     log : TorqueLog
         Measured ``t``, ``q``, ``dq``, ``tau`` (``ddq`` optional) of an exciting trajectory.
-    structure : Structure, "auto" or None
-        The terms beside the links: None (default) those of :func:`classical_structure`
-        (``friction`` says whether with the classical friction); ``"auto"`` chosen on
-        held-out data (:func:`~dynid.identification.selection.select_structure`), as
-        ``dynid identify`` chooses them without ``--terms``; or the terms given.
+    structure : Structure, "auto" or "classical"
+        The terms beside the links: ``"auto"`` (default) chosen on held-out data
+        (:func:`~dynid.identification.selection.select_structure`: rotor inertias,
+        friction laws and their parts), as ``dynid identify`` chooses them without
+        ``--terms``; ``"classical"`` those of :func:`classical_structure` (``friction``
+        says whether with the classical friction), ``dynid identify --terms
+        viscous,coulomb,offset``; or the terms given.
     cutoff_hz : float, "auto" or None
         Zero-phase low-pass cutoff [Hz] (:func:`~dynid.identification.prepare.prepare_log`);
         ``"auto"`` (default) reads it from the motion
         (:func:`~dynid.identification.trim.common_cutoff`); None for noise-free data
         (then ``ddq`` of the log is used if present, else differentiated).
-    trim_s, max_gap_s, decimate, max_std_percent, rtol, drive, estimator, std, folds
+    trim_s, max_gap_s, decimate, max_std_percent, rtol, drive, std, folds
         As :func:`~dynid.identification.selection.identify_recordings` (``folds``: the
         contiguous time blocks of the held-out judgement).
+    estimator : {"auto", "ols", "wls", "irls"} or Estimator
+        ``"auto"`` (default): ordinary or weighted least squares chosen on the held-out
+        folds, as ``dynid identify`` chooses (:mod:`~dynid.identification.estimator_choice`).
     friction : bool
-        With ``structure`` None: identify ``fv, fc, fo`` per joint together with the base
-        parameters. False with a ``structure`` given is refused.
+        With ``structure="classical"``: identify ``fv, fc, fo`` per joint together with
+        the base parameters. False with another structure is refused.
     base : BaseParameters, optional
-        Base parameters to use with a structure given or the default one; default
+        Base parameters to use with a structure given or the classical one; default
         ``base_parameters(robot, kind="torque")`` of its terms.
     validate_on : TorqueLog, optional
         A separate recording (same joints, read the same way) that the held-out error is
@@ -151,9 +157,10 @@ def identify_from_log(
     -------
     IdentifiedModel
         ``fit`` holds the ``r`` base parameters (with the statistics of the whole fit:
-        condition number, relative error, sigma); the terms (``friction`` with ``fv, fc,
-        fo`` per joint by default); ``info`` the preparation (``info.log``), the held-out
-        errors on the torques as measured (``info.heldout``), the structure chosen
+        condition number, relative error, sigma); the terms (``rotor_inertia``,
+        ``friction`` of the law chosen; ``friction`` with ``fv, fc, fo`` per joint with
+        ``"classical"``); ``info`` the preparation (``info.log``), the held-out errors on
+        the torques as measured (``info.heldout``), the structure chosen
         (``info.selection``, with ``"auto"``); ``holdout`` the folds' normal equations.
 
     Raises
@@ -163,8 +170,9 @@ def identify_from_log(
     DataError
         From the preparation of the log (gaps, too short, bad cutoff).
     OptionError
-        ``friction=False`` with a structure given; ``base`` with ``structure="auto"``;
-        an armature asked with known rotor inertias.
+        ``friction=False`` with a structure other than ``"classical"``; ``base`` with
+        ``structure="auto"``; an armature asked with known rotor inertias; a
+        ``structure`` that is none of the above.
     RankDeficientError
         The trajectory does not excite every base parameter (and friction column); the
         message names the nearly dependent columns.
@@ -176,12 +184,18 @@ def identify_from_log(
         (:func:`~dynid.identification.least_squares.conditioning_advice`); identified
         friction that is not dissipative.
     """
-    if structure is not None and not friction:
-        raise OptionError("friction=False applies to the default structure; give the terms")
+    if not isinstance(structure, Structure) and structure not in ("auto", "classical"):
+        raise OptionError(
+            f"must be 'auto', 'classical' or a Structure; got {structure!r}", field="structure"
+        )
+    if structure != "classical" and not friction:
+        raise OptionError(
+            "friction=False applies to structure='classical'; give the terms (a Structure)"
+        )
     return identify_recordings(
         robot,
         [log],
-        structure=classical_structure(drive, friction) if structure is None else structure,
+        structure=classical_structure(drive, friction) if structure == "classical" else structure,
         cutoff_hz=cutoff_hz,
         trim_s=trim_s,
         max_gap_s=max_gap_s,

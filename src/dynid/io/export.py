@@ -13,16 +13,18 @@
 
 URDF holds no spring: its export says, in a warning and a comment, that it leaves it out.
 
-:func:`save_robot` picks the format by ``format`` or the file suffix; :func:`save_robot_files`
-writes one file per format into an output folder. ``dynid export`` (its ``--format``
-choices), ``dynid retrieve`` and ``identify --consistent`` read this table, so a new format
-is a module and a line here.
+:func:`save_robot` picks the format by ``format`` or the file suffix, and writes a consistent
+fit's result (friction, rotor inertias, caveats) as the output folders do;
+:func:`save_robot_files` writes one file per format into an output folder. ``dynid export``
+(its ``--format`` choices), ``dynid retrieve`` and ``identify --consistent`` read this
+table, so a new format is a module and a line here.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..exceptions import DataError
 from ..friction.model import Friction, FrictionSum
@@ -32,6 +34,9 @@ from .robot.export_options import ExportOptions, RobotFormat
 from .robot.mjcf import export_mjcf
 from .robot.toml import export_toml
 from .robot.urdf import export_urdf
+
+if TYPE_CHECKING:
+    from ..feasibility.result import FeasibleResult
 
 __all__ = [
     "EXPORT_FORMATS",
@@ -84,7 +89,7 @@ def export_format(path: str | Path, format: str | None = None) -> str:
 
 def save_robot(
     path: str | Path,
-    robot: Robot,
+    robot: Robot | FeasibleResult,
     *,
     format: str | None = None,
     template: str | Path | None = None,
@@ -97,10 +102,23 @@ def save_robot(
 ) -> Path:
     """Write ``robot`` in one of :data:`ROBOT_FORMATS`; returns the path.
 
+    Given a consistent fit's result (a :class:`~dynid.feasibility.result.FeasibleResult`
+    of :func:`~dynid.feasibility.convex.fit.retrieve_sdp`,
+    :func:`~dynid.feasibility.convex.fit.identify_consistent` or
+    :func:`~dynid.feasibility.penalty.fit.retrieve`), the file is written as ``dynid
+    retrieve`` writes its robot files (:func:`~dynid.io.feasible_export.result_export`):
+    the friction identified with the links (offsets included where the format holds
+    them), the drive's rotor inertias (MJCF ``armature``, the TOML ``[drive]`` table), and
+    what the format cannot hold said in a warning (a URDF's armature by joint, with its
+    share of the joint's inertia; a friction offset) and at the top of the file. A
+    :class:`~dynid.model.robot.Robot` alone (``result.robot``) holds no rotor inertia and
+    no identified friction: its file has only the links and the robot's own friction.
+
     Parameters
     ----------
     path : str or Path
-    robot : Robot
+    robot : Robot or FeasibleResult
+        The robot, or a consistent fit's result (above).
     format : str, optional
         A name of :data:`ROBOT_FORMATS` (``"urdf"``, ``"mjcf"``, ``"toml"``). Default:
         from the suffix of ``path``.
@@ -109,10 +127,12 @@ def save_robot(
     friction : bool or Friction
         MJCF: the robot's friction, identified classical friction (at the joints or the
         motors), or none (:func:`dynid.io.robot.mjcf.save_mjcf`); URDF chain: identified
-        classical friction as ``<dynamics damping friction>``.
+        classical friction as ``<dynamics damping friction>``. True with a result: the
+        friction identified with the links (else the robot's own).
     drive : Drive, optional
         MJCF: a drive with known rotor inertias, written as ``armature``; TOML: the drive
-        as a ``[drive]`` table.
+        as a ``[drive]`` table; URDF: its rotor inertias named in a warning. Default with
+        a result: the result's drive.
 
     Raises
     ------
@@ -124,6 +144,14 @@ def save_robot(
     fmt = ROBOT_FORMATS[export_format(path, format)]
     if template is not None and not fmt.template:
         raise DataError(f"a URDF template applies to the urdf format only; got format {fmt.name!r}")
+    caveat = None
+    if not isinstance(robot, Robot):  # a consistent fit's result: as its output folder
+        from .feasible_export import result_export
+
+        robot, fitted = result_export(robot)
+        friction = fitted.friction if friction is True else friction
+        drive = fitted.drive if drive is None else drive
+        caveat = fitted.caveat
     options = ExportOptions(
         template=None if template is None else Path(template),
         base=base,
@@ -132,6 +160,7 @@ def save_robot(
         friction=friction,
         all_frames=all_frames,
         drive=drive,
+        caveat=caveat,
     )
     return fmt.save(path, robot, options)
 

@@ -8,35 +8,24 @@ feasible stage. The robots carry the friction of the fitted model
 motors, or both), none when it fitted a torque log without friction, else the input robot's.
 Rotor inertias the identified structure left out while it kept others are 0 in the robot
 files: one note names their joints, and each file says so at its top
-(:func:`~dynid.io.feasible.armature_left_out_note`).
+(:func:`~dynid.io.feasible.armature_left_out_note`). The robot files are written by the
+rule :func:`dynid.io.export.save_robot` of the result follows too
+(:func:`~dynid.io.feasible_export.result_export`).
 """
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from ..feasibility.result import FeasibleResult
-from ..identification.structural import combined_notes
-from ..progress import NOTE
-from .export import ROBOT_FORMATS, ExportOptions, save_robot_files
-from .feasible import (
-    armature_left_out,
-    armature_left_out_note,
-    combined_coefficients,
-    fitted_robot,
-    rejection_caveat,
-    result_rejection,
-    save_feasible_json,
-    unknown_scale_caveat,
-)
+from .export import ROBOT_FORMATS, save_robot_files
+from .feasible import save_feasible_json
+from .feasible_export import result_export
 from .report_json import save_report_json
 
 __all__ = ["FEASIBLE_BUNDLE", "save_feasible_bundle"]
-
-_log = logging.getLogger(__name__)
 
 #: The files :func:`save_feasible_bundle` writes, in order: feasible.json, one robot file
 #: per export format (:data:`~dynid.io.export.ROBOT_FORMATS`: robot.urdf, robot.xml,
@@ -89,22 +78,9 @@ def save_feasible_bundle(
     folder = Path(folder)
     recorded = {"column_map": column_map, "unknown_scale": unknown_scale}
     files = [save_feasible_json(folder / "feasible.json", result, **recorded)]
-    friction: Any = True if result.friction is None else result.friction
-    reason = result_rejection(result)
-    notes = combined_notes(combined_coefficients(result))  # not the motors' own friction alone
-    caveats = ([] if reason is None else [rejection_caveat(reason)]) + list(notes[:1])
-    if unknown_scale is not None:
-        caveats.append(unknown_scale_caveat(str(unknown_scale.get("finding", ""))))
-    robot = fitted_robot(result)
-    left = armature_left_out_note(robot.joint_names, result.drive, armature_left_out(result))
-    if left is not None:  # one note for the three robot files, and a line atop each
-        _log.log(NOTE, "robot files: %s", left)
-        caveats.append(left)
-    options = ExportOptions(
-        friction=friction,
-        drive=result.drive,
-        source=files[0].name,
-        caveat="; ".join(caveats) if caveats else None,
+    finding = None if unknown_scale is None else str(unknown_scale.get("finding", ""))
+    robot, options = result_export(
+        result, unknown_scale=finding, source=files[0].name, said="robot files"
     )
     files += save_robot_files(folder, robot, options)
     files.append(save_report_json(folder / "report.json", result, **report_extra))

@@ -19,12 +19,11 @@ from .._parallel import available_cores
 from ..exceptions import DynidError, OptionError
 from ..feasibility.bounds import Bounds, default_bounds
 from ..feasibility.convex import DEFAULT_SDP_MARGIN, SDPOptions
-from ..feasibility.determined import determined_by_data
 from ..feasibility.methods import METHODS
 from ..feasibility.methods import method as consistent_method
 from ..feasibility.penalty import RetrievalOptions, RetrievalProgress
 from ..feasibility.result import FeasibleResult
-from ..friction.model import FrictionModel, combined, through_drive
+from ..friction.model import FrictionModel, combined
 from ..identification.core import shared_bases
 from ..identification.model import IdentifiedModel
 from ..identification.static_flange import data_flange_note, model_flange_note
@@ -42,7 +41,6 @@ __all__ = [
     "RetrieveOptions",
     "load_bounds_for",
     "load_model_with_friction",
-    "with_model_friction",
     "retrieve_files",
 ]
 
@@ -76,22 +74,6 @@ def _with_friction(robot: Robot, path: str | Path | None) -> Robot:
             field="friction",
         )
     return robot.with_friction(fr)
-
-
-def with_model_friction(result: FeasibleResult, model: IdentifiedModel) -> FeasibleResult:
-    """``result`` (links retrieved from ``model``'s coefficients) with the friction
-    identified with the links beside them, unchanged (the retrieval fits the links alone),
-    and the model's drive, so that its files predict the model's torques: a torque-log
-    identification's friction was left out of ``feasible.json`` and ``robot.toml``. Its
-    spring (stiffnesses beside the links) likewise, unchanged."""
-    if result.spring is None and model.spring is not None:
-        result = replace(result, spring=model.spring)
-    fr = combined(model.frictions)
-    if result.friction is not None or fr is None:
-        return result
-    drive = result.drive or model.drive
-    # at the motors, through the result's drive: its rotor inertias the identified ones
-    return replace(result, friction=fr if drive is None else through_drive(fr, drive), drive=drive)
 
 
 def load_model_with_friction(
@@ -360,8 +342,7 @@ def retrieve_files(
     }
     given = prior if opt.prior is not None else None
     if kind == "model":
-        result = with_model_friction(m.from_coefficients(model, **common), model)
-        result = replace(result, determined=result.determined or determined_by_data(model))
+        result = m.from_coefficients(model, **common)  # with the model's friction, drive
         hand = model_flange_note(model, given) if _static_route(model) else None
         return Retrieval(_noted(result, hand), tuple(notes), model.info.column_map)
     hand = data_flange_note(robot, data.q, data.g, given)

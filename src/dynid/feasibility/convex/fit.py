@@ -50,6 +50,7 @@ from ...model.robot import Robot
 from ...progress import stage
 from ..bounds import Bounds
 from ..determined import Determined, determined_by_data
+from ..identified_terms import with_identified_terms
 from ..prior import Prior
 from ..prior_share import prior_share
 from .data_term import DataTerm, coefficient_term
@@ -80,7 +81,12 @@ def retrieve_sdp(
 
     The coefficients' full covariance weighs the data term (``model.fit.covariance``);
     exact coefficients are met exactly. Parameters as in :func:`solve_consistent`; the
-    result's robot carries ``model.robot``'s kinematics and friction.
+    result's robot carries ``model.robot``'s kinematics and friction. What the model
+    identified beside the links is carried unchanged
+    (:func:`~dynid.feasibility.identified_terms.with_identified_terms`): ``friction`` (its
+    law, offsets included), ``rotor_inertia`` and ``drive`` (the rotor inertias retrieved
+    with the links), ``spring``. :func:`dynid.io.export.save_robot` of the result (not of
+    ``result.robot`` alone) writes them, or says what a format cannot hold.
 
     Examples
     --------
@@ -106,7 +112,8 @@ def retrieve_sdp(
         rotor_inertia=_rotor_inertia(model, res.rotor_inertia),
         determined=determined_with_share(model, term, res),
     )
-    return res if model.drive is None else with_drive(res, model.drive)
+    res = res if model.drive is None else with_drive(res, model.drive)
+    return with_identified_terms(res, model)  # friction, offsets, springs: as identified
 
 
 def with_drive(res: ConsistentResult, drive: Drive) -> ConsistentResult:

@@ -17,6 +17,7 @@ from ...identification.model import IdentifiedModel
 from ...model.robot import Robot
 from ...regressors.base import BaseParameters
 from ..bounds import Bounds, default_bounds
+from ..identified_terms import with_identified_terms
 from .algorithm import solve
 from .objective import (
     PenaltyProblem,
@@ -169,7 +170,10 @@ def retrieve(
     Matches the model's kept coefficients ``fit.beta[fit.kept]``, each scaled by
     ``max(|beta_k|, std_k, floor)`` (``use_std=False`` ignores the standard deviations);
     pruned coefficients are ignored. See :func:`retrieve_from_coefficients` for the
-    parameters, the result and the errors.
+    parameters, the result and the errors. The model's friction (offsets included),
+    springs and drive are carried unchanged onto the result
+    (:func:`~dynid.feasibility.identified_terms.with_identified_terms`), which
+    :func:`dynid.io.export.save_robot` of the result writes.
 
     Examples
     --------
@@ -189,7 +193,7 @@ def retrieve(
             "rotor inertias with them (a drive); use the convex method (--method sdp), which "
             "identifies them with the links (>= 0)"
         )
-    return retrieve_from_coefficients(
+    res = retrieve_from_coefficients(
         model.robot,
         model.base,
         model.fit.beta,
@@ -205,6 +209,7 @@ def retrieve(
         require_feasible=require_feasible,
         prior=prior,
     )
+    return with_identified_terms(res, model)
 
 
 def retrieve_from_static(
