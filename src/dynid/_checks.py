@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .exceptions import DynidError, NonFiniteError, ShapeError
+from .exceptions import DynidError, NonFiniteError, ShapeError, WrongTypeError
 
 #: arrays up to this size are checked element by element in Python (a numpy reduction
 #: costs about 2 us whatever the size, the Python loop 40 ns an element)
@@ -36,13 +36,80 @@ def finite(name: str, x: NDArray[np.float64]) -> None:
         )
 
 
+def type_name(value: Any) -> str:
+    """The type of ``value`` as a message names it (``dict``, ``ndarray of complex128``,
+    ``None``)."""
+    if isinstance(value, np.ndarray):
+        return f"ndarray of {value.dtype}"
+    return "None" if value is None else type(value).__name__
+
+
+def wrong_type(name: str, value: Any, expected: str) -> WrongTypeError:
+    """The one-line :class:`WrongTypeError` of an argument: ``"{name}: expected
+    {expected}, got {type}"``."""
+    return WrongTypeError(f"{name}: expected {expected}, got {type_name(value)}")
+
+
+def of_type(name: str, value: Any, kind: type | tuple[type, ...], expected: str) -> Any:
+    """``value`` when it is an instance of ``kind``.
+
+    Raises
+    ------
+    WrongTypeError
+        It is not (:func:`wrong_type`).
+    """
+    if not isinstance(value, kind):
+        raise wrong_type(name, value, expected)
+    return value
+
+
+def one_or_many(name: str, value: Any, kind: type, expected: str) -> list[Any]:
+    """``value`` as a list of ``kind``: one instance, or a list or tuple of them.
+
+    Raises
+    ------
+    WrongTypeError
+        ``value`` is neither, or an item is not an instance (named by its index).
+    """
+    if isinstance(value, kind):
+        return [value]
+    if not isinstance(value, list | tuple):
+        raise wrong_type(name, value, expected)
+    for i, item in enumerate(value):
+        if not isinstance(item, kind):
+            raise WrongTypeError(
+                f"{name}: expected {expected}, got a {type(value).__name__} holding "
+                f"{type_name(item)} at index {i}"
+            )
+    return list(value)
+
+
+#: what an array argument must be
+_REAL = "a real numeric array_like"
+
+
 def as_array(name: str, x: ArrayLike, *, allow_nonfinite: bool = False) -> NDArray[np.float64]:
-    """Convert to a float64 array (a copy when needed) and check finiteness."""
-    if x is None:  # numpy would read None as NaN
-        raise ShapeError(f"{name} must be numeric array_like; got None")
+    """Convert to a float64 array (a copy when needed) and check finiteness.
+
+    Raises
+    ------
+    WrongTypeError
+        ``x`` is None, text, complex or of no numeric type.
+    ShapeError
+        ``x`` does not form an array (ragged nested sequences).
+    NonFiniteError
+        ``x`` holds NaN or infinity (unless ``allow_nonfinite``).
+    """
+    if x is None or isinstance(x, str | bytes | complex):  # numpy reads None as NaN
+        raise wrong_type(name, x, _REAL)
+    if isinstance(x, np.ndarray | np.generic) and x.dtype.kind not in "biuf":
+        if x.dtype.kind == "c" or x.dtype.kind in "USV":  # cast silently / not numbers
+            raise wrong_type(name, x, _REAL)
     try:
         a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
+    except TypeError as exc:
+        raise wrong_type(name, x, _REAL) from exc
+    except ValueError as exc:
         raise ShapeError(f"{name} must be numeric array_like; got {type(x).__name__}") from exc
     if not allow_nonfinite:
         finite(name, a)

@@ -276,3 +276,10 @@ def _finite_rows(name: str, a: NDArray[np.float64]) -> None:
         f"{name} must be finite; got {a[tuple(bad)]} in row {s}{where} ({rows} row(s) in all); "
         "hint: drop the invalid rows when loading (drop_invalid=True)"
     )
+
+
+#: How a message says what a static data argument must be.
+STATIC_EXPECTED = (
+    "a StaticDataset (dynid.acquire_static(controller), or StaticDataset(q, M, g); "
+    "a file: dynid.io.static_data.load_static_data)"
+)

@@ -616,3 +616,21 @@ def mdh_transform(a: float, d: float, alpha: float, theta: float) -> NDArray[np.
             [0.0, 0.0, 0.0, 1.0],
         ]
     )
+
+
+#: How a message says what a ``robot`` argument must be.
+ROBOT_EXPECTED = "a Robot (dynid.panda(), Robot.from_urdf(...), Robot.from_mdh(...))"
+
+
+def checked_robot(robot: object, name: str = "robot") -> Robot:
+    """``robot`` when it is a :class:`Robot`: the check of a public function's robot
+    argument at its entry.
+
+    Raises
+    ------
+    WrongTypeError
+        It is not (``"robot: expected a Robot (...), got str"``).
+    """
+    if not isinstance(robot, Robot):
+        raise _checks.wrong_type(name, robot, ROBOT_EXPECTED)
+    return robot

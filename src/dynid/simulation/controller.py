@@ -37,7 +37,7 @@ from ..dynamics.terms import gravity_torques, mass_matrix
 from ..exceptions import LimitError, OptionError
 from ..identification.data import StaticDataset
 from ..model.panda import panda
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from .trajectories import MAX_SAMPLES
 from .unmodelled import UnmodelledEffects
 
@@ -158,6 +158,7 @@ def sample_configurations(
     LimitError
         A joint's range is not wider than ``2 margin``.
     """
+    checked_robot(robot)
     if int(n) != n or n < 1:
         raise OptionError(f"n must be a positive integer; got {n}")
     if n * robot.n > MAX_SAMPLES:
