@@ -10,8 +10,8 @@ import json
 import math
 import re
 import unicodedata
-from collections.abc import Iterable
-from typing import Any
+from collections.abc import Iterable, Iterator, Mapping
+from typing import Any, Generic, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -164,6 +164,49 @@ def frozen(a: NDArray[Any]) -> NDArray[Any]:
         b.setflags(write=False)
         return b
     return np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)
+
+
+_K = TypeVar("_K")
+_V = TypeVar("_V")
+
+
+class FrozenMapping(Mapping[_K, _V], Generic[_K, _V]):
+    """A read-only mapping (a copy of the one given) that pickles and copies.
+
+    It stands where a frozen result holds a mapping (an identified model's terms, a
+    robot's frames, a data set's metadata): :class:`types.MappingProxyType` is read-only
+    too but cannot be pickled or deep-copied, so neither could the results holding one
+    (no ``multiprocessing``, no ``copy.deepcopy``).
+    """
+
+    __slots__ = ("_items",)
+    _items: dict[_K, _V]
+
+    def __init__(self, items: Mapping[_K, _V] | Iterable[tuple[_K, _V]] = ()) -> None:
+        object.__setattr__(self, "_items", dict(items))
+
+    def __getitem__(self, key: _K) -> _V:
+        return self._items[key]
+
+    def __iter__(self) -> Iterator[_K]:
+        return iter(self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"{type(self).__name__} is read-only")
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._items!r})"
+
+    def __reduce__(self) -> tuple[Any, tuple[dict[_K, _V]]]:
+        return type(self), (dict(self._items),)
+
+
+def frozen_mapping(items: Mapping[_K, _V]) -> FrozenMapping[_K, _V]:
+    """``items`` as a :class:`FrozenMapping`: itself when it is one, else a read-only copy."""
+    return items if isinstance(items, FrozenMapping) else FrozenMapping(items)
 
 
 #: Longest echo of a user's input in an error message [characters]: a value, a key or a

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from types import MappingProxyType
 from typing import Any, Literal
 
 import numpy as np
@@ -105,7 +104,7 @@ class StaticDataset:
         put("q", _checks.frozen(q))
         put("M", _checks.frozen(M))
         put("g", _checks.frozen(g))
-        put("metadata", MappingProxyType(dict(self.metadata)))
+        put("metadata", _checks.frozen_mapping(dict(self.metadata)))
         put("symmetry_rtol", float(self.symmetry_rtol))
 
     @property

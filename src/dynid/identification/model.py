@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -122,7 +121,7 @@ def _terms_mapping(terms: Mapping[str, IdentifiedTerm]) -> Mapping[str, Identifi
     for key, t in terms.items():
         if key != t.term.name:
             raise ShapeError(f"terms: key {key!r} holds the term named {t.term.name!r}")
-    return MappingProxyType(dict(terms))
+    return _checks.frozen_mapping(dict(terms))
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -23,7 +23,6 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -75,7 +74,7 @@ def _fixed_frames(frames: Mapping[str, Frame]) -> Mapping[str, Frame]:
         joint = None if f.joint is None else str(f.joint)
         out[str(k)] = Frame(int(f.link), _checks.frozen(T), joint)
     _check_names("joint", [f.joint for f in out.values() if f.joint is not None])
-    return MappingProxyType(out)
+    return _checks.frozen_mapping(out)
 
 
 def _check_names(kind: str, names: Sequence[str]) -> None:
