@@ -59,6 +59,8 @@ FLAGS: dict[str, str] = {
     "total_mass_band": "--no-total-mass",
     "radii": "--radius",
     "ranges": "--range",
+    "base_link": "--base",
+    "tip_link": "--tip",
 }
 
 
@@ -111,11 +113,20 @@ def import_robot(message: str, args: argparse.Namespace, given: frozenset[str]) 
 
 
 def cli_text(message: str) -> str:
-    """A library message as the command line says it: a Python option in a hint,
-    ``(drop_invalid=True)``, becomes its flag, and a flag the message already names is
-    not repeated (``pass --drop-invalid (drop_invalid=True)`` -> ``pass --drop-invalid``)."""
+    """A library message as the command line says it: a Python option in a hint becomes
+    its flag (:func:`flag`): a switch, ``drop_invalid=True`` (also in parentheses), and an
+    option of a value, ``max_std_percent=...`` (``hint: max_std_percent=... removes
+    them`` -> ``hint: --max-std-percent removes them``); a flag the message already names
+    is not repeated (``pass --drop-invalid (drop_invalid=True)`` -> ``pass
+    --drop-invalid``)."""
     out = re.sub(r"\((\w+)=True\)", lambda m: f"({flag(m.group(1))})", message)
+    out = _PYTHON_OPTION.sub(lambda m: flag(m.group(1)), out)
     return re.sub(r"(--[\w-]+) \(\1\)", r"\1", out)
+
+
+#: A Python option named in a library message: ``name=True`` or ``name=...`` (a word
+#: standing alone: not an attribute's or a longer name's end, nor after ``,`` or ``=``)
+_PYTHON_OPTION = re.compile(r"(?<![\w.,=])([a-z]\w*)=(?:True\b|\.\.\.)")
 
 
 def flag(field: str) -> str:
