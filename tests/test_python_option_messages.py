@@ -1,16 +1,21 @@
-"""The library's messages name Python arguments; the command line says the same messages
-with its flags (``cli_text``)."""
+"""The library's messages name Python arguments and print numbers plainly; the command line
+says the same messages with its flags (``cli_text``)."""
 
 import logging
 import warnings
 
+import numpy as np
 import pytest
 
 import dynid
+from dynid._checks import short
 from dynid.cli.__main__ import _signals_and_warnings
 from dynid.cli.common import cli_text
 from dynid.cli.console import Console, LogFormat
-from dynid.exceptions import DynidWarning, ModelError
+from dynid.exceptions import DataError, DynidWarning, ModelError
+from dynid.observer.model import from_robot
+from dynid.observer.residual import MomentumObserver
+from dynid.simulation.contact import Contact
 
 LINK = (
     '<link name="{0}"><inertial><mass value="1"/>'
@@ -80,3 +85,28 @@ def test_warnings_and_notes_are_printed_with_flags(capsys):
     assert (
         LogFormat("identify").format(record) == "dynid identify: warning: --max-std-percent removes"
     )
+
+
+def test_observer_times_are_said_plainly(panda):
+    """A repeated time said "got 0.0 after np.float64(0.0)" (numpy 2's repr)."""
+    obs = MomentumObserver(from_robot(panda))
+    q = np.zeros(7)
+    obs.step(q, q, q, np.float64(0.0))
+    with pytest.raises(
+        DataError, match=r"^t must increase from sample to sample; got 0.0 after 0.0$"
+    ):
+        obs.step(q, q, q, np.float64(0.0))
+    with pytest.raises(dynid.ShapeError, match=r"^t must have shape \(\); got \(1,\)$"):
+        obs.step(q, q, q, np.array([1.0]))  # was a bare TypeError of float()
+    obs.reset()
+    t = np.array([0.0, 0.001, 0.001])
+    with pytest.raises(DataError, match=r"sample 2 \(t = 0.001\) does not$"):
+        obs.run(t, np.zeros((3, 7)), np.zeros((3, 7)), np.zeros((3, 7)))
+
+
+def test_echoed_values_show_numpy_scalars_as_numbers():
+    """Echoed values (``got ...``) read as Python's numbers, in tuples too."""
+    assert short(np.float64(0.5)) == "0.5"
+    assert short((np.float64(1.5), np.int64(2))) == "(1.5, 2)"
+    with pytest.raises(dynid.OptionError, match=r"got \(1.0, nan\)$"):
+        Contact("link7", (np.float64(1.0), np.float64("nan")), 0.0, 1.0)

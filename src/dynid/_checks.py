@@ -214,8 +214,32 @@ def frozen_mapping(items: Mapping[_K, _V]) -> FrozenMapping[_K, _V]:
 ECHO_LIMIT = 200
 
 
+def plain(value: Any) -> Any:
+    """``value`` with numpy's scalars as Python's (in tuples, lists and dicts too) and an
+    array as a list: what a message echoes reads ``0.5``, not ``np.float64(0.5)`` (numpy
+    2's repr of its scalars)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        out: Any = value.tolist()
+        return out
+    if isinstance(value, tuple | list):
+        return type(value)(plain(v) for v in value)
+    if isinstance(value, dict):
+        return {plain(k): plain(v) for k, v in value.items()}
+    return value
+
+
+def number_text(x: Any) -> str:
+    """A number as a message says it: the shortest text that reads back as the same float
+    (``0.002``, ``1e-05``), a numpy scalar as a Python one."""
+    return repr(float(x))
+
+
 def short(value: Any, limit: int = ECHO_LIMIT) -> str:
-    """``repr(value)`` cut to ``limit`` characters (with the length of what was cut)."""
+    """``repr(value)`` cut to ``limit`` characters (with the length of what was cut), numpy
+    scalars written as Python's (:func:`plain`)."""
+    value = plain(value)
     if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 600:
         return f"an integer of about {int(value.bit_length() * math.log10(2)) + 1} digits"
     big = isinstance(value, str | bytes) and len(value) > limit
