@@ -125,3 +125,17 @@ def test_text_positions_are_refused_on_the_compiled_paths(panda):
     for q in (np.array([["0"] * 7] * 2), np.array(["0"] * 7), np.zeros((2, 7), complex)):
         with pytest.raises(WrongTypeError, match="^q: expected a real numeric array_like, got nd"):
             dynid.mass_matrix(panda, q)
+
+
+def test_entry_points_of_files_name_a_log_given_for_a_path(panda, log):
+    """A TorqueLog given where files are read said "'TorqueLog' object is not iterable";
+    the message names data and the functions that take logs already read."""
+    from dynid.workflows.retrieve import retrieve_files
+
+    for data in (log, [log]):
+        with pytest.raises(WrongTypeError, match=r"^data: expected a path \(str or Path\) or a"):
+            identify_files(panda, data)
+    with pytest.raises(WrongTypeError, match=r"\(logs already read: identify_logs, validate_t"):
+        validate_files(panda, log)
+    with pytest.raises(WrongTypeError, match=r"^source: expected a path \(str or Path\) of a file"):
+        retrieve_files(panda)

@@ -63,7 +63,7 @@ def of_type(name: str, value: Any, kind: type | tuple[type, ...], expected: str)
     return value
 
 
-def one_or_many(name: str, value: Any, kind: type, expected: str) -> list[Any]:
+def one_or_many(name: str, value: Any, kind: type | tuple[type, ...], expected: str) -> list[Any]:
     """``value`` as a list of ``kind``: one instance, or a list or tuple of them.
 
     Raises

@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from .. import _checks
 from .._parallel import available_cores
 from ..exceptions import DynidError, OptionError
 from ..feasibility.bounds import Bounds, default_bounds
@@ -312,6 +313,7 @@ def retrieve_files(
     OptionError
         Options the method refuses (``field`` names them).
     """
+    _checks.of_type("source", source, (str, Path), "a path (str or Path) of a file")
     opt = checked_options(options, RetrieveOptions)
     m = consistent_method(opt.method)
     method_options = opt.method_options()
