@@ -139,3 +139,28 @@ def test_entry_points_of_files_name_a_log_given_for_a_path(panda, log):
         validate_files(panda, log)
     with pytest.raises(WrongTypeError, match=r"^source: expected a path \(str or Path\) of a file"):
         retrieve_files(panda)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda r: dynid.random_fourier(r, 0), "^rng: expected a numpy.random.Generator"),
+        (lambda r: dynid.optimise_excitation(r, 7), "^rng: expected a numpy.random.Generator"),
+        (lambda r: dynid.acquire_static(r), "^controller: expected a SimulatedController"),
+        (lambda r: dynid.identifiability(r), r"^base: expected a BaseParameters \(dynid.base_p"),
+        (
+            lambda r: dynid.param_labels("7"),
+            r"^n: expected an int \(the number of links\), got str$",
+        ),
+        (lambda r: dynid.scale_into_limits(r, np.zeros((3, 7))), "^traj: expected a Trajectory"),
+        (
+            lambda r: dynid.check_limits(r, dynid.random_fourier(r, np.random.default_rng(0))),
+            r"random_fourier\(robot, rng\)\(t\)\), got FourierSeries$",
+        ),
+    ],
+)
+def test_generators_controllers_and_trajectories_of_the_wrong_type(panda, call, message):
+    """A seed for a Generator ('int' object has no attribute 'standard_normal'), a robot
+    for a controller, an unsampled Fourier series for a trajectory: each named."""
+    with pytest.raises(WrongTypeError, match=message):
+        call(panda)

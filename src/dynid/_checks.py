@@ -84,6 +84,20 @@ def one_or_many(name: str, value: Any, kind: type | tuple[type, ...], expected: 
     return list(value)
 
 
+def checked_rng(rng: Any, name: str = "rng") -> np.random.Generator:
+    """``rng`` when it is a :class:`numpy.random.Generator` (the one source of randomness).
+
+    Raises
+    ------
+    WrongTypeError
+        It is not (a seed given as an int: ``np.random.default_rng(seed)`` makes one).
+    """
+    out: np.random.Generator = of_type(
+        name, rng, np.random.Generator, "a numpy.random.Generator (np.random.default_rng(seed))"
+    )
+    return out
+
+
 #: what an array argument must be
 _REAL = "a real numeric array_like"
 

@@ -552,6 +552,7 @@ def identifiability(base: BaseParameters, *, tol: float = 1e-8) -> tuple[str, ..
     status : tuple of str, length p
         In the order of ``base.std_labels``.
     """
+    _checks.of_type("base", base, BaseParameters, "a BaseParameters (dynid.base_parameters(robot))")
     P = base.projection
     if base.rank == 0:
         return (UNIDENTIFIABLE,) * base.n_std

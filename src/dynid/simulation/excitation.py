@@ -530,6 +530,9 @@ def excitation_condition_number(
     per joint; Gaz et al. 2019 report 121.88 for theirs), sampled at ``fs`` [Hz] when an
     :class:`ExcitingTrajectory` is given, at its own samples otherwise.
     """
+    _checks.of_type(
+        "traj", traj, (Trajectory, ExcitingTrajectory), "a Trajectory or an ExcitingTrajectory"
+    )
     checked_robot(robot)
     base = base_parameters(robot, kind="torque") if base is None else base
     tr = traj.sample(fs) if isinstance(traj, ExcitingTrajectory) else traj
@@ -1023,6 +1026,7 @@ def optimise_excitation(
     ShapeError
         ``q_start`` not (n,), or a drive for another number of joints.
     """
+    _checks.checked_rng(rng)
     checked_robot(robot)
     if drive is not None:
         drive.check(robot.n)

@@ -250,6 +250,7 @@ def scale_into_limits(
     ShapeError
         ``traj.n != robot.n``.
     """
+    traj = _checks.of_type("traj", traj, Trajectory, TRAJECTORY_EXPECTED)
     checked_robot(robot)
     scaling = limit_scaling(robot, lambda: (traj,), method=method, margin=margin)
     return scaling.apply(traj), scaling.factor

@@ -188,6 +188,7 @@ def simulate_measurement(
     OptionError
         Negative noise, ``drop_fraction`` outside [0, 0.5), an unknown ``friction`` name.
     """
+    _checks.checked_rng(rng)
     checked_robot(robot)
     traj = _checks.of_type("traj", traj, Trajectory, TRAJECTORY_EXPECTED)
     n = robot.n

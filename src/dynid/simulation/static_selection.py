@@ -266,6 +266,7 @@ def select_static_configurations(
     LimitError
         Too few collision-free configurations, or limits narrower than the margin.
     """
+    _checks.checked_rng(rng)
     checked_robot(robot)
     if n < 1 or pool_factor < 2 or batches < 1 or exchange < 0:
         raise OptionError(

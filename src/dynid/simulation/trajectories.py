@@ -328,6 +328,7 @@ def random_fourier(
     LimitError
         ``q0`` is not strictly inside the position limits.
     """
+    _checks.checked_rng(rng)
     checked_robot(robot)
     if not 0 < margin <= 1:
         raise OptionError(f"margin must be in (0, 1]; got {margin}")
