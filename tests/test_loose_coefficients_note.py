@@ -52,15 +52,15 @@ def _identified(arm, stiffness):
 
 def test_loose_coefficients_at_the_floor_are_one_note(arm, caplog):
     """The truth's structure with an offset the truth lacks: at the noise floor, the loose
-    offset is one note (logged and in the model's notes, with the --max-std-percent hint),
-    no warning."""
+    offset is one note (logged and in the model's notes, with the hint naming the Python
+    option max_std_percent, which the command line names by its flag), no warning."""
     with caplog.at_level("NOTE"):
         got, said = _identified(arm, 0.0)
     assert got.heldout.verdict.level == "good", got.heldout.verdict.reason
     assert not [m for m in said if LOOSE in m], said
     (note,) = [n for n in got.model.info.notes if LOOSE in n]
     assert "fo1" in note and "do not change the predictions" in note
-    assert "--max-std-percent removes them" in note
+    assert "max_std_percent=... removes them" in note and "--" not in note
     assert [r for r in caplog.records if LOOSE in r.getMessage()]
 
 
@@ -70,5 +70,5 @@ def test_loose_coefficients_above_the_floor_stay_a_warning(arm):
     got, said = _identified(arm, 0.5)
     assert got.heldout.verdict.level != "good"
     (warned,) = [m for m in said if LOOSE in m]
-    assert "fo1" in warned and "--max-std-percent" in warned
+    assert "fo1" in warned and "max_std_percent=... removes them" in warned
     assert not [n for n in got.model.info.notes if LOOSE in n]

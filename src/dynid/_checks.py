@@ -10,13 +10,13 @@ import json
 import math
 import re
 import unicodedata
-from collections.abc import Iterable
-from typing import Any
+from collections.abc import Iterable, Iterator, Mapping
+from typing import Any, Generic, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .exceptions import DynidError, NonFiniteError, ShapeError
+from .exceptions import DynidError, NonFiniteError, ShapeError, WrongTypeError
 
 #: arrays up to this size are checked element by element in Python (a numpy reduction
 #: costs about 2 us whatever the size, the Python loop 40 ns an element)
@@ -36,13 +36,94 @@ def finite(name: str, x: NDArray[np.float64]) -> None:
         )
 
 
+def type_name(value: Any) -> str:
+    """The type of ``value`` as a message names it (``dict``, ``ndarray of complex128``,
+    ``None``)."""
+    if isinstance(value, np.ndarray):
+        return f"ndarray of {value.dtype}"
+    return "None" if value is None else type(value).__name__
+
+
+def wrong_type(name: str, value: Any, expected: str) -> WrongTypeError:
+    """The one-line :class:`WrongTypeError` of an argument: ``"{name}: expected
+    {expected}, got {type}"``."""
+    return WrongTypeError(f"{name}: expected {expected}, got {type_name(value)}")
+
+
+def of_type(name: str, value: Any, kind: type | tuple[type, ...], expected: str) -> Any:
+    """``value`` when it is an instance of ``kind``.
+
+    Raises
+    ------
+    WrongTypeError
+        It is not (:func:`wrong_type`).
+    """
+    if not isinstance(value, kind):
+        raise wrong_type(name, value, expected)
+    return value
+
+
+def one_or_many(name: str, value: Any, kind: type | tuple[type, ...], expected: str) -> list[Any]:
+    """``value`` as a list of ``kind``: one instance, or a list or tuple of them.
+
+    Raises
+    ------
+    WrongTypeError
+        ``value`` is neither, or an item is not an instance (named by its index).
+    """
+    if isinstance(value, kind):
+        return [value]
+    if not isinstance(value, list | tuple):
+        raise wrong_type(name, value, expected)
+    for i, item in enumerate(value):
+        if not isinstance(item, kind):
+            raise WrongTypeError(
+                f"{name}: expected {expected}, got a {type(value).__name__} holding "
+                f"{type_name(item)} at index {i}"
+            )
+    return list(value)
+
+
+def checked_rng(rng: Any, name: str = "rng") -> np.random.Generator:
+    """``rng`` when it is a :class:`numpy.random.Generator` (the one source of randomness).
+
+    Raises
+    ------
+    WrongTypeError
+        It is not (a seed given as an int: ``np.random.default_rng(seed)`` makes one).
+    """
+    out: np.random.Generator = of_type(
+        name, rng, np.random.Generator, "a numpy.random.Generator (np.random.default_rng(seed))"
+    )
+    return out
+
+
+#: what an array argument must be
+_REAL = "a real numeric array_like"
+
+
 def as_array(name: str, x: ArrayLike, *, allow_nonfinite: bool = False) -> NDArray[np.float64]:
-    """Convert to a float64 array (a copy when needed) and check finiteness."""
-    if x is None:  # numpy would read None as NaN
-        raise ShapeError(f"{name} must be numeric array_like; got None")
+    """Convert to a float64 array (a copy when needed) and check finiteness.
+
+    Raises
+    ------
+    WrongTypeError
+        ``x`` is None, text, complex or of no numeric type.
+    ShapeError
+        ``x`` does not form an array (ragged nested sequences).
+    NonFiniteError
+        ``x`` holds NaN or infinity (unless ``allow_nonfinite``).
+    """
+    if x is None or isinstance(x, str | bytes | complex):  # numpy reads None as NaN
+        raise wrong_type(name, x, _REAL)
+    if isinstance(x, np.ndarray | np.generic) and x.dtype.kind not in "biuf":
+        if x.dtype.kind == "c" or x.dtype.kind in "USV":  # cast silently / not numbers
+            raise wrong_type(name, x, _REAL)
     try:
         a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
+    except TypeError as exc:
+        raise wrong_type(name, x, _REAL) from exc
+    except ValueError as exc:
         raise ShapeError(f"{name} must be numeric array_like; got {type(x).__name__}") from exc
     if not allow_nonfinite:
         finite(name, a)
@@ -99,13 +180,80 @@ def frozen(a: NDArray[Any]) -> NDArray[Any]:
     return np.frombuffer(a.tobytes(), dtype=a.dtype).reshape(a.shape)
 
 
+_K = TypeVar("_K")
+_V = TypeVar("_V")
+
+
+class FrozenMapping(Mapping[_K, _V], Generic[_K, _V]):
+    """A read-only mapping (a copy of the one given) that pickles and copies.
+
+    It stands where a frozen result holds a mapping (an identified model's terms, a
+    robot's frames, a data set's metadata): :class:`types.MappingProxyType` is read-only
+    too but cannot be pickled or deep-copied, so neither could the results holding one
+    (no ``multiprocessing``, no ``copy.deepcopy``).
+    """
+
+    __slots__ = ("_items",)
+    _items: dict[_K, _V]
+
+    def __init__(self, items: Mapping[_K, _V] | Iterable[tuple[_K, _V]] = ()) -> None:
+        object.__setattr__(self, "_items", dict(items))
+
+    def __getitem__(self, key: _K) -> _V:
+        return self._items[key]
+
+    def __iter__(self) -> Iterator[_K]:
+        return iter(self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"{type(self).__name__} is read-only")
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._items!r})"
+
+    def __reduce__(self) -> tuple[Any, tuple[dict[_K, _V]]]:
+        return type(self), (dict(self._items),)
+
+
+def frozen_mapping(items: Mapping[_K, _V]) -> FrozenMapping[_K, _V]:
+    """``items`` as a :class:`FrozenMapping`: itself when it is one, else a read-only copy."""
+    return items if isinstance(items, FrozenMapping) else FrozenMapping(items)
+
+
 #: Longest echo of a user's input in an error message [characters]: a value, a key or a
 #: header line of megabytes is cut to this, with a note of its length.
 ECHO_LIMIT = 200
 
 
+def plain(value: Any) -> Any:
+    """``value`` with numpy's scalars as Python's (in tuples, lists and dicts too) and an
+    array as a list: what a message echoes reads ``0.5``, not ``np.float64(0.5)`` (numpy
+    2's repr of its scalars)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        out: Any = value.tolist()
+        return out
+    if isinstance(value, tuple | list):
+        return type(value)(plain(v) for v in value)
+    if isinstance(value, dict):
+        return {plain(k): plain(v) for k, v in value.items()}
+    return value
+
+
+def number_text(x: Any) -> str:
+    """A number as a message says it: the shortest text that reads back as the same float
+    (``0.002``, ``1e-05``), a numpy scalar as a Python one."""
+    return repr(float(x))
+
+
 def short(value: Any, limit: int = ECHO_LIMIT) -> str:
-    """``repr(value)`` cut to ``limit`` characters (with the length of what was cut)."""
+    """``repr(value)`` cut to ``limit`` characters (with the length of what was cut), numpy
+    scalars written as Python's (:func:`plain`)."""
+    value = plain(value)
     if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 600:
         return f"an integer of about {int(value.bit_length() * math.log10(2)) + 1} digits"
     big = isinstance(value, str | bytes) and len(value) > limit

@@ -94,6 +94,8 @@ def c_float64(x: Any) -> NDArray[np.float64] | None:
     sends a call to the full validation, which raises the documented errors."""
     if type(x) is np.ndarray and x.dtype is F64 and x.flags.c_contiguous:
         return x if x.ndim else None
+    if isinstance(x, np.ndarray | np.generic) and x.dtype.kind not in "biuf":
+        return None  # complex (numpy drops the imaginary part), text (read as numbers)
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):

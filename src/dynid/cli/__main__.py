@@ -193,7 +193,9 @@ def _signals_and_warnings(console: Console) -> Iterator[None]:
     shown: set[str] = set()
 
     def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
-        text = str(message)
+        from .common import cli_text
+
+        text = cli_text(str(message))  # its Python options named by their flags
         if text not in shown:
             shown.add(text)
             console.warn(text)

@@ -59,6 +59,8 @@ FLAGS: dict[str, str] = {
     "total_mass_band": "--no-total-mass",
     "radii": "--radius",
     "ranges": "--range",
+    "base_link": "--base",
+    "tip_link": "--tip",
 }
 
 
@@ -111,11 +113,30 @@ def import_robot(message: str, args: argparse.Namespace, given: frozenset[str]) 
 
 
 def cli_text(message: str) -> str:
-    """A library message as the command line says it: a Python option in a hint,
-    ``(drop_invalid=True)``, becomes its flag, and a flag the message already names is
-    not repeated (``pass --drop-invalid (drop_invalid=True)`` -> ``pass --drop-invalid``)."""
+    """A library message as the command line says it: a Python option in a hint becomes
+    its flag (:func:`flag`): a switch in parentheses, ``(drop_invalid=True)``, and an
+    option of a value, ``max_std_percent=...`` (``hint: max_std_percent=... removes
+    them`` -> ``hint: --max-std-percent removes them``); a flag the message already names
+    is not repeated (``pass --drop-invalid (drop_invalid=True)`` -> ``pass
+    --drop-invalid``). A ``name=...`` that is a flag's own value (``--units tau=...``,
+    ``--q=...``) or an XML attribute (``<mass value=...>``) stays as it is."""
     out = re.sub(r"\((\w+)=True\)", lambda m: f"({flag(m.group(1))})", message)
+    out = _PYTHON_OPTION.sub(lambda m: _option_flag(m, out), out)
     return re.sub(r"(--[\w-]+) \(\1\)", r"\1", out)
+
+
+#: A Python option of a value named in a library message, ``name=...``: a word standing
+#: alone (not an attribute's, a flag's or a longer name's end, nor after ``,`` or ``=``)
+_PYTHON_OPTION = re.compile(r"(?<![\w.,=-])([a-z]\w*)=\.\.\.")
+
+
+def _option_flag(m: re.Match[str], text: str) -> str:
+    """The flag of the option ``m`` matched in ``text``, or the match itself where it is a
+    flag's value (after ``--units ``) or inside an XML tag (``<mass value=...>``)."""
+    before = text[: m.start()]
+    if re.search(r"--[\w-]+ $", before) or before.rfind("<") > before.rfind(">"):
+        return m.group(0)
+    return flag(m.group(1))
 
 
 def flag(field: str) -> str:

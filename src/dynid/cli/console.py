@@ -147,8 +147,11 @@ class LogFormat(logging.Formatter):
 
     def format(self, record: logging.LogRecord) -> str:
         """One line of ``record``."""
-        if record.levelno >= NOTE:
-            return f"dynid {self.command}: {record.levelname.lower()}: {record.getMessage()}"
+        if record.levelno >= NOTE:  # the library's Python options named by their flags
+            from .common import cli_text
+
+            said = cli_text(record.getMessage())
+            return f"dynid {self.command}: {record.levelname.lower()}: {said}"
         return f"{record.levelname} {record.name}: {record.getMessage()}"
 
 

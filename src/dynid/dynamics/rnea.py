@@ -31,7 +31,7 @@ from .. import _checks, _kernels
 from ..exceptions import ShapeError
 from ..kinematics.forward import joint_rotations_translations
 from ..model.inertia import matrix_from_inertia6
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 
 __all__ = ["rnea", "rnea_numpy", "kernels", "LinkMotion", "link_motion"]
 
@@ -181,6 +181,7 @@ def rnea(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`rnea_numpy`.
     """
+    checked_robot(robot)
     if gravity is None:
         # float64 arrays of one shape (..., n) go to the kernel as they are; the kernel
         # checks finiteness, and anything else (or a failure) falls through to the full

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _kernels
 from ..exceptions import ModelError
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from .rnea import ZERO_GRAVITY, _rnea, _rnea_numpy, prepare_states
 
 __all__ = [
@@ -86,6 +86,7 @@ def mass_matrix(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     Composite-rigid-body algorithm in the compiled kernel when available; otherwise
     :func:`mass_matrix_numpy`.
     """
+    checked_robot(robot)
     n = len(robot.joint_names)
     out = _kernels.run(_MASS, robot, (q,), (n, n))
     if out is not None:
@@ -108,6 +109,7 @@ def gravity_torques(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     ------
     ShapeError, NonFiniteError
     """
+    checked_robot(robot)
     out = _kernels.run(_GRAVITY, robot, (q,), (len(robot.joint_names),))
     if out is not None:
         return out
@@ -138,6 +140,7 @@ def coriolis(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.float64]:
     -------
     c : ndarray, shape (..., n)
     """
+    checked_robot(robot)
     shape, (q2, dq2, _) = prepare_states(robot, q, dq, np.zeros(robot.n))
     if shape == (robot.n,) and _kernels.loaded(_RNEA) is not None:
         _kernels.packed(robot)  # the next single sample takes the thin path
@@ -183,6 +186,7 @@ def coriolis_matrix(robot: Robot, q: ArrayLike, dq: ArrayLike) -> NDArray[np.flo
     -------
     S : ndarray, shape (..., n, n)
     """
+    checked_robot(robot)
     q = _checks.as_batch("q", q, (robot.n,))
     dq = _checks.as_batch("dq", dq, (robot.n,))
     G = christoffel(robot, q)
@@ -212,6 +216,7 @@ def forward_dynamics(
         ``M`` is singular (to rounding: a Cholesky pivot^2 below ``1e-12`` of its diagonal,
         a joint that moves no inertia of its own), so the accelerations are undefined.
     """
+    checked_robot(robot)
     shape, (q2, dq2, tau2) = prepare_states(robot, q, dq, tau, ("q", "dq", "tau"))
     if shape == (robot.n,) and _kernels.loaded(_FORWARD) is not None:
         _kernels.packed(robot)  # the next single sample takes the thin path

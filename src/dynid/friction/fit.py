@@ -44,7 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError, WrongTypeError
-from ..identification.log import TorqueLog, joint_side_log
+from ..identification.log import TorqueLog, checked_log, joint_side_log
 from ..identification.model import IdentifiedModel
 from ..identification.motor_constants import read_at_the_joints
 from ..identification.prepare import MEASURED, Preprocessing, prepare_log
@@ -577,6 +577,8 @@ def fit_friction(
     ------
     OptionError
         Unknown ``kind``.
+    WrongTypeError
+        ``log`` is not a :class:`~dynid.identification.log.TorqueLog`.
     ShapeError
         Joint counts that differ.
     DataError
@@ -588,6 +590,7 @@ def fit_friction(
         Some joints do not move: their friction is set to zero (:func:`fit_law`).
     """
     law = law_named(kind)
+    checked_log(log)
     res = friction_residual(model, log, prep)
     return fit_law(law, res.dq, res.residual, dq_noise_std=res.dq_noise_std)
 

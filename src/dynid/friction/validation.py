@@ -31,7 +31,7 @@ from .. import _checks
 from ..dynamics.rnea import rnea
 from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
 from ..identification.input_noise import exact_to_round_off
-from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log
+from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, checked_log, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
 from ..identification.model import IdentifiedModel
 from ..identification.model_sign import anticorrelated
@@ -262,6 +262,7 @@ def validate_torques(
     DataError
         From the preparation of the log; a drive other than the model's.
     """
+    checked_log(log)
     if friction is not None and friction.n != log.n:
         raise ShapeError(f"friction model has {friction.n} joints; the log has {log.n}")
     d = model_drive(model, drive)

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from types import MappingProxyType
 from typing import Any, Literal
 
 import numpy as np
@@ -105,7 +104,7 @@ class StaticDataset:
         put("q", _checks.frozen(q))
         put("M", _checks.frozen(M))
         put("g", _checks.frozen(g))
-        put("metadata", MappingProxyType(dict(self.metadata)))
+        put("metadata", _checks.frozen_mapping(dict(self.metadata)))
         put("symmetry_rtol", float(self.symmetry_rtol))
 
     @property
@@ -276,3 +275,10 @@ def _finite_rows(name: str, a: NDArray[np.float64]) -> None:
         f"{name} must be finite; got {a[tuple(bad)]} in row {s}{where} ({rows} row(s) in all); "
         "hint: drop the invalid rows when loading (drop_invalid=True)"
     )
+
+
+#: How a message says what a static data argument must be.
+STATIC_EXPECTED = (
+    "a StaticDataset (dynid.acquire_static(controller), or StaticDataset(q, M, g); "
+    "a file: dynid.io.static_data.load_static_data)"
+)

@@ -200,13 +200,13 @@ def conditioning_advice(
             f"{fit.scaled_condition_number:.3g} > {ILL_CONDITIONED:g}); nearly dependent "
             f"columns: {', '.join(cols[:8]) or '?'}; hint: use more or different "
             "configurations (dynid acquire-static --pool) or a longer, optimised trajectory "
-            "(dynid excite), or fix these parameters (--max-std-percent drops them)"
+            "(dynid excite), or fix these parameters (max_std_percent=... drops them)"
         )
     loose = loose_coefficients(fit, labels)
     if loose:
         out.append(
             f"{len(loose)} {LOOSE_ADVICE} {LARGE_STD_PERCENT:g} %: {_named(loose)}; they are "
-            f"indistinguishable from zero with {what}; hint: --max-std-percent removes them, "
+            f"indistinguishable from zero with {what}; hint: max_std_percent=... removes them, "
             "or add excitation"
         )
     return out
@@ -234,7 +234,7 @@ def loose_note(loose: list[tuple[str, float]], what: str = "the trajectory") -> 
     return (
         f"{len(loose)} coefficient(s) {what} leaves loose (standard deviation above "
         f"{LARGE_STD_PERCENT:g} %: {_named(loose)}) do not change the predictions, held out "
-        "at the noise floor; --max-std-percent removes them"
+        "at the noise floor; max_std_percent=... removes them"
     )
 
 

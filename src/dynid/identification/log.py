@@ -502,3 +502,35 @@ def _mapped(log: TorqueLog, drive: Drive, states: Any, efforts: Any) -> TorqueLo
         cleaning=log.cleaning,
         dq_derived=log.dq_derived,
     )
+
+
+#: How a message says what a torque log argument must be.
+LOG_EXPECTED = (
+    "a TorqueLog (dynid.io.torque_log.load_torque_log(path), or TorqueLog(t, q, dq, tau))"
+)
+#: How a message says what an argument of one or more torque logs must be.
+LOGS_EXPECTED = "a TorqueLog or a sequence of TorqueLog"
+
+
+def checked_log(log: object, name: str = "log") -> TorqueLog:
+    """``log`` when it is a :class:`TorqueLog`: the check of a public function's log
+    argument at its entry.
+
+    Raises
+    ------
+    WrongTypeError
+        It is not (``"log: expected a TorqueLog (...), got dict"``).
+    """
+    out: TorqueLog = _checks.of_type(name, log, TorqueLog, LOG_EXPECTED)
+    return out
+
+
+def checked_logs(logs: object, name: str = "logs") -> list[TorqueLog]:
+    """``logs`` (one :class:`TorqueLog`, or a list or tuple of them) as a list.
+
+    Raises
+    ------
+    WrongTypeError
+        Neither, or an item is not a TorqueLog (named by its index).
+    """
+    return _checks.one_or_many(name, logs, TorqueLog, LOGS_EXPECTED)

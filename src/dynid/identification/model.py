@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -122,7 +121,7 @@ def _terms_mapping(terms: Mapping[str, IdentifiedTerm]) -> Mapping[str, Identifi
     for key, t in terms.items():
         if key != t.term.name:
             raise ShapeError(f"terms: key {key!r} holds the term named {t.term.name!r}")
-    return MappingProxyType(dict(terms))
+    return _checks.frozen_mapping(dict(terms))
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -411,3 +410,35 @@ def _without_symbols(expression: str, symbols: set[str]) -> str:
     terms = expression.replace(" - ", " + -").split(" + ")
     kept = [t for t in terms if t.lstrip("-").rpartition("*")[2] not in symbols]
     return " + ".join(kept).replace(" + -", " - ")
+
+
+def checked_model(model: object, name: str = "model") -> IdentifiedModel | Robot:
+    """``model`` when it is an :class:`IdentifiedModel` or a :class:`Robot` (its own link
+    parameters): the check of an entry point's model argument.
+
+    Raises
+    ------
+    WrongTypeError
+        Neither (``"model: expected an IdentifiedModel (...) or a Robot, got str"``).
+    """
+    out: IdentifiedModel | Robot = _checks.of_type(
+        name, model, (IdentifiedModel, Robot), MODEL_EXPECTED
+    )
+    return out
+
+
+def kinematics_of(model: object, name: str = "model") -> Robot:
+    """The robot of an entry point's ``model`` argument (:func:`checked_model`): an
+    identified model's, or the robot itself.
+
+    Raises
+    ------
+    WrongTypeError
+        Neither an :class:`IdentifiedModel` nor a :class:`Robot`.
+    """
+    checked = checked_model(model, name)
+    return checked.robot if isinstance(checked, IdentifiedModel) else checked
+
+
+#: How a message says what a model argument must be.
+MODEL_EXPECTED = "an IdentifiedModel (dynid.io.model_json.load_model_json(path)) or a Robot"

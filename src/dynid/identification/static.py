@@ -47,10 +47,10 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import RankDeficientError, ShapeError
 from ..model.drive import Drive
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..regressors.base import BaseParameters
 from .core import identify, informative_blocks
-from .data import StaticDataset
+from .data import STATIC_EXPECTED, StaticDataset
 from .estimators import Estimator, EstimatorName
 from .least_squares import StdMethod
 from .model import IdentifiedModel
@@ -164,6 +164,8 @@ def identify_static(
     With the Panda, 1010 configurations and noise-free data the fit recovers the
     coefficients of the generating parameters to round-off; rank 43 after ``g1`` is dropped.
     """
+    checked_robot(robot)
+    data = _checks.of_type("data", data, StaticDataset, STATIC_EXPECTED)
     return identify(
         robot,
         data,

@@ -53,7 +53,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from itertools import chain
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -221,15 +220,17 @@ class ColumnMap:
         object.__setattr__(
             self,
             "file_flips",
-            MappingProxyType({k: MappingProxyType(dict(v)) for k, v in self.file_flips.items()}),
+            _checks.frozen_mapping(
+                {k: _checks.frozen_mapping(dict(v)) for k, v in self.file_flips.items()}
+            ),
         )
-        object.__setattr__(self, "flips", MappingProxyType(dict(self.flips)))
+        object.__setattr__(self, "flips", _checks.frozen_mapping(dict(self.flips)))
         signs = {k: tuple(v) for k, v in self.file_signs.items()}
-        object.__setattr__(self, "file_signs", MappingProxyType(signs))
-        object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
-        object.__setattr__(self, "factors", MappingProxyType(dict(self.factors)))
-        object.__setattr__(self, "names", MappingProxyType(dict(self.names)))
-        object.__setattr__(self, "lengths", MappingProxyType(dict(self.lengths)))
+        object.__setattr__(self, "file_signs", _checks.frozen_mapping(signs))
+        object.__setattr__(self, "columns", _checks.frozen_mapping(dict(self.columns)))
+        object.__setattr__(self, "factors", _checks.frozen_mapping(dict(self.factors)))
+        object.__setattr__(self, "names", _checks.frozen_mapping(dict(self.names)))
+        object.__setattr__(self, "lengths", _checks.frozen_mapping(dict(self.lengths)))
 
     @classmethod
     def from_units(

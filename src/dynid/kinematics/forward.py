@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _kernels
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 
 __all__ = [
     "joint_transforms",
@@ -109,6 +109,7 @@ def joint_transforms(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     -------
     T : ndarray, shape (..., n, 4, 4)
     """
+    checked_robot(robot)
     q = check_q(robot, q)
     R, p = joint_rotations_translations(robot, q.reshape(-1, robot.n))
     T = np.zeros(R.shape[:-2] + (4, 4))
@@ -144,6 +145,7 @@ def link_poses(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
     T_base_link : ndarray, shape (..., n + 1, 4, 4)
         Index 0 is the base (identity), index i is link i; translations in [m].
     """
+    checked_robot(robot)
     T = _kernels.run(_LINK_POSES, robot, (q,), (len(robot.joint_names) + 1, 4, 4))
     if T is not None:
         return T
@@ -205,6 +207,7 @@ def fk(
     -----
     Uses the compiled kernel when available (see :func:`kernels`), else :func:`fk_numpy`.
     """
+    checked_robot(robot)
     link, T_link_frame, CF = frame_constants(robot, frame, tool)
     out = _kernels.run(_FRAME_POSE, robot, (q,), (4, 4), CF)
     if out is not None:

@@ -56,7 +56,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _kernels
 from ..exceptions import DataError, LimitError, ShapeError, WrongTypeError
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ._ik_numpy import Chain, rotvec, solve_numpy
 from .forward import frame_constants
 
@@ -133,22 +133,28 @@ class IKOptions:
         ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise DataError(f"IKOptions.{name} must be a positive finite number; got {v!r}")
+                raise DataError(
+                    f"IKOptions.{name} must be a positive finite number; got {_checks.short(v)}"
+                )
         if not (
             isinstance(self.damping, (int, float))
             and math.isfinite(self.damping)
             and self.damping >= 0
         ):
-            raise DataError(f"IKOptions.damping must be a finite number >= 0; got {self.damping!r}")
+            raise DataError(
+                f"IKOptions.damping must be a finite number >= 0; got {_checks.short(self.damping)}"
+            )
         if not 0 < self.dt * self.gain < 2:
             raise DataError(
                 "IKOptions.dt * gain must lie in (0, 2) for the discrete loop to converge; "
-                f"got {self.dt * self.gain!r}"
+                f"got {_checks.short(self.dt * self.gain)}"
             )
         for name, low in (("max_iterations", 1), ("stall_iterations", 1), ("max_restarts", 0)):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low:
-                raise DataError(f"IKOptions.{name} must be an integer >= {low}; got {v!r}")
+                raise DataError(
+                    f"IKOptions.{name} must be an integer >= {low}; got {_checks.short(v)}"
+                )
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -327,6 +333,7 @@ def ik(
     >>> ik(robot, T).converged
     True
     """
+    checked_robot(robot)
     opts = _DEFAULT_OPTIONS if options is None else options
     if not isinstance(opts, IKOptions):
         raise WrongTypeError(f"options must be an IKOptions; got {type(opts).__name__}")

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _kernels
 from ..exceptions import ShapeError
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from .forward import check_q, frame_constants, frame_pose_in_link, link_poses_prepared
 
 __all__ = ["jacobian", "jacobian_numpy", "jacobian_to_tool"]
@@ -56,6 +56,7 @@ def jacobian(
     Uses the compiled kernel when available (:func:`dynid._kernels.dispatch.compiled`),
     else :func:`jacobian_numpy`.
     """
+    checked_robot(robot)
     link, T_link_frame, CF = frame_constants(robot, frame, tool)
     out = _kernels.run(_JACOBIAN, robot, (q,), (6, len(robot.joint_names)), CF)
     if out is not None:

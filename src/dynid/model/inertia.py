@@ -52,6 +52,8 @@ def param_labels(n: int) -> tuple[str, ...]:
 
     ``m<i>`` [kg], ``mc<i>x`` ... [kg m], ``J<i>xx`` ... [kg m^2] (about the link origin).
     """
+    if isinstance(n, bool) or not isinstance(n, int | np.integer):
+        raise _checks.wrong_type("n", n, "an int (the number of links)")
     out: list[str] = []
     for i in range(1, n + 1):
         out += [f"m{i}", f"mc{i}x", f"mc{i}y", f"mc{i}z"]

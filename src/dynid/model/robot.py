@@ -23,7 +23,6 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -75,7 +74,7 @@ def _fixed_frames(frames: Mapping[str, Frame]) -> Mapping[str, Frame]:
         joint = None if f.joint is None else str(f.joint)
         out[str(k)] = Frame(int(f.link), _checks.frozen(T), joint)
     _check_names("joint", [f.joint for f in out.values() if f.joint is not None])
-    return MappingProxyType(out)
+    return _checks.frozen_mapping(out)
 
 
 def _check_names(kind: str, names: Sequence[str]) -> None:
@@ -616,3 +615,21 @@ def mdh_transform(a: float, d: float, alpha: float, theta: float) -> NDArray[np.
             [0.0, 0.0, 0.0, 1.0],
         ]
     )
+
+
+#: How a message says what a ``robot`` argument must be.
+ROBOT_EXPECTED = "a Robot (dynid.panda(), Robot.from_urdf(...), Robot.from_mdh(...))"
+
+
+def checked_robot(robot: object, name: str = "robot") -> Robot:
+    """``robot`` when it is a :class:`Robot`: the check of a public function's robot
+    argument at its entry.
+
+    Raises
+    ------
+    WrongTypeError
+        It is not (``"robot: expected a Robot (...), got str"``).
+    """
+    if not isinstance(robot, Robot):
+        raise _checks.wrong_type(name, robot, ROBOT_EXPECTED)
+    return robot

@@ -75,7 +75,9 @@ class ObserverOptions:
     def __post_init__(self) -> None:
         g = np.atleast_1d(np.asarray(self.gain, dtype=np.float64))
         if g.ndim != 1 or not np.all(np.isfinite(g)) or np.any(g <= 0):
-            raise OptionError(f"observer gain K_O must be > 0 [1/s]; got {self.gain!r}")
+            raise OptionError(
+                f"observer gain K_O must be > 0 [1/s]; got {_checks.short(self.gain)}"
+            )
         if self.discretisation not in ("exact", "euler"):
             raise OptionError(
                 f"discretisation must be 'exact' or 'euler'; got {self.discretisation!r}"
@@ -230,6 +232,7 @@ class MomentumObserver:
             and q.shape == self._shape
             and dq.shape == self._shape
             and tau.shape == self._shape
+            and isinstance(t, float | int)  # a time of shape (1,) is validated (named)
         ):
             r = np.empty(self.n)
             if e(self._D, self._S, q, dq, tau, float(t), r):
@@ -244,7 +247,8 @@ class MomentumObserver:
         tf = float(_checks.as_exact("t", t, ()))
         if self._S[0] and not tf > self._S[1]:
             raise DataError(
-                f"t must increase from sample to sample; got {tf!r} after {self._S[1]!r}"
+                f"t must increase from sample to sample; got {_checks.number_text(tf)} after "
+                f"{_checks.number_text(self._S[1])}"
             )
         held = self.model.position_torques(qa[None])
         if held is not None:  # a spring's torque: spent beside the links'
@@ -281,7 +285,8 @@ class MomentumObserver:
         if bad.size or (N and self._S[0] and not ta[0] > self._S[1]):
             k = int(bad[0]) + 1 if bad.size else 0
             raise DataError(
-                f"t must increase from sample to sample; sample {k} (t = {ta[k]!r}) does not"
+                "t must increase from sample to sample; sample "
+                f"{k} (t = {_checks.number_text(ta[k])}) does not"
             )
         held = self.model.position_torques(qa)
         if held is not None:  # a spring's torque: spent beside the links'
@@ -297,7 +302,10 @@ class MomentumObserver:
             stop = mod.observer_batch(D, self._S, fl(ta), fl(qa), fl(dqa), fl(u), r.reshape(-1))
             if stop < 0:
                 return r
-            raise DataError(f"sample {stop} of the log stopped the observer (t = {ta[stop]!r})")
+            raise DataError(
+                f"sample {stop} of the log stopped the observer "
+                f"(t = {_checks.number_text(ta[stop])})"
+            )
         u = self._u(qa, dqa, taua, friction=self.model.friction is not None)
         return self._run_numpy(ta, qa, dqa, u)
 

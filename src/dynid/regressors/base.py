@@ -50,7 +50,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import OptionError, ShapeError
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from .static import static_regressor, static_rows
 from .terms import ModelTerm
 from .torque import torque_regressor_prepared
@@ -468,6 +468,7 @@ def base_parameters(
     OptionError
         An unknown ``kind``.
     """
+    checked_robot(robot)
     import scipy.linalg  # scipy on first use (start-up time)
 
     rng = np.random.default_rng(0) if rng is None else rng
@@ -551,6 +552,7 @@ def identifiability(base: BaseParameters, *, tol: float = 1e-8) -> tuple[str, ..
     status : tuple of str, length p
         In the order of ``base.std_labels``.
     """
+    _checks.of_type("base", base, BaseParameters, "a BaseParameters (dynid.base_parameters(robot))")
     P = base.projection
     if base.rank == 0:
         return (UNIDENTIFIABLE,) * base.n_std

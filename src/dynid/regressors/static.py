@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks, _kernels
 from ..exceptions import ShapeError
 from ..kinematics.forward import link_poses_prepared
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 
 __all__ = [
     "static_first_columns",
@@ -220,6 +220,7 @@ def static_regressor(robot: Robot, q: ArrayLike) -> NDArray[np.float64]:
         ``Y_s @ phi == static_vector(mass_matrix(q), gravity_torques(q))``; rows as in
         :func:`static_labels`, columns as ``robot.param_labels``.
     """
+    checked_robot(robot)
     q = _checks.as_batch("q", q, (robot.n,))
     Y = _static_regressor(robot, q.reshape(-1, robot.n))
     return Y.reshape(q.shape[:-1] + Y.shape[1:])

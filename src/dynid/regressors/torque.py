@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks, _kernels
 from ..dynamics.rnea import link_motion, prepare_states
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..spatial import skew
 
 __all__ = [
@@ -194,6 +194,7 @@ def torque_regressor(
     Compiled over the batch (:mod:`dynid._kernels.regressors`) when numba is available,
     else :func:`torque_regressor_numpy`.
     """
+    checked_robot(robot)
     shape, (q2, dq2, ddq2) = prepare_states(robot, q, dq, ddq)
     g = robot.gravity if gravity is None else _checks.as_exact("gravity", gravity, (3,))
     Y = torque_regressor_prepared(robot, q2, dq2, ddq2, g)

@@ -61,7 +61,9 @@ class Contact:
     def __post_init__(self) -> None:
         w = np.asarray(self.wrench, dtype=np.float64).reshape(-1)
         if w.size not in (3, 6) or not np.all(np.isfinite(w)):
-            raise OptionError(f"contact wrench must be 3 or 6 finite numbers; got {self.wrench!r}")
+            raise OptionError(
+                f"contact wrench must be 3 or 6 finite numbers; got {_checks.short(self.wrench)}"
+            )
         object.__setattr__(
             self, "wrench", tuple(float(x) for x in np.concatenate([w, np.zeros(6 - w.size)]))
         )

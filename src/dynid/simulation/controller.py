@@ -37,7 +37,7 @@ from ..dynamics.terms import gravity_torques, mass_matrix
 from ..exceptions import LimitError, OptionError
 from ..identification.data import StaticDataset
 from ..model.panda import panda
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from .trajectories import MAX_SAMPLES
 from .unmodelled import UnmodelledEffects
 
@@ -158,6 +158,7 @@ def sample_configurations(
     LimitError
         A joint's range is not wider than ``2 margin``.
     """
+    checked_robot(robot)
     if int(n) != n or n < 1:
         raise OptionError(f"n must be a positive integer; got {n}")
     if n * robot.n > MAX_SAMPLES:
@@ -206,6 +207,12 @@ def acquire_static(
         ``q`` (n, dof) [rad], ``M`` (n, dof, dof) [kg m^2], ``g`` (n, dof) [N m]; metadata
         records the source, the robot name, the noise level and the margin.
     """
+    controller = _checks.of_type(
+        "controller",
+        controller,
+        SimulatedController,
+        "a SimulatedController (SimulatedController(robot))",
+    )
     q = sample_configurations(controller.robot, n, rng, margin=margin)
     return acquire_static_at(controller, q, margin=margin)
 
@@ -218,6 +225,12 @@ def acquire_static_at(
     ``margin`` is recorded in the metadata only (e.g. the one the configurations were
     drawn with, :func:`dynid.simulation.static_selection.select_static_configurations`).
     """
+    controller = _checks.of_type(
+        "controller",
+        controller,
+        SimulatedController,
+        "a SimulatedController (SimulatedController(robot))",
+    )
     q = _checks.as_batch("q", q, (controller.robot.n,)).reshape(-1, controller.robot.n)
     _log.info("acquiring M(q) and g(q) at %d configurations", len(q))
     M, g = controller.read(q)

@@ -65,7 +65,7 @@ from ..exceptions import OptionError
 from ..friction.model import robot_friction
 from ..identification.classical import friction_regressor
 from ..model.drive import Drive
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.torque import torque_regressor_prepared
 from .clearance import Approach, closest_approaches
@@ -530,6 +530,10 @@ def excitation_condition_number(
     per joint; Gaz et al. 2019 report 121.88 for theirs), sampled at ``fs`` [Hz] when an
     :class:`ExcitingTrajectory` is given, at its own samples otherwise.
     """
+    _checks.of_type(
+        "traj", traj, (Trajectory, ExcitingTrajectory), "a Trajectory or an ExcitingTrajectory"
+    )
+    checked_robot(robot)
     base = base_parameters(robot, kind="torque") if base is None else base
     tr = traj.sample(fs) if isinstance(traj, ExcitingTrajectory) else traj
     return _conds(_classical_regressor(robot, base, tr))
@@ -1022,6 +1026,8 @@ def optimise_excitation(
     ShapeError
         ``q_start`` not (n,), or a drive for another number of joints.
     """
+    _checks.checked_rng(rng)
+    checked_robot(robot)
     if drive is not None:
         drive.check(robot.n)
     robot = design_limits(robot, options)

@@ -15,9 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks
 from ..exceptions import LimitError, OptionError, ShapeError
-from ..model.robot import Robot
-from .trajectories import Trajectory
+from ..model.robot import Robot, checked_robot
+from .trajectories import TRAJECTORY_EXPECTED, Trajectory
 
 __all__ = [
     "LimitReport",
@@ -111,6 +112,8 @@ def check_limits(robot: Robot, traj: Trajectory) -> LimitReport:
     ShapeError
         ``traj.n != robot.n``.
     """
+    checked_robot(robot)
+    traj = _checks.of_type("traj", traj, Trajectory, TRAJECTORY_EXPECTED)
     return check_limits_blocks(robot, (traj,))
 
 
@@ -247,6 +250,8 @@ def scale_into_limits(
     ShapeError
         ``traj.n != robot.n``.
     """
+    traj = _checks.of_type("traj", traj, Trajectory, TRAJECTORY_EXPECTED)
+    checked_robot(robot)
     scaling = limit_scaling(robot, lambda: (traj,), method=method, margin=margin)
     return scaling.apply(traj), scaling.factor
 

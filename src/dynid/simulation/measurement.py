@@ -33,9 +33,9 @@ from ..exceptions import OptionError, ShapeError
 from ..friction.model import FrictionModel, FrictionSum, placed_friction, robot_friction
 from ..identification.log import TorqueLog, recorded_side_log
 from ..model.drive import Drive
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from .contact import Contact, contact_torques
-from .trajectories import Trajectory, uniform_times
+from .trajectories import TRAJECTORY_EXPECTED, Trajectory, uniform_times
 from .unmodelled import UnmodelledEffects
 
 __all__ = [
@@ -188,6 +188,9 @@ def simulate_measurement(
     OptionError
         Negative noise, ``drop_fraction`` outside [0, 0.5), an unknown ``friction`` name.
     """
+    _checks.checked_rng(rng)
+    checked_robot(robot)
+    traj = _checks.of_type("traj", traj, Trajectory, TRAJECTORY_EXPECTED)
     n = robot.n
     if traj.n != n:
         raise ShapeError(f"trajectory has {traj.n} joints; robot {robot.name!r} has {n}")

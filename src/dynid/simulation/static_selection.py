@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import LimitError, OptionError
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..regressors.base import BaseParameters, base_parameters
 from ..regressors.static import static_regressor
 from .collision import Obstacles, capsule_model, obstacle_distances, self_distances
@@ -266,6 +266,8 @@ def select_static_configurations(
     LimitError
         Too few collision-free configurations, or limits narrower than the margin.
     """
+    _checks.checked_rng(rng)
+    checked_robot(robot)
     if n < 1 or pool_factor < 2 or batches < 1 or exchange < 0:
         raise OptionError(
             f"need n >= 1, pool_factor >= 2, batches >= 1 and exchange >= 0; got {n}, "

@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import DataError, LimitError, OptionError, ShapeError
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 
 __all__ = [
     "GAZ2019_SINUSOID_AMPLITUDES",
@@ -328,6 +328,8 @@ def random_fourier(
     LimitError
         ``q0`` is not strictly inside the position limits.
     """
+    _checks.checked_rng(rng)
+    checked_robot(robot)
     if not 0 < margin <= 1:
         raise OptionError(f"margin must be in (0, 1]; got {margin}")
     lo, hi = robot.q_min, robot.q_max
@@ -351,3 +353,7 @@ def random_fourier(
         )
     s = np.where(np.isfinite(s), s, 1.0 / vb)
     return FourierSeries(w_f, a * s[:, None], b * s[:, None], q0)
+
+
+#: How a message says what a sampled trajectory argument must be.
+TRAJECTORY_EXPECTED = "a Trajectory (sinusoid_trajectory(...), or random_fourier(robot, rng)(t))"

@@ -22,14 +22,14 @@ import numpy as np
 
 from ..exceptions import OptionError
 from ..identification.consistency import kinematics_record
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..simulation.controller import (
     DEFAULT_MARGIN,
     SimulatedController,
     acquire_static,
     acquire_static_at,
 )
-from .options import check_count, check_number
+from .options import check_count, check_number, checked_options
 
 __all__ = ["AcquireStaticOptions", "StaticAcquisition", "acquire_static_data", "streams"]
 
@@ -138,7 +138,8 @@ def acquire_static_data(
     DataError
         An unreadable obstacles file.
     """
-    opt = options or AcquireStaticOptions()
+    checked_robot(robot)
+    opt = checked_options(options, AcquireStaticOptions)
     rng_q, rng_noise = streams(opt.seed)
     effects = None
     if opt.unmodelled:

@@ -28,6 +28,7 @@ from typing import Any, Literal, TypeVar
 
 import numpy as np
 
+from .. import _checks
 from ..exceptions import DataError, DynidError, DynidWarning, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
@@ -627,11 +628,14 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
 
     Raises
     ------
+    WrongTypeError
+        Neither a path nor a list or tuple of paths (a :class:`TorqueLog` read already:
+        ``identify_logs``, ``validate_torques``).
     DataError
         No path, a folder without data files, a file named twice (however written), or
         two files of identical content.
     """
-    given = [paths] if isinstance(paths, str | Path) else list(paths)
+    given = _checks.one_or_many("data", paths, (str, Path), PATHS_EXPECTED)
     out: list[Path] = []
     for p in map(Path, given):
         if p.is_dir():
@@ -707,3 +711,9 @@ def _refuse_copies(paths: list[Path]) -> None:
                     "it would count twice and judge itself when one recording is left out; "
                     "hint: give it once"
                 )
+
+
+#: How a message says what a ``data`` argument of files must be.
+PATHS_EXPECTED = (
+    "a path (str or Path) or a list of paths (logs already read: identify_logs, validate_torques)"
+)

@@ -34,7 +34,7 @@ import numpy as np
 from ..friction.model import own_at_motors_note
 from ..io.excitation import load_obstacles
 from ..model.drive import Drive
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..progress import stage
 from ..simulation.collision import (
     DEFAULT_OBSTACLE_CLEARANCE,
@@ -52,6 +52,7 @@ from ..simulation.excitation import (
     not_tightened,
     optimise_excitation,
 )
+from .options import checked_options
 
 __all__ = [
     "EXCITE_RATE_HZ",
@@ -383,13 +384,15 @@ def design_excitation(
     DataError
         An unreadable obstacles file.
     """
+    checked_robot(robot)
+    options = checked_options(options, ExcitationOptions)
     obs = None if obstacles is None else load_obstacles(obstacles)
     start = time.monotonic()
     with stage(STAGE):
         res = optimise_excitation(
             robot,
             np.random.default_rng(seed),
-            options or ExcitationOptions(),
+            options,
             obstacles=obs,
             progress=progress,
             evaluated=evaluated,

@@ -47,7 +47,7 @@ from ..friction.select import (
     torque_noise_std,
 )
 from ..friction.validation import RECORDED, own_friction
-from ..identification.model import IdentifiedModel
+from ..identification.model import IdentifiedModel, checked_model
 from ..identification.spikes import SPIKES_BEFORE_FIT
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -58,6 +58,7 @@ from .options import (
     check_choice,
     check_cutoff,
     check_number,
+    checked_options,
     library_cutoff,
     velocity_cutoff,
 )
@@ -207,7 +208,8 @@ def fit_friction_files(
         piece long enough to filter, or no joint moving beyond its velocity noise band
         (the message starts with the file's name).
     """
-    opt = options or FrictionOptions()
+    checked_model(model)
+    opt = checked_options(options, FrictionOptions)
     drop, gap = read_as_identified(
         model.info.log if isinstance(model, IdentifiedModel) else None,
         opt.drop_invalid,

@@ -64,7 +64,7 @@ from ..identification.gravity_scale import (
     gravity_scale_words,
 )
 from ..identification.least_squares import LOOSE_ADVICE, STD_METHODS, StdMethod, loose_note
-from ..identification.log import TorqueLog
+from ..identification.log import TorqueLog, checked_log, checked_logs
 from ..identification.model import IdentifiedModel
 from ..identification.motor_constants import shared_gear_ratio
 from ..identification.residual_dependence import outside_model_note, round_off_note
@@ -74,7 +74,7 @@ from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
 from ..identification.torque_delay import TorqueDelay
 from ..model.drive import Drive
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..progress import NOTE
 from .data_files import (
     ColumnSpec,
@@ -101,6 +101,7 @@ from .options import (
     check_count,
     check_cutoff,
     check_number,
+    checked_options,
     library_cutoff,
     only_with,
     refused_with,
@@ -464,7 +465,8 @@ def identify_files(
         ``folds``, ``validate_on`` or ``terms`` with static data, ``max_gap_s`` with
         static data and ``consistent``; an unreadable prior (``field`` names it).
     """
-    opt = options or IdentifyOptions()
+    checked_robot(robot)
+    opt = checked_options(options, IdentifyOptions)
     paths = data_files(data)
     prior = _prior(robot, opt)
     path = paths[0]
@@ -556,7 +558,8 @@ def identify_logs(
     DataError, RankDeficientError
         As :func:`~dynid.identification.selection.identify_recordings`.
     """
-    opt = options or IdentifyOptions()
+    checked_robot(robot)
+    opt = checked_options(options, IdentifyOptions)
     for name in ("columns", "drop_invalid", "q_start", "validate_on"):
         if getattr(opt, name) not in (None, False):
             raise OptionError(
@@ -564,7 +567,9 @@ def identify_logs(
                 "it (or give the separate log as validate_on)",
                 field=name,
             )
-    logs = [logs] if isinstance(logs, TorqueLog) else list(logs)
+    logs = checked_logs(logs)
+    if validate_on is not None:
+        checked_log(validate_on, "validate_on")
     if opt.folds is not None and len(logs) > 1:
         raise OptionError(
             f"sets time blocks of one recording; with {len(logs)} recordings each one is "

@@ -74,6 +74,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks
 from ..exceptions import DataError, DynidError, DynidWarning, OptionError, ShapeError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
@@ -524,6 +525,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     DataError
         A bad file (named), thresholds of another joint count.
     """
+    _checks.of_type("opts", opts, ObserveOptions, "an ObserveOptions")
     if not opts.data:
         raise OptionError("give one or more --data logs")
     if opts.calibrate == (opts.thresholds is not None):

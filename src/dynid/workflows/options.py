@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
+from .. import _checks
 from ..exceptions import OptionError
 
 __all__ = [
@@ -18,11 +19,31 @@ __all__ = [
     "check_cutoff",
     "check_count",
     "check_number",
+    "checked_options",
     "library_cutoff",
     "velocity_cutoff",
     "only_with",
     "refused_with",
 ]
+
+_O = TypeVar("_O")
+
+
+def checked_options(options: object, kind: type[_O], name: str = "options") -> _O:
+    """An entry point's ``options``: ``kind()`` for None, else ``options`` when it is a
+    ``kind`` (a dict of the same fields is not: ``kind(**fields)`` makes one).
+
+    Raises
+    ------
+    WrongTypeError
+        Anything else (``"options: expected an IdentifyOptions, got dict"``).
+    """
+    if options is None:
+        return kind()
+    article = "an" if kind.__name__[:1] in "AEIOU" else "a"
+    out: _O = _checks.of_type(name, options, kind, f"{article} {kind.__name__}")
+    return out
+
 
 #: ``cutoff_hz`` of the options that turns the low-pass off (``--cutoff none``): the
 #: states and torques are used as recorded, the accelerations differentiated from them.

@@ -36,7 +36,7 @@ from ..feasibility.payload import (
 )
 from ..feasibility.payload_arm import ArmFriction
 from ..feasibility.payload_friction import friction_structure
-from ..identification.model import IdentifiedModel
+from ..identification.model import IdentifiedModel, kinematics_of
 from ..identification.pieces import recording_line
 from ..identification.spikes import SPIKES_BEFORE_FIT
 from ..identification.structure import Structure
@@ -195,8 +195,8 @@ def identify_payload_files(
     OptionError
         ``terms`` with static data, or naming an unknown term, an armature or a spring.
     """
+    kin = kinematics_of(arm, "arm")
     structure = _friction_terms(terms)
-    kin = arm.robot if isinstance(arm, IdentifiedModel) else arm
     kin.frame(frame)  # an unknown frame is the option's error, not a file's
     paths = data_files(data)
     base = None if unloaded is None else data_files(unloaded)

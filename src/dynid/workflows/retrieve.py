@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from .. import _checks
 from .._parallel import available_cores
 from ..exceptions import DynidError, OptionError
 from ..feasibility.bounds import Bounds, default_bounds
@@ -32,7 +33,7 @@ from ..io.friction_json import load_friction_json
 from ..io.model_json import load_model_json
 from ..model.robot import Robot
 from .data_files import ColumnSpec, check_file_entries, column_map, read_static_file
-from .options import check_band, check_choice, check_count, check_number
+from .options import check_band, check_choice, check_count, check_number, checked_options
 from .prior import load_prior
 from .static_outliers import without_outlying
 
@@ -296,7 +297,8 @@ def retrieve_files(
     OptionError
         Options the method refuses (``field`` names them).
     """
-    opt = options or RetrieveOptions()
+    _checks.of_type("source", source, (str, Path), "a path (str or Path) of a file")
+    opt = checked_options(options, RetrieveOptions)
     m = consistent_method(opt.method)
     method_options = opt.method_options()
     spec = None if opt.columns in (None, (None, None)) else opt.columns

@@ -29,7 +29,7 @@ from ..friction.model import FrictionModel, own_at_motors_note
 from ..io.excitation import inadmissible_note, load_exciting_trajectory, load_trajectory
 from ..io.friction_json import load_friction_json
 from ..model.drive import Drive
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..simulation.contact import Contact
 from ..simulation.limits import check_limits_blocks, limit_scaling
 from ..simulation.measurement import (
@@ -48,7 +48,7 @@ from ..simulation.trajectories import (
     sinusoid_trajectory,
     uniform_times,
 )
-from .options import check_choice, check_count, check_number, only_with
+from .options import check_choice, check_count, check_number, checked_options, only_with
 
 __all__ = ["SimulateOptions", "SimulatedLog", "simulate_log"]
 
@@ -200,7 +200,8 @@ def simulate_log(robot: Robot, options: SimulateOptions | None = None) -> Simula
     DataError
         An unreadable trajectory or friction file.
     """
-    opt = options or SimulateOptions()
+    checked_robot(robot)
+    opt = checked_options(options, SimulateOptions)
     for c in opt.contacts:
         robot.frame(c.frame)  # an unknown frame: UnknownNameError naming the robot's frames
     rng = np.random.default_rng(opt.seed)

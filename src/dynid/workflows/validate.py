@@ -52,6 +52,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _checks
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.delay_check import validations_delay
 from ..friction.fit import model_drive, same_drive, torques_through
@@ -70,7 +71,7 @@ from ..identification.gravity_scale import recorded_scale
 from ..identification.gravity_tilt import GravityTilt
 from ..identification.log import TorqueLog
 from ..identification.metrics import TorqueErrors
-from ..identification.model import IdentifiedModel
+from ..identification.model import IdentifiedModel, kinematics_of
 from ..identification.motion_range import motion_range_hint, with_motion_range_hint
 from ..identification.pieces import check_below_nyquist
 from ..identification.recorded_signs import SignFinding
@@ -87,7 +88,14 @@ from ..observer.residual_load import ResidualLoad
 from ..progress import NOTE
 from .as_identified import identification_beside, read_as_identified
 from .data_files import ColumnSpec, data_files, data_kind, in_file
-from .options import NO_FILTER, Cutoff, check_number, library_cutoff, velocity_cutoff
+from .options import (
+    NO_FILTER,
+    Cutoff,
+    check_number,
+    checked_options,
+    library_cutoff,
+    velocity_cutoff,
+)
 from .recordings import (
     Recorded,
     despiked_recordings,
@@ -167,7 +175,9 @@ class ValidateOptions:
             if name == "cutoff_hz" and v == NO_FILTER:
                 continue
             if v is not None and not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
-                raise OptionError(f"{name} ({what}) must be a positive number; got {v!r}")
+                raise OptionError(
+                    f"{name} ({what}) must be a positive number; got {_checks.short(v)}"
+                )
         check_number(self, "torque_delay_s", low=-1.0, high=1.0)
         fr = self.friction
         if not isinstance(fr, str | Path) and not hasattr(fr, "torques"):
@@ -423,9 +433,9 @@ def validate_files(
     ShapeError
         A friction model of another joint count.
     """
-    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    robot = kinematics_of(model)
     own = _own_record(model, feasible, source)  # whose record reads and prepares the data
-    opt = _as_identified(options or ValidateOptions(), own)  # as identify read its logs
+    opt = _as_identified(checked_options(options, ValidateOptions), own)  # as identify read
     drive, placed = _drives(model, opt.drive, feasible)
     rec = recorded or read_recordings(
         _torque_logs(data), robot, recorded=None if own is None else own.info.column_map,

@@ -320,7 +320,7 @@ def _chain_ends(
         roots = [link for link in links if link not in parent_joint]
         if len(roots) != 1:
             raise ModelError(
-                f"{source} has {len(roots)} root links {roots}; pass --base to choose one"
+                f"{source} has {len(roots)} root links {roots}; pass base_link=... to choose one"
             )
         base_link = roots[0]
     if tip_link is None:
@@ -328,7 +328,7 @@ def _chain_ends(
         if len(leaves) != 1:
             raise ModelError(
                 f"several leaf links below base link {base_link!r}: {leaves}; "
-                "pass --tip to choose the end of the chain"
+                "pass tip_link=... to choose the end of the chain"
             )
         tip_link = leaves[0]
     return base_link, tip_link

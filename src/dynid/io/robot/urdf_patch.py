@@ -148,7 +148,7 @@ def _check_same_chain(robot: Robot, chain: Robot, source: str) -> None:
     if robot.n != chain.n:
         raise ModelError(
             f"the chain has {chain.n} moving joints, the robot {robot.n}; "
-            "choose --base/--tip so that the chains match",
+            "choose base=.../tip=... so that the chains match",
             file=source,
         )
     for i in range(robot.n):
