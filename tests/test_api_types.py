@@ -164,3 +164,13 @@ def test_generators_controllers_and_trajectories_of_the_wrong_type(panda, call, 
     for a controller, an unsampled Fourier series for a trajectory: each named."""
     with pytest.raises(WrongTypeError, match=message):
         call(panda)
+
+
+def test_identify_from_log_names_a_list_of_logs(panda, log):
+    """Regression (a Python API trial): ``identify_from_log(robot, [log1, log2])`` raised
+    AttributeError "'list' object has no attribute 'dq_derived'"; it names the argument
+    and the function that takes several."""
+    with pytest.raises(WrongTypeError, match="^log: expected a TorqueLog.*got list"):
+        dynid.identify_from_log(panda, [log, log])
+    with pytest.raises(WrongTypeError, match="^robot: "):
+        dynid.identify_from_log("panda", log)

@@ -41,13 +41,13 @@ import numpy as np
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
-from ..model.robot import Robot
+from ..model.robot import Robot, checked_robot
 from ..regressors.base import BaseParameters
 from ..regressors.terms import friction_labels
 from .estimators import Estimator, EstimatorName
 from .holdout import DEFAULT_FOLDS
 from .least_squares import StdMethod
-from .log import TorqueLog
+from .log import TorqueLog, checked_log
 from .log_rows import (
     friction_regressor,
     log_blocks,
@@ -165,6 +165,9 @@ def identify_from_log(
 
     Raises
     ------
+    WrongTypeError
+        ``robot`` not a Robot, ``log`` not a TorqueLog (a list of logs:
+        :func:`~dynid.workflows.identify.identify_logs` takes several).
     ShapeError
         ``log.n != robot.n``.
     DataError
@@ -184,6 +187,7 @@ def identify_from_log(
         (:func:`~dynid.identification.least_squares.conditioning_advice`); identified
         friction that is not dissipative.
     """
+    robot, log = checked_robot(robot), checked_log(log)
     if not isinstance(structure, Structure) and structure not in ("auto", "classical"):
         raise OptionError(
             f"must be 'auto', 'classical' or a Structure; got {structure!r}", field="structure"
