@@ -170,7 +170,17 @@ def test_identify_from_log_names_a_list_of_logs(panda, log):
     """Regression (a Python API trial): ``identify_from_log(robot, [log1, log2])`` raised
     AttributeError "'list' object has no attribute 'dq_derived'"; it names the argument
     and the function that takes several."""
-    with pytest.raises(WrongTypeError, match="^log: expected a TorqueLog.*got list"):
+    with pytest.raises(WrongTypeError, match="^log: expected a TorqueLog, got a list of 2; sev"):
         dynid.identify_from_log(panda, [log, log])
+    with pytest.raises(WrongTypeError, match="identify_logs, which keeps each apart"):
+        dynid.identify_from_log(panda, (log,))
     with pytest.raises(WrongTypeError, match="^robot: "):
         dynid.identify_from_log("panda", log)
+
+
+def test_fk_names_a_list_of_frames_as_a_type(panda):
+    """Regression (a Python API trial): ``fk(robot, q, ["flange"])`` said "Unknown frame
+    ['flange']" as if the name were wrong; a frame is one name a call."""
+    with pytest.raises(WrongTypeError, match="^frame: expected a frame's name"):
+        dynid.fk(panda, Q7, ["flange"])
+    np.testing.assert_array_equal(dynid.fk(panda, Q7, "flange"), dynid.fk(panda, Q7))

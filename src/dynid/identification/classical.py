@@ -39,7 +39,7 @@ from typing import Literal
 
 import numpy as np
 
-from ..exceptions import OptionError
+from ..exceptions import OptionError, WrongTypeError
 from ..model.drive import Drive
 from ..model.robot import Robot, checked_robot
 from ..regressors.base import BaseParameters
@@ -187,7 +187,13 @@ def identify_from_log(
         (:func:`~dynid.identification.least_squares.conditioning_advice`); identified
         friction that is not dissipative.
     """
-    robot, log = checked_robot(robot), checked_log(log)
+    robot = checked_robot(robot)
+    if isinstance(log, list | tuple):
+        raise WrongTypeError(
+            f"log: expected a TorqueLog, got a {type(log).__name__} of {len(log)}; several "
+            "recordings go to dynid.workflows.identify.identify_logs, which keeps each apart"
+        )
+    log = checked_log(log)
     if not isinstance(structure, Structure) and structure not in ("auto", "classical"):
         raise OptionError(
             f"must be 'auto', 'classical' or a Structure; got {structure!r}", field="structure"

@@ -459,8 +459,8 @@ def velocity_note(cutoff_hz: float) -> str:
         "then central differences) at the cut-off of the step that prepares the log "
         "(identification, validation and friction at theirs, "
         f"{cutoff_hz:g} Hz when the log is read alone; the observer at "
-        f"{OBSERVER_CUTOFF_HZ:g} Hz; a cut-off not below half the log's rate at a quarter "
-        "of the rate)"
+        f"{OBSERVER_CUTOFF_HZ:g} Hz; a cut-off at or above half the log's sample rate, "
+        "where no filter holds, lowered to a quarter of the rate)"
     )
 
 

@@ -360,7 +360,10 @@ class Robot:
         return inertial_from_phi(self.phi)[2]
 
     def frame(self, name: str) -> Frame:
-        """The named frame; raises :class:`UnknownNameError` listing the available ones."""
+        """The named frame; raises :class:`UnknownNameError` listing the available ones,
+        :class:`WrongTypeError` for anything but a name (a list of names: one call each)."""
+        if not isinstance(name, str):
+            raise _checks.wrong_type("frame", name, "a frame's name (str; one call a frame)")
         try:
             return self.frames[name]
         except (KeyError, TypeError):  # TypeError: not a name (unhashable)
