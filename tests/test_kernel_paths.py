@@ -909,12 +909,13 @@ def test_a_scalar_is_not_a_joint_vector_of_a_one_joint_robot():
                 f(r1, *args)
 
 
-def test_a_frame_that_is_not_a_name_is_an_unknown_frame(panda):
-    """An unhashable frame raises UnknownNameError on every path, as a wrong name does."""
+def test_a_frame_that_is_not_a_name_is_a_wrong_type(panda):
+    """A frame that is not a name (a list of names) raises WrongTypeError naming ``frame``
+    on every path, never a TypeError of an unhashable key."""
     q = np.zeros(7)
     dynid.fk(panda, q), dynid.jacobian(panda, q)
     for f in (dynid.fk, dynid.jacobian, fk_numpy, jacobian_numpy):
-        with pytest.raises(dynid.UnknownNameError, match="available"):
+        with pytest.raises(dynid.WrongTypeError, match="^frame: expected a frame's name"):
             f(panda, q, frame=["flange"])
 
 

@@ -96,6 +96,17 @@ def classical_structure(drive: Drive | None = None, friction: bool = True) -> St
     return Structure(armature=armature, friction=_CLASSICAL if friction else ())
 
 
+def _one_log(log: object) -> TorqueLog:
+    """``log`` when it is one :class:`TorqueLog`; a list of them named with the function
+    that takes several (:func:`~dynid.identification.log.checked_log` otherwise)."""
+    if isinstance(log, list | tuple):
+        raise WrongTypeError(
+            f"log: expected a TorqueLog, got a {type(log).__name__} of {len(log)}; several "
+            "recordings go to dynid.workflows.identify.identify_logs, which keeps each apart"
+        )
+    return checked_log(log)
+
+
 def identify_from_log(
     robot: Robot,
     log: TorqueLog,
@@ -187,13 +198,7 @@ def identify_from_log(
         (:func:`~dynid.identification.least_squares.conditioning_advice`); identified
         friction that is not dissipative.
     """
-    robot = checked_robot(robot)
-    if isinstance(log, list | tuple):
-        raise WrongTypeError(
-            f"log: expected a TorqueLog, got a {type(log).__name__} of {len(log)}; several "
-            "recordings go to dynid.workflows.identify.identify_logs, which keeps each apart"
-        )
-    log = checked_log(log)
+    robot, log = checked_robot(robot), _one_log(log)
     if not isinstance(structure, Structure) and structure not in ("auto", "classical"):
         raise OptionError(
             f"must be 'auto', 'classical' or a Structure; got {structure!r}", field="structure"
