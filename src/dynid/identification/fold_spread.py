@@ -110,10 +110,12 @@ def coefficient_covariance(
     p = rows[0][1].shape[-1]
     G, meat = np.zeros((p, p)), np.zeros((p, p))
     for k, Y in rows:
-        w = 1.0 / s if weighted else np.ones_like(s)
-        G += k * np.einsum("mjp,j,mjq->pq", Y, w, Y)
-        if not weighted:
-            meat += k * np.einsum("mjp,j,mjq->pq", Y, s, Y)
+        flat = Y.reshape(-1, p)
+        if weighted:
+            G += k * _weighted_gram(Y, 1.0 / s)
+        else:
+            G += k * (flat.T @ flat)
+            meat += k * _weighted_gram(Y, s)
     Gp = _pinv(G)
     return Gp if weighted else Gp @ meat @ Gp
 
@@ -122,7 +124,7 @@ def prediction_variance(Y: NDArray[np.float64], cov: NDArray[np.float64]) -> NDA
     """``diag(Y_i Sigma Y_i^T)`` (M, n) [N^2 m^2]: the variance coefficients of covariance
     ``cov`` (p, p) put into the prediction ``Y_i x`` at each sample ``i`` of ``Y``
     (M, n, p)."""
-    out = np.einsum("mjp,pq,mjq->mj", Y, cov, Y)
+    out = np.sum((Y @ cov) * Y, axis=-1)
     return np.asarray(np.maximum(out, 0.0), dtype=np.float64)  # round-off below zero
 
 
@@ -187,6 +189,15 @@ def loose_folds(
         "held-out error of so few data tells little of the model; hint: --validate-on a "
         "recording of another trajectory, or longer recordings"
     )
+
+
+def _weighted_gram(Y: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``sum_i Y_i^T diag(w) Y_i`` (p, p) of rows ``Y`` (M, n, p) and joint weights ``w``
+    (n,), as one product of the stacked rows (BLAS; an einsum of three operands loops)."""
+    flat = Y.reshape(-1, Y.shape[-1])
+    weighted = (Y * w[None, :, None]).reshape(flat.shape)
+    out: NDArray[np.float64] = weighted.T @ flat
+    return out
 
 
 def _pinv(G: NDArray[np.float64]) -> NDArray[np.float64]:
