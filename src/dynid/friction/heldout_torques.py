@@ -506,7 +506,7 @@ def _each_recording(
 
 #: Samples of each recording at most whose regressor the folds' covariance is summed over
 #: (every k-th: the regressor is smooth, its normal equations barely change).
-_SPREAD_SAMPLES = 4_000
+_SPREAD_SAMPLES = 1_500
 
 
 def _fold_spread(

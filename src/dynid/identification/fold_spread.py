@@ -124,7 +124,8 @@ def prediction_variance(Y: NDArray[np.float64], cov: NDArray[np.float64]) -> NDA
     """``diag(Y_i Sigma Y_i^T)`` (M, n) [N^2 m^2]: the variance coefficients of covariance
     ``cov`` (p, p) put into the prediction ``Y_i x`` at each sample ``i`` of ``Y``
     (M, n, p)."""
-    out = np.sum((Y @ cov) * Y, axis=-1)
+    flat = Y.reshape(-1, Y.shape[-1])
+    out = np.einsum("ip,ip->i", flat @ cov, flat).reshape(Y.shape[:-1])
     return np.asarray(np.maximum(out, 0.0), dtype=np.float64)  # round-off below zero
 
 
