@@ -633,6 +633,5 @@ def checked_robot(robot: object, name: str = "robot") -> Robot:
     WrongTypeError
         It is not (``"robot: expected a Robot (...), got str"``).
     """
-    if not isinstance(robot, Robot):
-        raise _checks.wrong_type(name, robot, ROBOT_EXPECTED)
-    return robot
+    out: Robot = _checks.of_type(name, robot, Robot, ROBOT_EXPECTED)
+    return out
