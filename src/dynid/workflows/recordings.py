@@ -40,7 +40,8 @@ unwrapped by the preparation's rule (:func:`unwrapped_recorded`), not a whole tu
   tau=...``, or the model's recorded one): an error naming it and ``--units tau=mNm``
   (:func:`check_torque_unit`; ``identify`` and ``observe`` alike);
 * a recording whose positions lie far outside the model's joint limits (of another robot):
-  a warning naming it;
+  a warning naming it; torques beyond the model's effort limits: a note naming the joints
+  (:mod:`~dynid.identification.effort_limits`);
 * one-sample torque spikes (:func:`~dynid.identification.spikes.despiked`, the rule
   ``identify`` applies before fitting): replaced by :func:`despiked_recordings`
   (``validate`` before judging, ``observe`` before the observer runs), with a warning per
@@ -70,6 +71,7 @@ from ..identification.derivative_columns import (
     acceleration_noise_ratio,
     velocity_finding,
 )
+from ..identification.effort_limits import effort_limit_finding
 from ..identification.log import (
     DEFAULT_CUTOFF_HZ,
     TorqueLog,
@@ -911,8 +913,10 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
     and a recording with joints in degrees
     (:func:`~dynid.identification.unit_mix.joints_in_degrees`); warn about a recording
     whose (joint-side) positions lie far outside the joint limits (:data:`LIMIT_MARGIN`
-    beyond them), naming it; a joint recorded wrapped (:attr:`Recorded.wrapped`) is left
-    to the preparation's warning, which names its jumps and its limits.
+    beyond them), naming it; note torques beyond the effort limits
+    (:func:`~dynid.identification.effort_limits.effort_limit_finding`); a joint recorded
+    wrapped (:attr:`Recorded.wrapped`) is left to the preparation's warning, which names
+    its jumps and its limits.
 
     Raises
     ------
@@ -946,6 +950,8 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
                 DynidWarning,
                 stacklevel=3,
             )
+    if (said := effort_limit_finding(robot, [log.tau for log in sides])) is not None:
+        _log.log(NOTE, "%s", said)
 
 
 def _counts_hint(q: NDArray[np.float64]) -> str:
