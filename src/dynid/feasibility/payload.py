@@ -1073,7 +1073,11 @@ def model_with_payload(model: IdentifiedModel, est: PayloadEstimate) -> Identifi
     (:func:`robot_with_payload`) and ``P`` the model's base-parameter map
     (:attr:`~dynid.regressors.base.BaseParameters.projection`); its friction, rotor
     inertias, offsets, drive and recorded preprocessing as they are. The standard
-    deviations stay the arm's (the load's are the estimate's).
+    deviations stay the arm's (the load's are the estimate's). Its description (the link
+    inertials the checks against the description and a consistent fit's prior read,
+    :attr:`~dynid.identification.model.IdentifiedModel.description`) carries the load too:
+    without it, validating the loaded model on the loaded arm read the load as torque
+    constants 1.34 x off (a simulated xArm's currents, true factor 1).
 
     A base-parameter model has no links of its own to add the load to: its
     ``equivalent_robot`` puts each combination on one parameter (masses of 0 holding first
@@ -1085,4 +1089,6 @@ def model_with_payload(model: IdentifiedModel, est: PayloadEstimate) -> Identifi
     P = model.base.projection[:, : dphi.size]
     beta = np.asarray(model.fit.beta) + P @ dphi
     rest = [np.asarray(t.values) for t in model.appended]
-    return model.with_coefficients(np.concatenate([beta, *rest]))
+    loaded_model = model.with_coefficients(np.concatenate([beta, *rest]))
+    described = np.asarray(model.description.phi).reshape(-1) + dphi
+    return replace(loaded_model, description_phi=described.reshape(kin.n, 10))
