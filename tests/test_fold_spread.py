@@ -100,6 +100,7 @@ def test_two_short_recordings_of_the_truths_structure_are_at_the_floor(arm):
     assert v.level == "good", v.reason
     assert np.all(floor.joint_ratios <= SYSTEMATIC_RATIO), floor.joint_ratios
     assert "that of the coefficients fitted without these samples" in v.reason
+    assert str(v) == f"{v.label}: {v.reason}" and str(v).startswith("at the noise floor: ")
     assert floor.fit_rms is not None and np.all(floor.fit_rms > 0)
     assert held.as_dict()["fit_noise_rms"] == pytest.approx(floor.fit_rms.tolist())
 

@@ -150,6 +150,10 @@ class Verdict:
         """The model does not explain the torques."""
         return self.level == "unusable"
 
+    def __str__(self) -> str:
+        """The verdict as the commands print it: ``"label: reason"``."""
+        return f"{self.label}: {self.reason}"
+
 
 def worst(*levels: Level) -> Level:
     """The worst of ``levels`` (``"good"`` when none)."""
