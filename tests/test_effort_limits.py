@@ -64,3 +64,10 @@ def test_the_commands_check_notes_it(caplog):
         check_limits(rec, dynid.panda())
     said = [r.getMessage() for r in caplog.records if "effort limits" in r.getMessage()]
     assert len(said) == 1 and "(peak 24 N m, limit 12 N m: 2 x)" in said[0]
+
+
+def test_a_limit_at_the_largest_float_is_no_limit():
+    """An export writes a joint without a limit as the largest float: no overflow, no note."""
+    robot = dataclasses.replace(dynid.panda(), tau_max=np.full(7, np.finfo(float).max))
+    with np.errstate(over="raise"):
+        assert effort_limit_finding(robot, [_alternating([100.0] * 7)]) is None

@@ -109,14 +109,17 @@ def test_retrieve_model_refuses_columns_in_one_line(tmp_path, capsys):
     assert len(err) == 1 and "--columns applies to --static only" in err[0]
 
 
-def test_validate_refuses_static_data_in_one_line_naming_predict(tmp_path, capsys):
-    """validate on static data: one line saying the file holds static data and what gives a
-    model's M and g at a held-out configuration (not the torque log's header error), exit
-    code 2, nothing written."""
-    q, M, g, _ = _truth(3, False)
+def test_validate_judges_static_data_and_names_the_hand_the_description_lacks(tmp_path, capsys):
+    """validate on static data (Pinocchio's M and g of the Panda with its hand, a file that
+    records no noise) judges the model's M and g there: the description without the hand
+    errs on g by the hand's gravity torques, which the verdict does not call good; with
+    the hand's torques subtracted, round-off."""
+    q, M, g, _ = _truth(12, True)
     path = save_static_data(tmp_path / "heldout.csv", StaticDataset(q, M, g))
     out = tmp_path / "v"
-    assert main(["validate", "--robot", "panda", "--data", str(path), "--out", str(out)]) == 2
-    err = [ln for ln in capsys.readouterr().err.splitlines() if "error" in ln]
-    assert len(err) == 1 and "heldout.csv holds static data (q, M, g)" in err[0], err
-    assert "dynid predict" in err[0] and "header" not in err[0] and not out.exists()
+    assert main(["validate", "--robot", "panda", "--data", str(path), "--out", str(out)]) == 0
+    doc = json.loads((out / "validation.json").read_text())
+    assert doc["schema"] == "dynid-static-validation/1" and doc["verdict"]["level"] != "good"
+    g0 = dynid.gravity_torques(dynid.panda(), q)
+    expected = 100 * np.linalg.norm(g0 - g) / np.linalg.norm(g)  # the hand's share of g
+    assert doc["g_error_percent"] == pytest.approx(expected, rel=1e-9)

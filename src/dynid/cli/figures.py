@@ -14,6 +14,7 @@ from ..feasibility.convex import ConsistentResult
 from ..friction.fit import FrictionFit, FrictionResidual
 from ..friction.heldout_torques import HeldOutTorques
 from ..friction.validation import Validation
+from ..identification.static_validation import StaticValidation
 from ..io.observer_files import log_labels, observation_names
 from ..observer.detection import threshold_series
 from ..observer.results import ObserveResult
@@ -21,6 +22,7 @@ from ..plots import feasible as feasible_plots
 from ..plots import friction as friction_plots
 from ..plots import identification as identification_plots
 from ..plots import observer as observer_plots
+from ..plots import static_check as static_plots
 from ..plots import torques as torque_plots
 from .common import save_figure
 
@@ -53,6 +55,17 @@ def save_friction_figure(
     return save_figure(
         lambda: friction_plots.plot_friction_fit(residual, fit, joint_names=names, **kw), path
     )
+
+
+def save_static_validation_figure(
+    out: Path, result: StaticValidation, *, names: list[str], title: str | None = None
+) -> list[Path]:
+    """Write ``validation_static.png`` under ``out`` (skipped without matplotlib)."""
+    path = save_figure(
+        lambda: static_plots.plot_static_validation(result, joint_names=names, title=title),
+        out / "validation_static.png",
+    )
+    return [] if path is None else [path]
 
 
 def save_validation_figures(

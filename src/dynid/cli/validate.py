@@ -72,6 +72,15 @@ above the noise sits at low speed (standstill, reversals, the edges of a move: w
 velocities' noise and low-pass blur a friction step) the verdict says so, with the error
 elsewhere against the noise.
 
+Static data (q, M, g at configurations, as acquire-static writes them: the controller's
+M(q) and g(q) the paper identifies from) given to --data are judged as such: the model's
+M and g at the file's configurations against the file's, the relative errors of M, g and
+both, per joint (g_j and row j of M) against the noise the file records (its
+relative_noise, with an identified model's coefficients' own error), and the verdict by
+the same rules; validation.json then has schema dynid-static-validation/1 and the figure
+is OUT/validation_static.png. One static file a call; the torque logs' options (--cutoff,
+--friction, --drive, --columns, ...) are refused there.
+
 Exit status: 0 when the model explains the log (at the noise floor, usable or poor); 1
 when it is unusable, its files written all the same (the verdict line says why); 2 an
 error (a bad file, another joint count: one line naming the file).
@@ -87,6 +96,7 @@ the log.
 
 Example:
   dynid validate --robot panda --data traj.csv --out out/validation
+  dynid validate --model out/identification.json --data static_held.csv --out out/static
   dynid validate --model out/identification.json --data held/ --out out/validation
 """
 
@@ -95,13 +105,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..exceptions import DataError
 from ..friction.pooled import joined_validation
 from ..identification.model import IdentifiedModel
-from ..io.validation_json import save_validation_json
+from ..identification.static_validation import StaticValidation
+from ..io.validation_json import save_static_validation_json, save_validation_json
 from ..model.robot import Robot
 from ..model.units import unit_said
 from ..workflows.validate import ValidateOptions, ValidateResult, validate_files
-from .applies import urdf_chain
+from ..workflows.validate_static import static_files, validate_static_file
+from .applies import Applies, urdf_chain
 from .common import (
     CUTOFF_NONE_HELP,
     add_column_options,
@@ -118,7 +131,7 @@ from .common import (
     shown,
 )
 from .console import Console
-from .figures import save_validation_figures
+from .figures import save_static_validation_figure, save_validation_figures
 from .sources import load_model_source, params_as_robot
 from .summaries import format_rms_table
 
@@ -126,7 +139,34 @@ NAME = "validate"
 #: ``--out`` is a folder: its files are one output set (:mod:`dynid.outputs.run_output`).
 OUTPUT = "folder"
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
-APPLIES = (urdf_chain(also=("params",)),)
+APPLIES = (
+    urdf_chain(also=("params",)),
+    Applies(
+        (
+            "friction",
+            "no_friction",
+            "columns",
+            "units",
+            "cutoff",
+            "max_gap",
+            "torque_delay",
+            "drive",
+            "q_start",
+        ),
+        lambda a: _torque_logs(a),
+        "torque logs",
+        "static data hold M and g at rest: no motion to filter, no friction, no drive",
+    ),  # fmt: skip
+)
+
+
+def _torque_logs(args: argparse.Namespace) -> bool:
+    """The route of torque logs: ``--data`` holds no static data (files the readers
+    refuse are theirs to name)."""
+    try:
+        return static_files(args.data) is None
+    except (DataError, OSError):
+        return True
 
 
 def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -175,6 +215,9 @@ def run(args: argparse.Namespace, console: Console) -> int:
     args = params_as_robot(args)  # a URDF, TOML or MJCF --params: as --robot reads it
     model, label = load_model_source(args)
     robot = model.robot if isinstance(model, IdentifiedModel) else model
+    static = static_files(args.data)
+    if static is not None:
+        return _run_static(args, console, model, label, static)
     options = ValidateOptions(
         friction=args.friction or ("none" if args.no_friction else "own"),
         columns=(args.columns, args.units),
@@ -195,6 +238,47 @@ def run(args: argparse.Namespace, console: Console) -> int:
         _save_figures(args.out, result, list(robot.joint_names), label)
     print_validation(console, result, robot, path)
     return 1 if result.verdict.unusable else 0
+
+
+def _run_static(
+    args: argparse.Namespace,
+    console: Console,
+    model: IdentifiedModel | Robot,
+    label: str,
+    path: Path,
+) -> int:
+    """Static data: the model's M and g at the file's configurations, validation.json
+    (schema ``dynid-static-validation/1``), the figure and the table."""
+    robot = model.robot if isinstance(model, IdentifiedModel) else model
+    result = validate_static_file(model, path, drop_invalid=args.drop_invalid)
+    out = save_static_validation_json(
+        args.out / "validation.json", result, robot=robot, model=label, data=path.name
+    )
+    if not args.no_figures:
+        title = shown(f"{label} on {path.name}")
+        save_static_validation_figure(args.out, result, names=list(robot.joint_names), title=title)
+    print_static_validation(console, result, robot, path.name, out)
+    return 1 if result.verdict.unusable else 0
+
+
+def print_static_validation(
+    console: Console, result: StaticValidation, robot: Robot, name: str, path: Path
+) -> None:
+    """The table per joint (g and M errors), the errors of M and g, the verdict."""
+    cols = {
+        f"RMS g [{unit_said(robot, 'N m')}]": result.g_rms,
+        "RMS M row [kg m^2]": result.m_rms,
+        "relative [%]": result.joint_percent,
+    }
+    floor = result.floor_percent
+    console.print(
+        format_rms_table(list(robot.joint_names), cols),
+        f"{name}: {result.n_configurations} static configurations; relative error of M "
+        f"{result.m_error_percent:.3g} %, of g {result.g_error_percent:.3g} %"
+        + (f"; noise floor {floor:.3g} %" if floor else "; the data record no noise"),
+        f"relative error {result.relative_error_percent:.3g} %; wrote {path}",
+        f"verdict: {result.verdict}",
+    )
 
 
 def _save_figures(out: Path, result: ValidateResult, names: list[str], label: str) -> None:

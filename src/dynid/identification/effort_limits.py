@@ -59,7 +59,9 @@ def effort_limit_finding(robot: Robot, taus: Sequence[NDArray[np.float64]]) -> s
     peaks = peak_efforts(taus)
     limits = np.asarray(robot.tau_max, dtype=float)
     usable = np.isfinite(limits) & (limits > 0) & np.isfinite(peaks)
-    over = np.flatnonzero(usable & (peaks > LIMIT_SHARE * np.where(usable, limits, np.inf)))
+    # peak / share > limit: a placeholder limit near the float's largest (an export's
+    # "no limit") never overflows
+    over = np.flatnonzero(usable & (np.where(usable, peaks, 0.0) / LIMIT_SHARE > limits))
     if over.size == 0:
         return None
     units = [joint_unit("N m", bool(robot.prismatic[j])) for j in over]

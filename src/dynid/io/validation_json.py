@@ -12,6 +12,12 @@
      ...the caller's keys (model, friction_source, data, cutoff_hz; seed)...,
      "units": {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}}
 
+On static data (``dynid validate`` given ``q, M, g``), schema
+``dynid-static-validation/1``: the model's ``M`` and ``g`` against the file's
+(:meth:`~dynid.identification.static_validation.StaticValidation.as_dict`: the relative
+errors of M, g and both, ``g_rms``, ``m_rms``, per joint, the noise floor and the
+verdict), then ``model``, ``data``, ``joint_names`` and ``units``.
+
 The units are a revolute joint's; on an arm with prismatic joints each says theirs too
 (``"N m (rail: N)"``, :func:`~dynid.model.units.unit_said`).
 """
@@ -23,13 +29,24 @@ from typing import Any
 
 from ..friction.recordings import RecordingsValidation
 from ..friction.validation import Validation
+from ..identification.static_validation import StaticValidation
 from ..model.units import JointKinds, units_said
 from .json_files import save_json
 
-__all__ = ["VALIDATION_SCHEMA", "VALIDATION_UNITS", "save_validation_json"]
+__all__ = [
+    "STATIC_VALIDATION_SCHEMA",
+    "VALIDATION_SCHEMA",
+    "VALIDATION_UNITS",
+    "save_static_validation_json",
+    "save_validation_json",
+]
 
 #: ``schema`` of validation.json.
 VALIDATION_SCHEMA = "dynid-validation/1"
+#: ``schema`` of validation.json on static data.
+STATIC_VALIDATION_SCHEMA = "dynid-static-validation/1"
+#: ``units`` of validation.json on static data.
+STATIC_VALIDATION_UNITS = {"g_rms": "N m", "m_rms": "kg m^2", "errors": "%"}
 #: ``units`` of validation.json.
 VALIDATION_UNITS = {"rms": "N m", "mse": "N^2 m^2", "relative_error_percent": "%"}
 
@@ -70,3 +87,24 @@ def save_validation_json(
     """
     doc = {**validation.as_dict(), **metadata, "units": units_said(robot, VALIDATION_UNITS)}
     return save_json(path, doc, schema=VALIDATION_SCHEMA)
+
+
+def save_static_validation_json(
+    path: str | Path,
+    result: StaticValidation,
+    *,
+    robot: JointKinds,
+    model: str,
+    data: str,
+) -> Path:
+    """Write a static validation (schema ``dynid-static-validation/1``): ``result``'s
+    errors and verdict, the ``model`` and ``data`` compared, ``robot``'s joint names and
+    the units per joint kind; returns ``path``."""
+    doc = {
+        **result.as_dict(),
+        "model": model,
+        "data": data,
+        "joint_names": list(robot.joint_names),
+        "units": units_said(robot, STATIC_VALIDATION_UNITS, ("g_rms",)),
+    }
+    return save_json(path, doc, schema=STATIC_VALIDATION_SCHEMA)

@@ -29,6 +29,7 @@ from ..identification.verdict import (
     joint_levels,
     judge_prediction,
 )
+from ..io.validation_json import STATIC_VALIDATION_SCHEMA
 from .constants import constants_facts
 from .delay import delay_facts, delay_section
 from .html import (
@@ -45,6 +46,7 @@ from .html import (
 )
 from .run import Answer, RunFiles
 from .springs import spring_facts, springs_section
+from .static_check import static_answer
 
 __all__ = ["friction_answer", "validate_answer"]
 
@@ -68,6 +70,8 @@ def validate_answer(run: RunFiles) -> Answer | None:
     doc = run.doc("validation.json")
     if doc is None:
         return None
+    if doc.get("schema") == STATIC_VALIDATION_SCHEMA:  # static data: M and g at configurations
+        return static_answer(run, doc)
     without, with_ = doc.get("without_friction") or {}, doc.get("with_friction")
     best = doc.get("relative_error_percent")
     if not is_number(best):

@@ -368,7 +368,7 @@ def _torque_logs(
     Raises
     ------
     DataError
-        Naming the file and ``dynid predict``.
+        Naming the file and :func:`~dynid.workflows.validate_static.validate_static_file`.
     """
     for path in data_files(data):
         try:
@@ -377,10 +377,10 @@ def _torque_logs(
             continue
         if static:
             raise DataError(
-                f"{path.name} holds static data (q, M, g): validate judges a model's torques "
-                "on torque logs (t, q, dq, tau); hint: a model's M and g at a held-out "
-                "configuration are `dynid predict --model DIR/identification.json --q=... "
-                "--json` (or --params feasible.json), to set against that row of the file"
+                f"{path.name} holds static data (q, M, g): validate_files judges a model's "
+                "torques on torque logs (t, q, dq, tau); hint: validate_static_file(model, "
+                "path) judges its M and g at the file's configurations (as `dynid validate` "
+                "does given static data)"
             )
     return data
 
