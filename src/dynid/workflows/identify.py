@@ -41,6 +41,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
+from .._checks import caller_level
 from ..exceptions import DataError, DynidError, DynidWarning, OptionError
 from ..feasibility.convex import (
     DEFAULT_SDP_MARGIN,
@@ -583,7 +584,7 @@ def identify_logs(
     if shared is None:
         return _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
     said = shared.sentence()
-    warnings.warn(said, DynidWarning, stacklevel=2)
+    warnings.warn(said, DynidWarning, stacklevel=caller_level())
     opt = dataclasses.replace(opt, drive=shared.corrected(opt.drive))  # type: ignore[arg-type]
     got = _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
     info = got.model.info
@@ -718,7 +719,7 @@ def _predicted_heldout(
         warnings.warn(
             f"skipped the held-out prediction (heldout.json and its figures): {exc}",
             DynidWarning,
-            stacklevel=4,
+            stacklevel=caller_level(),
         )
         return None
 
@@ -760,7 +761,7 @@ def _say_gravity_scale(
     gains = None if held is None else held.gains
     fix = None if gains is None or gains.effort != "current" else gains.common
     found = gravity_scale_words(robot, factor, drive, fix)
-    warnings.warn(found, DynidWarning, stacklevel=4)
+    warnings.warn(found, DynidWarning, stacklevel=caller_level())
     info = dataclasses.replace(
         model.info,
         notes=(*model.info.notes, found),
@@ -815,7 +816,7 @@ def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> Identi
     outside the joint limits and a relative error far above the recorded noise warned."""
     outside = limit_violations(robot, data.q)
     if outside is not None:
-        warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=3)
+        warnings.warn(f"{path.name}: {outside}", DynidWarning, stacklevel=caller_level())
     model = in_file(
         path,
         lambda: identify_static(
@@ -830,7 +831,7 @@ def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> Identi
     )
     misfit = fit_mismatch(model.fit.relative_error_percent, data.metadata)
     if misfit is not None:
-        warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=3)
+        warnings.warn(f"{path.name}: {misfit}", DynidWarning, stacklevel=caller_level())
     return _record(model, opt)
 
 
