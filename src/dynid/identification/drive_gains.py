@@ -491,8 +491,8 @@ class DriveGains:
                     f"{unit} {k + 1}'s by {self.factor[k]:.3g} (std {std[k]:.2g})" for k in named
                 )
                 + " (relative to each other, their geometric mean 1: without the robot "
-                "description's masses the common factor is not known; dynid identify with "
-                "--robot names it)"
+                "description's masses the common factor is not known; an identification "
+                "with them names it)"
             )
         elif what == "current":
             said += "; ".join(
@@ -563,7 +563,7 @@ class DriveGains:
             return said + ": change torque_constant in the drive file and identify again"
         return said + (
             f': a scale per {unit} is a drive file with effort = "current" and these factors '
-            "as torque_constant (--units tau=... scales every joint alike)"
+            "as torque_constant (units='tau=...' scales every joint alike)"
         )
 
 

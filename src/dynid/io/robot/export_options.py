@@ -157,9 +157,9 @@ def kept_elsewhere(
     str
         ``the MJCF export (robot.xml) holds them as armature, the TOML export (robot.toml)
         as its [drive] table``; a format not written as ``a TOML export (r.toml, not
-        written) would hold it exactly`` (each one so), after those written with ``, and``: the file's
-        name, not how it is asked for (``path`` of :func:`~dynid.io.export.save_robot`,
-        ``--out`` of a command).
+        written) would hold it exactly`` (each one so), after those written with ``, and``:
+        the file's name, not how it is asked for (``path`` of
+        :func:`~dynid.io.export.save_robot`, ``--out`` of a command).
     """
     stem = Path(path).stem
     named = source and options.source is not None
