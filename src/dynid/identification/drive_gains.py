@@ -425,11 +425,14 @@ class DriveGains:
         ]
         unchecked = [k for k in self.unknown_scale if not self.determined[k]]
         if unchecked:
+            why_not = (
+                "one guessed as the others' is off alike"
+                if common
+                else "their torques as right as their constants"
+            )
             parts.append(
-                f"{unit}(s) {_ids(unchecked)} not checked by these data (their torques as right "
-                "as their constants; a known payload or a torque sensor checks them"
-                + ("; one guessed as the others' is off alike" if common else "")
-                + ")"
+                f"{unit}(s) {_ids(unchecked)} not checked by these data ({why_not}; a known "
+                "payload or a torque sensor checks them)"
             )
         return f"torque constants: {'; '.join(parts)} ({CONSTANTS_DOC})"
 
@@ -573,16 +576,14 @@ def _common_words(gains: DriveGains, common: float) -> str:
     fix: the corrected values (:func:`corrected_constants`) where the constants read through
     are known, else the factor to multiply them by."""
     js = np.flatnonzero(gains.determined)
-    lo, hi = float(gains.factor[js].min()), float(gains.factor[js].max())
     fix = (
         f"multiply torque_constant by {common:.3g}"
         if gains.constants is None
         else corrected_constants(gains.constants, common)
     )
     return (
-        f"{gains.per}s {_ids(js)} share one factor ({lo:.3g} to {hi:.3g}), beyond the "
-        f"description's masses' error: {fix}, unless a load the description lacks makes it "
-        "(identify's gravity finding tells)"
+        f"{gains.per}s {_ids(js)} share one factor beyond the description's masses' error: "
+        f"{fix}, unless a load the description lacks makes it"
     )
 
 
