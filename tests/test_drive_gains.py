@@ -434,7 +434,7 @@ def test_the_constants_line_says_what_the_data_check_and_what_they_cannot(panda)
     assert found is not None and found.constants_words() is None  # torques: no line
     current = dataclasses.replace(found, effort="current", per="motor")
     words = current.constants_words()
-    assert words is not None and words.startswith("torque constants: the true torque_constant over")
+    assert words is not None and words.startswith("torque constants: true over read-through")
     read = _factors_said(words)
     assert set(read) == {1, 2, 3, 4, 5, 6}, words
     for k, (f, u) in read.items():
@@ -444,8 +444,8 @@ def test_the_constants_line_says_what_the_data_check_and_what_they_cannot(panda)
         r"no change to the drive file for motor\(s\) ([\d, ]+): it is within 10 %", words
     )
     assert same is not None and "2" in same[1].split(", "), words  # every checked, not named
-    assert "on the scale of the description's masses, which the data do not check" in words
-    assert "not checked by these data: motor(s) 7, whose torques are as right as the" in words
-    assert "(a known payload or a torque sensor checks them)" in words
+    assert "on the description's masses' scale" in words
+    assert "motor(s) 7 not checked by these data (their torques as right as their" in words
+    assert "a known payload or a torque sensor checks them)" in words
     assert words.endswith("(docs: tutorials/motor-currents.md#what-the-data-check)")
     assert current.as_dict()["constants"] == words

@@ -52,7 +52,7 @@ def test_urdf_export_of_smooth_friction_names_everything_it_leaves_out(tmp_path)
         export_urdf, tmp_path / "robot.urdf", _arm(), ExportOptions(friction=smooth)
     )
     assert len(lines) == 1 and lines[0].startswith("URDF export: robot.urdf holds"), lines
-    toml = "a TOML export (--out robot.toml, not written) would hold it exactly"
+    toml = "a TOML export (robot.toml, not written) would hold it exactly"
     for said in ("tanh(dq / width)", "sign's width", "0.006 rad/s at joint 2", "offsets fo",
                  "-0.44 N m at joint 2", toml):  # fmt: skip
         assert said in lines[0], (said, lines[0])
@@ -152,8 +152,8 @@ def test_urdf_export_names_each_rotor_inertia_it_drops_on_a_line_of_its_own(tmp_
     names = _arm().joint_names
     for name, g, i in zip(names, (3.0, 2.0), ia, strict=True):  # armature g^2 I_a
         assert f"{name} {g**2 * i:.4g}" in rotors, rotors
-    assert "an MJCF export (--out robot.xml, not written) would hold them as armature" in rotors
-    assert "a TOML export (--out robot.toml) as its [drive] table" in rotors
+    assert "an MJCF export (robot.xml, not written) would hold them as armature" in rotors
+    assert "a TOML export (robot.toml, not written) as its [drive] table" in rotors
     _, alone = _warnings(export_urdf, tmp_path / "r.urdf", _arm(), ExportOptions(drive=drive))
     assert len(alone) == 1 and alone[0].startswith("URDF export: r.urdf leaves out"), alone
 

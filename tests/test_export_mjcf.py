@@ -293,9 +293,9 @@ def test_urdf_export_names_what_it_drops_and_mjcf_holds_it(tmp_path):
     lines = [str(w.message) for w in got if issubclass(w.category, DynidWarning)]
     assert len(lines) == 2 and all(x.startswith("URDF export: ") for x in lines), lines
     assert "Coulomb friction of coupled motors" in lines[0] and "rotor" not in lines[0]
-    assert "MJCF" not in lines[1].split("MJCF export (--out r.xml, not written)")[0], lines[1]
+    assert "MJCF" not in lines[1].split("MJCF export (r.xml, not written)")[0], lines[1]
     assert "leaves out the drive's rotor inertias" in lines[1]
-    assert "an MJCF export (--out r.xml, not written) would hold them as armature" in lines[1]
+    assert "an MJCF export (r.xml, not written) would hold them as armature" in lines[1]
     K = drive.transmission
     arm = np.diag(K.T @ np.diag(ia) @ K)
     damping = np.diag(K.T @ np.diag(fv) @ K)

@@ -49,7 +49,8 @@ def _named(line: str) -> list[str]:
 def test_a_single_export_names_only_files_that_exist(tmp_path):
     """Regression: one URDF export named X.xml and X.toml as holding the rotor inertias and
     the friction though neither was written; now every file it names exists (feasible.json,
-    read), and the MJCF and TOML exports are offered as --out."""
+    read), and the MJCF and TOML exports are offered by name, each "not written" (no flag:
+    the Python caller gives a path)."""
     params = _feasible(tmp_path / "feasible.json")
     lines = []
     for out in ("one.urdf", "one.xml"):
@@ -60,10 +61,10 @@ def test_a_single_export_names_only_files_that_exist(tmp_path):
     for line in lines:
         assert all((tmp_path / name).exists() for name in _named(line)), line
     assert "feasible.json holds it exactly" in lines[0]
-    assert "a TOML export (--out one.toml, not written) would hold it exactly" in lines[0]
-    assert "an MJCF export (--out one.xml, not written) would hold them as armature" in lines[1]
-    assert "a TOML export (--out one.toml) as its [drive] table" in lines[1]
-    assert "feasible.json holds it exactly" in lines[2] and "--out one.toml" in lines[2]
+    assert "a TOML export (one.toml, not written) would hold it exactly" in lines[0]
+    assert "an MJCF export (one.xml, not written) would hold them as armature" in lines[1]
+    assert "a TOML export (one.toml, not written) as its [drive] table" in lines[1]
+    assert "feasible.json holds it exactly" in lines[2] and "(one.toml, not written)" in lines[2]
 
 
 def test_an_output_folder_names_the_files_written_beside_each_other(tmp_path):
@@ -129,7 +130,7 @@ def test_a_friction_urdf_cannot_hold_is_said_in_one_sentence(tmp_path):
         assert f", written {written}" in line
         assert ", without the Stribeck peak fs - fc at low speed (no per-joint term)" in line
         assert " and the offsets fo (up to +0.8 N m at joint 7); feasible.json holds it " in line
-        kept = "exactly, and a TOML export (--out s.toml, not written) would hold it exactly"
+        kept = "exactly, and a TOML export (s.toml, not written) would hold it exactly"
         assert line.endswith(kept) or f"{kept}; mj_inverse's friction " in line, line
 
 

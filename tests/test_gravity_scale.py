@@ -61,14 +61,14 @@ def test_one_factor_on_every_parameter_is_named_with_the_torque_constant(q):
     drive = Drive(np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
     said = gravity_scale_finding(robot, model, [q], drive)
     assert said is not None and "0.83 times the robot description's" in said
-    assert "torque_constant" in said and "multiply it by 1.2" in said
+    assert "torque_constant" in said and "(1.2 times the 1 the currents were read through)" in said
     plain = gravity_scale_finding(robot, model, [q])
-    assert plain is not None and "--units tau=1.2" in plain and "currents" not in plain
+    assert plain is not None and "units='tau=1.2'" in plain and "currents" not in plain
     # currents read as torques (3 times the model's): the drive of currents is named too,
     # its torque constants one per motor (a single --units factor fits one joint at most)
     currents = exact_model(robot, robot.with_params(1 / 3 * robot.phi))
     said = gravity_scale_finding(robot, currents, [q])
-    assert said is not None and "--units tau=3" in said
+    assert said is not None and "units='tau=3'" in said
     assert 'effort = "current"' in said and "torque_constant" in said
 
 
@@ -92,7 +92,7 @@ def test_one_factor_near_a_shared_gear_ratio_names_constants_given_at_the_motors
     model = exact_model(robot, robot.with_params(robot.phi / 90.0))
     geared = Drive(100.0 * np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
     said = gravity_scale_finding(robot, model, [q], geared)
-    assert said is not None and "multiply it by 90" in said
+    assert said is not None and "(90 times the 1 the currents were read through)" in said
     assert "near the gear ratio, 100: torque_constant looks given at the motors" in said
     plain = Drive(np.eye(7), np.zeros(7), effort="current", torque_constant=np.ones(7))
     assert "given at the motors" not in (gravity_scale_finding(robot, model, [q], plain) or "")
@@ -152,7 +152,7 @@ def test_torques_scaled_on_every_joint_keep_the_sensor_scale_hint():
     assert found is not None and found.one_factor
     assert abs(found.factor - 0.9) < 3 * found.factor_std
     said = gravity_scale_finding(robot, model, [log.q])
-    assert said is not None and "--units tau=1.11" in said and "0.902 (std 0.0016)" in said
+    assert said is not None and "units='tau=1.11'" in said and "0.902 (std 0.0016)" in said
 
 
 def test_identify_notes_masses_off_and_records_no_scale(caplog):
@@ -245,17 +245,39 @@ def test_a_wrong_torque_constant_beside_masses_off_is_named_first_with_its_fix(s
     masses = _true_ratios(robot, truth, q)[gravity_ratios(robot, got.model, q)[2]]
     factor = got.model.info.extra["gravity_scale"]["factor"]
     assert 2.45 * masses.min() <= factor <= 2.45 * masses.max()
-    kt = 2.45 * SO_KT / factor
+    common = got.heldout.gains.common
+    kt = 2.45 * SO_KT * common
     assert abs(kt / SO_KT - 1) <= np.max(np.abs(1 - 1 / masses))
     (found,) = [w for w in said if "gravity torques" in w]
+    fix = f"torque_constant = [{', '.join([f'{kt:.4g}'] * 5)}]"
     assert found.startswith(
-        f"the torque constants the currents were read through look {factor:.3g} times the "
-        f"true ones on every motor: torque_constant = [{', '.join([f'{kt:.4g}'] * 5)}]"
+        f"the torque constants look off by one factor on every motor: put {fix} "
+        f"({common:.3g} times the {2.45 * SO_KT:.4g} the currents were read through)"
     )
     assert "needs no change" not in found and "a mass of about" not in found
     assert not any("needs no change" in n for n in got.model.info.notes)
     assert line is not None and "no change to the drive file" not in line
-    assert "share one factor" in line and "or a load the description lacks" in line
+    assert "share one factor" in line and "unless a load the description lacks" in line
+
+
+def test_the_warning_and_the_constants_line_give_one_fix_nearer_the_truth(so101):
+    """Regression (an SO-100 trial): one torque-constant factor was named twice with two
+    numbers, the gravity warning's (the gravity torques' ratio, 0.421) and the constants
+    line's (the held-out gains' common factor, 0.415; the truth 0.408). Both now give the
+    same corrected constants, the gains' (fitted with every motor's currents at once),
+    which lie nearer the true constant than the gravity torques' ratio gives them; the
+    line names the factor once (no "times the true one" beside "multiply by")."""
+    robot, truth = so101
+    got, said, line, _ = _so_identified(robot, truth, 2.45 * SO_KT)
+    (found,) = [w for w in said if "gravity torques" in w]
+    kt_line = line.split("torque_constant = [")[1].split("]")[0]
+    kt_warn = found.split("torque_constant = [")[1].split("]")[0]
+    assert kt_line == kt_warn, (line, found)
+    kt = np.array([float(v) for v in kt_warn.split(", ")])
+    by_gravity = 2.45 * SO_KT / got.model.info.extra["gravity_scale"]["factor"]
+    assert np.all(np.abs(kt - SO_KT) < abs(by_gravity - SO_KT)), (kt, by_gravity)
+    assert "times the true one" not in line and "multiply" not in line
+    assert len(found) < 600 and len(line) < 700
 
 
 def test_currents_in_ma_read_as_amperes_name_the_unit(so101):
@@ -265,7 +287,7 @@ def test_currents_in_ma_read_as_amperes_name_the_unit(so101):
     said = _so_identified(robot, truth, SO_KT, scale=1000.0)[1]
     (found,) = [w for w in said if "identified gravity torques" in w]
     assert found.startswith("the currents read") and "currents in mA read as A" in found
-    assert "--units tau=mA" in found and "needs no change" not in found
+    assert "units='tau=mA'" in found and "needs no change" not in found
 
 
 def test_a_load_the_description_lacks_is_still_named_as_a_mass(so101):

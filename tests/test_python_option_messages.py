@@ -73,6 +73,9 @@ def test_urdf_reader_names_tip_link_and_the_command_line_says_tip(tmp_path):
         ("needs a finite <mass value=...>", "needs a finite <mass value=...>"),
         ("`dynid predict --q=... --json`", "`dynid predict --q=... --json`"),
         ("(--keep-outlying, keep_outlying=True)", "(--keep-outlying, keep_outlying=True)"),
+        # a string option given its value: the flag and the value
+        ("scale them (units='tau=1.2') again", "scale them (--units tau=1.2) again"),
+        ("a tag <joint name='a'> stays", "a tag <joint name='a'> stays"),
     ],
 )
 def test_a_python_option_becomes_its_flag(python, command_line):

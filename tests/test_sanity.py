@@ -42,7 +42,7 @@ def test_a_clean_log_has_no_findings(panda_log):
     ("change", "match"),
     [
         (lambda g: TorqueLog(g.t, g.q, g.dq, -g.tau), "--units tau=-1"),
-        (lambda g: TorqueLog(g.t, g.q, g.dq, 1e3 * g.tau), "--units tau=mNm"),
+        (lambda g: TorqueLog(g.t, g.q, g.dq, 1e3 * g.tau), "units='tau=mNm'"),
         (lambda g: TorqueLog(g.t, np.degrees(g.q), np.degrees(g.dq), g.tau), "--units q=deg"),
         (lambda g: TorqueLog(1e3 * g.t, g.q, g.dq, g.tau), "--units t=ms"),
     ],
@@ -64,9 +64,9 @@ def test_only_a_clean_factor_of_1000_reads_as_torques_in_other_units(panda_log):
         k: TorqueLog(panda_log.t, panda_log.q, panda_log.dq, k * panda_log.tau)
         for k in (1e3, 1.6e3, 1e-3, 300.0)
     }
-    assert "--units tau=mNm" in torque_unit_finding(robot, scaled[1e3])
-    assert "--units tau=mNm" in torque_unit_finding(robot, scaled[1.6e3])
-    assert "--units tau=1000" in torque_unit_finding(robot, scaled[1e-3])
+    assert "units='tau=mNm'" in torque_unit_finding(robot, scaled[1e3])
+    assert "units='tau=mNm'" in torque_unit_finding(robot, scaled[1.6e3])
+    assert "units='tau=1000'" in torque_unit_finding(robot, scaled[1e-3])
     assert torque_unit_finding(robot, scaled[300.0]) is None
     assert "times the model's gravity torques" in check_torque_log(robot, scaled[300.0])[0]
     for k in (0.6, 1.6):  # a URDF whose masses (and so inertias) are off
@@ -92,7 +92,7 @@ def test_a_current_drive_with_torque_constants_is_named_not_asked_for(panda_log)
         # the torques hold more than gravity: the factor within 15 % of the constants' ratio
         assert factor is not None and float(factor[1]) == pytest.approx(k, rel=0.15)
     refused = torque_unit_finding(robot, read, wrong)
-    assert "torque_constant" in refused and "--units tau=1000" not in refused
+    assert "torque_constant" in refused and "units='tau=1000'" not in refused
     bare = joint_side_log(currents, dataclasses.replace(true, torque_constant=np.full(7, 0.02)))
     assert "currents need" in check_torque_log(robot, bare)[0]  # no drive given: asked for
     wrong = dataclasses.replace(true, torque_constant=np.full(7, 0.02))

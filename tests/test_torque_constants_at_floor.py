@@ -235,7 +235,7 @@ def test_the_constants_line_says_a_factor_clear_of_1_in_sample_and_why_not_named
     assert said is not None and "4" in said[1].split(", "), words
     assert "it is within 10 % of 1" in said[2]
     assert "at the noise floor it is within 5 times its spread over the folds of 1" in said[2]
-    assert "not checked by these data: joint(s) 5, 6, 7, whose torques are as right" in words
+    assert "joint(s) 5, 6, 7 not checked by these data (their torques as right" in words
 
 
 def test_validate_and_identify_print_the_constants_line(fits, other_currents, tmp_path, capsys):
@@ -250,13 +250,11 @@ def test_validate_and_identify_print_the_constants_line(fits, other_currents, tm
     assert main([*argv, "--no-figures", "--out", str(tmp_path / "v")]) == 0
     out = capsys.readouterr().out.splitlines()
     verdict = next(i for i, line in enumerate(out) if line.startswith("verdict: "))
-    assert out[verdict + 1].startswith(
-        "torque constants: the true torque_constant over the drive file's"
-    )
+    assert out[verdict + 1].startswith("torque constants: true over read-through")
     doc = json.loads((tmp_path / "v" / "validation.json").read_text())
     assert doc["drive_gains"]["constants"] == out[verdict + 1]
     page = (tmp_path / "v" / "report.html").read_text()
-    assert "Torque constants: the true torque_constant over the drive file" in page
+    assert "Torque constants: true over read-through" in page
     kt = ", ".join(f"{x:.17g}" for x in KT * np.asarray(NEAR))
     drive = tmp_path / "drive.toml"
     drive.write_text(
@@ -268,8 +266,8 @@ def test_validate_and_identify_print_the_constants_line(fits, other_currents, tm
     assert main(argv) == 0
     out = capsys.readouterr().out.splitlines()
     verdict = next(i for i, line in enumerate(out) if line.startswith("held-out verdict"))
-    assert out[verdict + 1].startswith("torque constants: the true torque_constant")
+    assert out[verdict + 1].startswith("torque constants: true over read-through")
     doc = json.loads((tmp_path / "i" / "heldout.json").read_text())
     assert doc["drive_gains"]["constants"] == out[verdict + 1]
     page = (tmp_path / "i" / "report.html").read_text()
-    assert "Torque constants: the true torque_constant" in page
+    assert "Torque constants: true over read-through" in page

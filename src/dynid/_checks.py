@@ -411,3 +411,33 @@ def parse_toml(text: str, file: str, error: type[DynidError]) -> dict[str, Any]:
         raise error("not valid TOML (arrays or tables nested too deeply)", file=file) from None
     except ValueError:  # int() refusing a literal of more than 4300 digits
         raise error("not valid TOML (an integer of more than 4300 digits)", file=file) from None
+
+
+#: Modules a warning's caller frame is never in: the package's own and those that only
+#: pass a call through (a context manager's exit, a partial).
+_PASS_THROUGH = ("contextlib", "functools")
+
+
+def caller_level() -> int:
+    """The ``stacklevel`` of a library warning that points to the user's call: the first
+    frame outside the ``dynid`` package (and outside :data:`_PASS_THROUGH`), counted from
+    the function that calls ``warnings.warn(..., stacklevel=caller_level())``; the
+    outermost frame where every frame is the package's (a command line run).
+
+    One rule for every warning, whatever the depth of the call that makes it: a fixed
+    ``stacklevel`` points into the package as soon as a call is made through another
+    entry point."""
+    import sys
+
+    frame = sys._getframe(1)  # the function that warns: stacklevel 1
+    level = 1
+    while frame.f_back is not None and _inside(frame):
+        frame = frame.f_back
+        level += 1
+    return level
+
+
+def _inside(frame: Any) -> bool:
+    """Whether ``frame`` runs code of the package or of :data:`_PASS_THROUGH`."""
+    name = str(frame.f_globals.get("__name__", ""))
+    return name == "dynid" or name.startswith("dynid.") or name in _PASS_THROUGH

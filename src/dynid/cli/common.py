@@ -118,9 +118,12 @@ def cli_text(message: str) -> str:
     option of a value, ``max_std_percent=...`` (``hint: max_std_percent=... removes
     them`` -> ``hint: --max-std-percent removes them``); a flag the message already names
     is not repeated (``pass --drop-invalid (drop_invalid=True)`` -> ``pass
-    --drop-invalid``). A ``name=...`` that is a flag's own value (``--units tau=...``,
-    ``--q=...``) or an XML attribute (``<mass value=...>``) stays as it is."""
+    --drop-invalid``). A string option given its value, ``units='tau=mA'``, becomes the
+    flag and the value, ``--units tau=mA``. A ``name=...`` that is a flag's own value
+    (``--units tau=...``, ``--q=...``) or an XML attribute (``<mass value=...>``) stays as
+    it is."""
     out = re.sub(r"\((\w+)=True\)", lambda m: f"({flag(m.group(1))})", message)
+    out = _PYTHON_VALUE.sub(lambda m: _value_flag(m, out), out)
     out = _PYTHON_OPTION.sub(lambda m: _option_flag(m, out), out)
     return re.sub(r"(--[\w-]+) \(\1\)", r"\1", out)
 
@@ -128,6 +131,20 @@ def cli_text(message: str) -> str:
 #: A Python option of a value named in a library message, ``name=...``: a word standing
 #: alone (not an attribute's, a flag's or a longer name's end, nor after ``,`` or ``=``)
 _PYTHON_OPTION = re.compile(r"(?<![\w.,=-])([a-z]\w*)=\.\.\.")
+
+
+#: A Python string option given its value in a library message, ``units='tau=mA'``: a
+#: word standing alone, the value quoted and without spaces.
+_PYTHON_VALUE = re.compile(r"(?<![\w.,=-])([a-z]\w*)='([^'\s<>]+)'")
+
+
+def _value_flag(m: re.Match[str], text: str) -> str:
+    """The flag and value of the option ``m`` matched in ``text``, ``--units tau=mA``, or
+    the match itself inside an XML tag."""
+    before = text[: m.start()]
+    if before.rfind("<") > before.rfind(">"):
+        return m.group(0)
+    return f"{flag(m.group(1))} {m.group(2)}"
 
 
 def _option_flag(m: re.Match[str], text: str) -> str:

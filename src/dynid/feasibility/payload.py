@@ -93,6 +93,7 @@ from typing import Any, Literal, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from ..exceptions import (
     DataError,
     DynidWarning,
@@ -638,7 +639,7 @@ def _estimate(
     undetermined = every if at_bound or (misfit and p == 10) else by_std
     about_inertia = inertia_doubts(by_std, I, si, at_bound=at_bound, margin=margin)
     for line in doubts + about_inertia:
-        warnings.warn(line, DynidWarning, stacklevel=3)
+        warnings.warn(line, DynidWarning, stacklevel=caller_level())
     return PayloadEstimate(
         frame=frame,
         link=k,

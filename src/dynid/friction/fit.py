@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from .._checks import caller_level
 from ..dynamics.rnea import rnea
 from ..exceptions import ConvergenceError, DataError, DynidWarning, ShapeError, WrongTypeError
 from ..identification.log import TorqueLog, checked_log, joint_side_log
@@ -237,7 +238,7 @@ def same_drive(drive: Drive | None, own: Drive | None, whose: str, what: str) ->
                     f"as identify did (torque_constant looks given at the motors): read so; "
                     f"hint: put {whose}'s torque_constant in the drive file",
                     DynidWarning,
-                    stacklevel=2,
+                    stacklevel=caller_level(),
                 )
                 return own
             if own.effort == "current" and own.torque_constant is not None:
@@ -247,7 +248,7 @@ def same_drive(drive: Drive | None, own: Drive | None, whose: str, what: str) ->
                     f"{_short(theirs.get('torque_constant'))} (identified through them); "
                     f"hint: leave out --drive to read them through {whose}'s",
                     DynidWarning,
-                    stacklevel=2,
+                    stacklevel=caller_level(),
                 )
             return replace(own, effort=drive.effort, torque_constant=drive.torque_constant)
         given = ", ".join(
@@ -309,7 +310,7 @@ def _identifiable(dq: NDArray[np.float64], noise_std: ArrayLike | None) -> NDArr
             "not identifiable from this log and is set to zero; hint: record a trajectory "
             "that moves them",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
     return moving
 

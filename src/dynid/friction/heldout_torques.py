@@ -806,7 +806,8 @@ def residual_gains(
         return None
     per: Literal["joint", "motor"] = "joint" if per_joint(drive) else "motor"  # gear ratio 1
     if drive is not None and drive.effort == "current":
-        return dataclasses.replace(found, effort="current", per=per, floor=floor)
+        kt = None if drive.torque_constant is None else np.asarray(drive.torque_constant)
+        return dataclasses.replace(found, effort="current", per=per, floor=floor, constants=kt)
     return dataclasses.replace(found, per=per, floor=floor)
 
 

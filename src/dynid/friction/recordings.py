@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.cut_loss import left_out_finding
 from ..identification.input_noise import StateNoise, state_noise
@@ -336,7 +337,7 @@ def _say_left_out(raw: _Raw, left: list[tuple[int, str]], max_gap_s: float | Non
     if (
         finding := left_out_finding(raw.names, raw.pieces, left, raw.trim_s, max_gap_s)
     ) is not None:
-        warnings.warn(finding, DynidWarning, stacklevel=3)
+        warnings.warn(finding, DynidWarning, stacklevel=caller_level())
 
 
 def _kept(

@@ -67,6 +67,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.candidates import RELATIVE_TIE, paired_fold_se
 from ..identification.dissipation import Violation
@@ -448,7 +449,7 @@ def _dissipative(scores: Sequence[CandidateScore]) -> list[CandidateScore]:
         f"offset aside), so the one kept pushes the arm somewhere: {where}; hint: check the "
         "torque sign of those joints (--units tauJ=-1) and the model's terms",
         DynidWarning,
-        stacklevel=3,
+        stacklevel=caller_level(),
     )
     return list(scores)
 

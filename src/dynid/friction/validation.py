@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from .._checks import caller_level
 from ..dynamics.rnea import rnea
 from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
 from ..identification.input_noise import exact_to_round_off
@@ -446,7 +447,7 @@ def _warn_opposite_sign(tau: NDArray[np.float64], tau_model: NDArray[np.float64]
             "model was identified with; hint: a log recorded as the identification's was, or "
             "its torque columns negated",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
 
 

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from .._memo import scoped, value_key
 from ..exceptions import DynidWarning, OptionError, RankDeficientError, ShapeError
 from ..model.drive import Drive
@@ -356,7 +357,7 @@ def identify(
         raise _rank_error(exc, data, columns, stack, fit_rtol, structural) from exc
     held = None if judge is None else judge(stack, columns, ~frozen, fit.beta)
     for msg in conditioning_advice(fit, labels, what=_what(data)) if advise else ():
-        warnings.warn(msg, DynidWarning, stacklevel=2)
+        warnings.warn(msg, DynidWarning, stacklevel=caller_level())
     info = _record(data, columns, fit, stack, est.name, std, max_std_percent, rtol)
     if held is not None:
         kept = np.flatnonzero(fit.kept)

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning
 from ..regressors.terms import PART_LABELS, LinearFriction, ModelTerm
 
@@ -456,5 +457,5 @@ def warn_unphysical(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
             "the friction pushes the arm there (--terms without that part, or with "
             f"the part left out on that joint: -LABEL){sign}",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )

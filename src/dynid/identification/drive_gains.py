@@ -60,6 +60,7 @@ __all__ = [
     "RAISE",
     "SIGNIFICANT",
     "DriveGains",
+    "corrected_constants",
     "drive_gains",
     "effort_columns",
 ]
@@ -150,6 +151,10 @@ class DriveGains:
         over the folds (:attr:`heldout_std`) from 1 as well (none without folds): a Panda's
         15 s current log at 100 Hz through constants within 2 % of the true ones read
         joint 4's 0.857, std 0.012 in-sample but 0.075 over the folds, and named it.
+    constants : ndarray, shape (m,), optional
+        The torque constants [N m/A] the currents were read through (the drive's, as the
+        identification used them), for the corrected values the finding gives; None for
+        a log of torques.
     """
 
     factor: NDArray[np.float64]
@@ -165,6 +170,7 @@ class DriveGains:
     heldout_std: NDArray[np.float64] | None = None
     applied: bool = False
     floor: bool = False
+    constants: NDArray[np.float64] | None = None
 
     def ratio_std(self, k: int, r: int) -> float:
         """The standard deviation [-] of motor ``k``'s gain relative to motor ``r``'s,
@@ -382,7 +388,8 @@ class DriveGains:
 
     def constants_words(self) -> str | None:
         """One line for a log of motor currents: which motors' torque constants the data
-        check (:attr:`determined`: the true over the drive file's, at the description's
+        check (:attr:`determined`: the true over those the currents were read through
+        (:attr:`constants`), at the description's
         masses' scale where :attr:`scaled`, which the data do not check, else relative),
         why each that is not named needs no change to the drive file
         (:meth:`unnamed_reason`, the motors of one reason together: a factor read 0.92 +-
@@ -400,14 +407,9 @@ class DriveGains:
                 for k in checked
             )
             scale = (
-                "on the scale of the description's masses, which the data do not check"
-                if self.scaled
-                else "relative to each other, their common scale not known"
+                "on the description's masses' scale" if self.scaled else "relative to each other"
             )
-            parts = [
-                f"the true torque_constant over the drive file's, read from the data {scale}: "
-                f"{reads}"
-            ]
+            parts = [f"true over read-through ({scale}): {reads}"]
         if self.named:
             parts.append(f"{unit}(s) {_ids(self.named)} named above, with the fix")
         why: dict[str, list[int]] = {}
@@ -423,11 +425,14 @@ class DriveGains:
         ]
         unchecked = [k for k in self.unknown_scale if not self.determined[k]]
         if unchecked:
+            why_not = (
+                "one guessed as the others' is off alike"
+                if common
+                else "their torques as right as their constants"
+            )
             parts.append(
-                f"not checked by these data: {unit}(s) {_ids(unchecked)}, whose "
-                "torques are as right as the drive file's constants (a known payload or a "
-                "torque sensor checks them)"
-                + ("; a constant guessed as the others' is off alike" if common else "")
+                f"{unit}(s) {_ids(unchecked)} not checked by these data ({why_not}; a known "
+                "payload or a torque sensor checks them)"
             )
         return f"torque constants: {'; '.join(parts)} ({CONSTANTS_DOC})"
 
@@ -489,8 +494,8 @@ class DriveGains:
                     f"{unit} {k + 1}'s by {self.factor[k]:.3g} (std {std[k]:.2g})" for k in named
                 )
                 + " (relative to each other, their geometric mean 1: without the robot "
-                "description's masses the common factor is not known; dynid identify with "
-                "--robot names it)"
+                "description's masses the common factor is not known; an identification "
+                "with them names it)"
             )
         elif what == "current":
             said += "; ".join(
@@ -561,34 +566,50 @@ class DriveGains:
             return said + ": change torque_constant in the drive file and identify again"
         return said + (
             f': a scale per {unit} is a drive file with effort = "current" and these factors '
-            "as torque_constant (--units tau=... scales every joint alike)"
+            "as torque_constant (units='tau=...' scales every joint alike)"
         )
 
 
 def _common_words(gains: DriveGains, common: float) -> str:
     """The part of :meth:`DriveGains.constants_words` naming the determined motors' common
     factor ``common`` [-] (:attr:`DriveGains.common`) as their torque constants' with its
-    fix."""
+    fix: the corrected values (:func:`corrected_constants`) where the constants read through
+    are known, else the factor to multiply them by."""
     js = np.flatnonzero(gains.determined)
-    lo, hi = float(gains.factor[js].min()), float(gains.factor[js].max())
+    fix = (
+        f"multiply torque_constant by {common:.3g}"
+        if gains.constants is None
+        else corrected_constants(gains.constants, common)
+    )
     return (
-        f"{gains.per}(s) {_ids(js)} share one factor, {common:.3g} ({lo:.3g} to {hi:.3g}), "
-        f"beyond the description's masses' error (over {100 * MASSES:g} % from 1, "
-        f"{AGREE:g} or more times the {gains.per}s' spread about it): their torque_constant "
-        f"{1 / common:.3g} times the true one (multiply it by {common:.3g}) or a load the "
-        "description lacks, which the identified gravity torques tell apart (identify's "
-        "note of them)"
+        f"{gains.per}s {_ids(js)} share one factor beyond the description's masses' error: "
+        f"{fix}, unless a load the description lacks makes it"
+    )
+
+
+def corrected_constants(constants: ArrayLike, factor: float) -> str:
+    """The fix of torque constants ``constants`` (m,) [N m/A] the currents were read
+    through, all off by one ``factor`` [-] (the true over the read), in words a user copies
+    into the drive file: ``torque_constant = [0.7159, 0.7159] (0.415 times the 1.725 the
+    currents were read through)``; the one function both findings of such a factor (the
+    held-out gains' and the gravity torques') write it with."""
+    kt = np.asarray(constants, dtype=np.float64)
+    fixed = ", ".join(f"{v:.4g}" for v in kt * factor)
+    read = f"{kt[0]:.4g}" if np.allclose(kt, kt[0]) else f"[{', '.join(f'{v:.4g}' for v in kt)}]"
+    return (
+        f"torque_constant = [{fixed}] ({factor:.3g} times the {read} the currents were read "
+        "through)"
     )
 
 
 def _read(factor: float, std: float, spread: NDArray[np.float64] | None, k: int) -> str:
     """A factor with its uncertainty, the larger of its in-sample standard deviation
     ``std`` and its spread over the folds (``spread[k]``), said where that is the larger:
-    ``0.932 +- 0.074 (over the folds; 0.0081 in-sample)``."""
+    ``0.932 +- 0.074 (over the folds)``."""
     over = np.nan if spread is None else float(spread[k])
     if not over > std:
         return f"{factor:.3g} +- {std:.2g}"
-    return f"{factor:.3g} +- {over:.2g} (over the folds; {std:.2g} in-sample)"
+    return f"{factor:.3g} +- {over:.2g} (over the folds)"
 
 
 def _ids(motors: Any) -> str:

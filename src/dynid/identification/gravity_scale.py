@@ -49,7 +49,7 @@ from ..dynamics.terms import gravity_torques
 from ..model.drive import Drive
 from ..model.robot import Robot
 from ..regressors.torque import torque_regressor
-from .drive_gains import AGREE, MASSES
+from .drive_gains import AGREE, MASSES, corrected_constants
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded
 
@@ -351,36 +351,39 @@ def _std(x: float) -> str:
     return "" if not np.isfinite(x) else f" (std {x:.2g})"
 
 
-def gravity_scale_words(robot: Robot, found: GravityRatios, drive: Drive | None = None) -> str:
+def gravity_scale_words(
+    robot: Robot, found: GravityRatios, drive: Drive | None = None, fix: float | None = None
+) -> str:
     """:func:`gravity_scale_finding`'s sentence of the factor :func:`gravity_scale_factor`
     ``found`` (one factor on every loaded joint, or beyond the masses' error: then
-    :func:`beyond_masses_words`) of ``robot``."""
+    :func:`beyond_masses_words`) of ``robot``. ``fix``: the torque constants' correction
+    [-] (true over read) where another estimate of the same factor is judged better (the
+    held-out gains' common factor, :attr:`~.drive_gains.DriveGains.common`): the finding
+    then names that one, so that the two agree; else ``1 / found.factor``."""
     if found.beyond_masses:
-        return beyond_masses_words(robot, found, drive)
+        return beyond_masses_words(robot, found, drive, fix)
     mean, r, js = found.factor, found.ratios, found.joints
     names = ", ".join(robot.joint_names[j] for j in js)
     said = (
         f"the identified gravity torques are {mean:.3g}{_std(found.factor_std)} times the "
         f"robot description's on every joint gravity loads ({names}: {r[js].min():.3g} to "
-        f"{r[js].max():.3g}, one factor within their uncertainty): one factor on every "
-        "joint is a scale the fit cannot see (it predicts the log as well with it; its "
-        "masses and inertias carry it)"
+        f"{r[js].max():.3g}), one factor the fit cannot see (it predicts the log as well)"
     )
-    if drive is not None and drive.effort == "current":
+    if drive is not None and drive.effort == "current" and drive.torque_constant is not None:
+        k = 1 / mean if fix is None else fix
         return (
-            f"{said}; if the description's masses are right, the drive file's torque_constant "
-            f"is {mean:.3g} times the true one: multiply it by {1 / mean:.3g}"
-            f"{at_the_motors(drive, 1 / mean)}"
+            f"{said}; if the description's masses are right, the torque constants are off: "
+            f"{corrected_constants(drive.torque_constant, k)}{at_the_motors(drive, k)}"
         )
     currents = (
-        '; or the log holds motor currents: a drive file with effort = "current" and each '
-        "motor's torque_constant (a factor per joint)"
+        '; or the log holds motor currents: a drive with effort = "current" and each '
+        "motor's torque_constant"
         if not 0.5 <= mean <= 2.0
         else ""
     )
     return (
         f"{said}; if the description's masses are right, the torques are {1 / mean:.3g} "
-        f"times too small (a sensor scale: --units tau={1 / mean:.3g}){currents}"
+        f"times too small (a sensor scale: units='tau={1 / mean:.3g}'){currents}"
     )
 
 
@@ -389,55 +392,50 @@ def gravity_scale_words(robot: Robot, found: GravityRatios, drive: Drive | None 
 _UNIT_TOL = 0.15
 
 
-def beyond_masses_words(robot: Robot, found: GravityRatios, drive: Drive | None = None) -> str:
+def beyond_masses_words(
+    robot: Robot, found: GravityRatios, drive: Drive | None = None, fix: float | None = None
+) -> str:
     """The finding of factors :func:`gravity_scale_factor` ``found`` that differ between
     the loaded joints of ``robot`` and share a common factor beyond the masses' error
     (:attr:`GravityRatios.beyond_masses`): the torques' scale first, with its fix
-    (``drive``'s torque constants times its inverse, each given; an effort unit's near
-    1000), then why the masses do not make it."""
+    (``drive``'s torque constants corrected, :func:`~.drive_gains.corrected_constants`, by
+    ``fix`` where given, :func:`gravity_scale_words`, else by ``1 / found.factor``; an
+    effort unit's near 1000), then why the masses do not make it."""
     mean, r, js = found.factor, found.ratios, found.joints
-    fix = 1.0 / mean
+    k = 1.0 / mean if fix is None else fix
     unit = abs(np.log(mean / 1000.0)) < np.log1p(_UNIT_TOL)
     current = drive is not None and drive.effort == "current"
     if current and unit:
         lead = (
             f"the currents read {mean:.3g} times the description's gravity torques on every "
-            "joint: currents in mA read as A (--units tau=mA reads them, the drive file as "
-            "it is)"
+            "joint: currents in mA read as A (units='tau=mA' reads them, the drive as it is)"
         )
     elif current:
         assert drive is not None and drive.torque_constant is not None  # a drive of currents
-        kt = np.asarray(drive.torque_constant, dtype=np.float64) * fix
         lead = (
-            f"the torque constants the currents were read through look {mean:.3g} times the "
-            f"true ones on every motor: torque_constant = [{', '.join(f'{v:.4g}' for v in kt)}]"
-            f" in the drive file (theirs times {fix:.3g}){at_the_motors(drive, fix)}, and "
-            "identify again"
+            "the torque constants look off by one factor on every motor: put "
+            f"{corrected_constants(drive.torque_constant, k)} in the drive file"
+            f"{at_the_motors(drive, k)} and identify again"
         )
     else:
-        which = " (mN m read as N m: --units tau=mNm)" if unit else ""
+        which = " (mN m read as N m: units='tau=mNm')" if unit else ""
         lead = (
             f"the torques look {mean:.3g} times the true ones on every joint{which}: scale "
-            f"them by {fix:.3g} (--units tau={fix:.3g}) and identify again"
+            f"them by {k:.3g} (units='tau={k:.3g}') and identify again"
             + (
-                '; or the log holds motor currents: a drive file with effort = "current" '
-                "and each motor's torque_constant"
+                '; or the log holds motor currents: a drive with effort = "current" and '
+                "each motor's torque_constant"
                 if not unit and not 0.5 <= mean <= 2.0
                 else ""
             )
         )
     each = ", ".join(f"{robot.joint_names[j]} {r[j]:.4g}" for j in js)
-    times = abs(np.log(mean)) / max(np.log1p(found.spread), 1e-300)
     return (
-        f"{lead}: the identified gravity torques are {r[js].min():.3g} to {r[js].max():.3g} "
-        f"times the robot description's on the joints gravity loads ({each}), one common "
-        f"factor {mean:.3g}{_std(found.factor_std)} with the joints within "
-        f"{100 * found.spread:.2g} % of it (beyond their uncertainty: the description's "
-        "masses' own error, joint by joint), far beyond what those masses make (its distance "
-        f"from 1 {times:.2g} times that spread, at least {AGREE:g}, and over "
-        f"{100 * MASSES:g} %): a scale the fit cannot see (it predicts the log as well with "
-        "it; its masses and inertias carry it), if the description's masses are right; no "
-        "mass at the flange is read from it"
+        f"{lead}. Why: the identified gravity torques are {r[js].min():.3g} to "
+        f"{r[js].max():.3g} times the description's ({each}), within "
+        f"{100 * found.spread:.2g} % of each other, too far from 1 for an error of its "
+        f"masses (over {100 * MASSES:g} %, and {AGREE:g} times that spread), and no load at "
+        "the flange fits them better"
     )
 
 

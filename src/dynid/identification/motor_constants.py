@@ -162,19 +162,23 @@ class SharedGearRatio:
         span = f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g} to {hi:.3g}"
         g = f"{self.gear_ratio:.4g}"
         mid = abs(float(np.mean(np.log(self.common))))
+        far = mid >= np.log1p(MASSES)
         why = (
-            "the masses' error"
-            if mid < np.log1p(MASSES)
-            else f"beyond the description's masses' error ({100 * MASSES:g} %): a factor of "
-            "the constants' own besides, which the gravity torques of the fitted model name"
+            f"beyond the description's masses' error ({100 * MASSES:g} %): a further factor "
+            "of the constants, which the gravity torques of the fitted model name"
+            if far
+            else "the masses' error"
         )
         return (
             f"torque_constant looks given at the motors: the currents read through it are "
             f"1/{g} (the gear ratio every joint shares) times the description's gravity "
-            f"torques, times {span} ({why}); on a joint-side log (side = "
-            "\"joint\") torque_constant is each joint's torque per A, the motor's constant "
-            f"times its gear ratio: the currents are read through torque_constant x {g} "
-            "(identification.json's drive holds them: put them in the drive file)"
+            f"torques, times {span} ({why}); on a joint-side log it is each joint's torque "
+            f"per A, so the currents are read through torque_constant x {g}"
+            + (
+                ""
+                if far
+                else " (identification.json's drive holds them: put them in the drive file)"
+            )
         )
 
 

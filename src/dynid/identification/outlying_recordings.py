@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from ..exceptions import DynidWarning
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -91,7 +92,7 @@ def _warn_outlying(
         + ("" if given else "; the structure is chosen on the other recordings")
         + _final_said(keep, skip, cuts or {}, [n for n, _ in per]),
         DynidWarning,
-        stacklevel=3,
+        stacklevel=caller_level(),
     )
 
 
@@ -272,7 +273,7 @@ def _burst_cuts(
             f"each joint's noise): {'; '.join(said)}; the structure is chosen and fitted "
             "again on the rest",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
     return cuts
 

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from .._times import longest_gaps, offset_text, said_times, stamp_text
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..model.drive import Drive
@@ -320,7 +321,6 @@ def recording_pieces(
     turns: NDArray[np.bool_],
     max_gap_s: float | None = None,
     *,
-    stacklevel: int = 3,
     robot: Robot | None = None,
     drive: Drive | None = None,
     say_wrapped: bool = True,
@@ -367,12 +367,12 @@ def recording_pieces(
             f"{name}: {alone} sample(s) isolated between gaps longer than the longest gap "
             "bridged left out",
             DynidWarning,
-            stacklevel=stacklevel,
+            stacklevel=caller_level(),
         )
     joints = tuple(sorted(turned))
     if joints and say_wrapped:
         said = wrapped_finding(joints, motors, robot=None if motors else robot, log=log)
-        warnings.warn(f"{name}: {said}", DynidWarning, stacklevel)
+        warnings.warn(f"{name}: {said}", DynidWarning, stacklevel=caller_level())
     return pieces, joints
 
 
@@ -712,7 +712,7 @@ def with_start_turns(
         f"{name}: motor(s) {', '.join(str(j + 1) for j in motors)} recorded wrapped into "
         f"[-pi, pi]: unwrapped, their whole turns at the first sample {source}",
         DynidWarning,
-        stacklevel=2,
+        stacklevel=caller_level(),
     )
     out = TorqueLog(log.t, q, log.dq, log.tau, log.ddq, log.cleaning, log.dq_derived)
     if log.dq_derived:  # derived from the wrapped angles as read: a turn's jump at each wrap

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import signals
+from .._checks import caller_level
 from .._times import said_time
 from ..exceptions import DataError, DynidWarning, ShapeError
 from .log import _SIGNALS, DEFAULT_CUTOFF_HZ, TorqueLog, default_max_gap
@@ -556,7 +557,7 @@ def _usable_cutoff(cutoff_hz: float | None, rate: float, n_samples: int) -> floa
             f"of this {rate:.4g} Hz log; filtering at {rate / 4:.4g} Hz instead (choose with "
             "cutoff_hz / --cutoff)",
             DynidWarning,
-            stacklevel=4,
+            stacklevel=caller_level(),
         )
         cutoff_hz = rate / 4
     if cutoff_hz is not None and n_samples <= 15:

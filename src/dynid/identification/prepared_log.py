@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import signals
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -256,7 +257,7 @@ def prepare_torque_log(
     if check and (opposite := opposite_sign(robot, jlog)) is not None:
         raise DataError(opposite)  # a fit would negate the masses
     for finding in check_torque_log(robot, jlog, drive) if check else ():  # said first
-        warnings.warn(finding, DynidWarning, stacklevel=3)
+        warnings.warn(finding, DynidWarning, stacklevel=caller_level())
     still = still_friction(jlog, drive)
     f_q = None
     if cutoff_hz == "auto":

@@ -44,6 +44,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError, ShapeError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -537,7 +538,7 @@ def prepare_recordings(
                 f"log has {log.n} joints; robot {robot.name!r} has {robot.n}", file=name
             )
         if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
-            warnings.warn(spikes, DynidWarning, stacklevel=2)
+            warnings.warn(spikes, DynidWarning, stacklevel=caller_level())
             log = despiked(log)[0]  # before the filter spreads them
         mine, joints = recording_pieces(
             name, log, turns, max_gap_s, robot=robot, drive=drive, say_wrapped=False
@@ -559,10 +560,10 @@ def prepare_recordings(
         for finding in check_torque_log(robot, joint_side_log(whole, drive), drive):
             found.setdefault(finding, []).append(names[r])
     for finding, which in wrapped.items():
-        warnings.warn(f"{', '.join(which)}: {finding}", DynidWarning, stacklevel=2)
+        warnings.warn(f"{', '.join(which)}: {finding}", DynidWarning, stacklevel=caller_level())
     for finding, which in found.items():  # one warning a finding, its recordings named
         shown = finding if len(names) == 1 else f"{', '.join(which)}: {finding}"
-        warnings.warn(shown, DynidWarning, stacklevel=2)
+        warnings.warn(shown, DynidWarning, stacklevel=caller_level())
     cutoff, edge = _cutoff_and_edge(pieces, drive, turns, cutoff_hz, trim_s)
     kw = dict(cutoff_hz=cutoff, trim_s=edge, max_gap_s=max_gap_s, decimate=decimate)
     kw["torque_delay_s"] = float(torque_delay_s)
@@ -712,7 +713,7 @@ def _prepared(
     if (
         finding := left_out_finding(names, pieces, left, kw["trim_s"], kw["max_gap_s"])
     ) is not None:
-        warnings.warn(finding, DynidWarning, stacklevel=3)
+        warnings.warn(finding, DynidWarning, stacklevel=caller_level())
     return prepared, recording, skipped, gone
 
 

@@ -17,6 +17,7 @@ import warnings
 
 import numpy as np
 
+from .._checks import caller_level
 from ..exceptions import DynidWarning
 from ..model.drive import Drive
 from .model import IdentifiedModel
@@ -83,7 +84,7 @@ def warned_negative_inertias(model: IdentifiedModel) -> tuple[str, ...]:
     :class:`~dynid.exceptions.DynidWarning`; the sentences for the model's notes."""
     said = negative_inertias(model)
     for line in said:
-        warnings.warn(line, DynidWarning, stacklevel=3)
+        warnings.warn(line, DynidWarning, stacklevel=caller_level())
     return said
 
 

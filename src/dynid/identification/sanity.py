@@ -164,8 +164,8 @@ def _scale_line(a: float, refused: bool = False, drive: Drive | None = None) -> 
         at = "at the motor" if drive.side == "motor" else "at the joint"
         hint = (
             f"check torque_constant (N m per A, {at}) and gear_ratio in the drive file"
-            + ("; currents in mA: --units tau=0.001" if p == 3 else "")
-            + (" (--units tau=1 reads the currents as they are)" if refused else "")
+            + ("; currents in mA: units='tau=0.001'" if p == 3 else "")
+            + (" (units='tau=1' reads the currents as they are)" if refused else "")
         )
         return (
             f"the measured torques (the currents times the drive's torque constants) are "
@@ -174,14 +174,14 @@ def _scale_line(a: float, refused: bool = False, drive: Drive | None = None) -> 
             f"hint: {hint}"
         )
     hint = (
-        "--units tau=mNm"
+        "units='tau=mNm'"
         if p == 3
-        else "--units tau=1000 (kN m)"
+        else "units='tau=1000' (kN m)"
         if p == -3
         else 'currents need a drive file with effort = "current" and torque_constant'
     )
     if refused:
-        hint += " (--units tau=Nm reads them as N m)"
+        hint += " (units='tau=Nm' reads them as N m)"
     return (
         f"the measured torques are {abs(a):.3g} times the model's gravity torques: a unit "
         f"off by a power of ten, or currents logged as torques; hint: {hint}"

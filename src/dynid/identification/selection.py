@@ -63,6 +63,7 @@ from typing import Any, Literal, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from ..exceptions import DynidWarning, OptionError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -1180,7 +1181,7 @@ def _warned(model: IdentifiedModel, terms: Sequence[ModelTerm]) -> None:
     ``beta19`` at 50.5 %."""
     warn_unphysical(model, terms)
     for msg in model_advice(model):
-        warnings.warn(msg, DynidWarning, stacklevel=2)
+        warnings.warn(msg, DynidWarning, stacklevel=caller_level())
 
 
 def _check_given(

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from ..exceptions import DynidWarning, ShapeError
 from ..model.robot import Robot
 from .dataset import Dataset, ModelColumns, RegressorBlock
@@ -178,22 +179,20 @@ def stack_dataset(
     if info.all():
         return stack
     y_out = np.concatenate([stack.y[a:b] for a, b, _ in stack.rows[~info]])
-    _warn_dropped(robot, stack.dropped, np.max(np.abs(y_out)), np.max(np.abs(stack.y)), 5)
+    _warn_dropped(robot, stack.dropped, np.max(np.abs(y_out)), np.max(np.abs(stack.y)))
     return stack
 
 
-def _warn_dropped(
-    robot: Robot, dropped: tuple[str, ...], big: float, top: float, level: int
-) -> None:
+def _warn_dropped(robot: Robot, dropped: tuple[str, ...], big: float, top: float) -> None:
     """Warn when rows without information hold data (``big`` of the largest ``top``),
-    ``level`` frames above (at the caller of :func:`identify`)."""
+    at the user's call (:func:`~dynid._checks.caller_level`)."""
     if big > _DROPPED_DATA_RTOL * top:
         warnings.warn(
             f"rows {list(dropped)} carry no information for robot {robot.name!r} (its "
             f"regressor is zero there) but the data reach |{big:.3g}|; hint: check the "
             "gravity vector and the kinematics against the source of the data",
             DynidWarning,
-            stacklevel=level,
+            stacklevel=caller_level(),
         )
     _log.info("dropping rows without information: %s", ", ".join(dropped))
 
@@ -219,7 +218,7 @@ def _streamed_groups(
     if info.all():
         return StreamedRows(source)
     dropped = tuple(lab for lab, ok in zip(labels, info, strict=True) if not ok)
-    _warn_dropped(robot, dropped, float(ymax[~info].max()), float(ymax.max()), 6)
+    _warn_dropped(robot, dropped, float(ymax[~info].max()), float(ymax.max()))
 
     def kept() -> Iterator[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp]]]:
         for W, y, g in source():

@@ -59,6 +59,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning
 from ..identification.data import StaticDataset
 from ..identification.log import (
@@ -1200,7 +1201,7 @@ def load_label_column(
             f"{path.name}: column {name!r} read as no contact labels ({exc}); hint: name the "
             "labels with --columns label=NAME",
             DynidWarning,
-            stacklevel=2,
+            stacklevel=caller_level(),
         )
         return None
     if tpl not in table.columns:

@@ -56,6 +56,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import __version__, _checks
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, ModelError, ShapeError
 from ..feasibility.constraints import Constraint
 from ..feasibility.result import FeasibleResult
@@ -236,7 +237,7 @@ def feasible_to_dict(
             f"feasible.json: the robot's {robot.friction.kind} friction is not part of the file "
             "(which holds the sigmoid at the joints) and is not written; save it as friction.json",
             DynidWarning,
-            stacklevel=2,
+            stacklevel=caller_level(),
         )
     parts = friction_parts(None if result is None else result.friction)
     drive = None if result is None else result.drive
@@ -501,7 +502,7 @@ def _check_link(where: str, mass: float, I6: NDArray[np.float64]) -> None:
         warnings.warn(
             f"{where} is physically inconsistent: {'; '.join(problems)}; kept as given",
             DynidWarning,
-            stacklevel=4,
+            stacklevel=caller_level(),
         )
 
 
@@ -531,7 +532,7 @@ def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
             f"{Path(path).name} holds a fit that was not accepted ({rejected}): its "
             "parameters are used as given",
             DynidWarning,
-            stacklevel=2,
+            stacklevel=caller_level(),
         )
     return out
 

@@ -29,6 +29,7 @@ from typing import Any, Literal, TypeVar
 import numpy as np
 
 from .. import _checks
+from .._checks import caller_level
 from ..exceptions import DataError, DynidError, DynidWarning, OptionError
 from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
@@ -373,7 +374,7 @@ def _read_torque_log(
         mapped = load_mapped_torque_log(path, columns, n=n)
         said_of = commanded_torques(columns.template("tau"), header_names(path), mapped.log.n)
         if said_of is not None:  # a controller's torque read as measured: once per run
-            warnings.warn(said_of, DynidWarning, stacklevel=4)
+            warnings.warn(said_of, DynidWarning, stacklevel=caller_level())
         for note in mapped.conversions:  # as asked: a note
             _log.log(NOTE, "%s: %s", path.name, note)
         for note in mapped.notes:  # velocities derived: said once for every such recording

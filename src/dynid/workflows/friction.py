@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from ..exceptions import DynidWarning
 from ..friction.dissipative import ALLOWANCE_STD, law_violations
 from ..friction.fit import FrictionFit, FrictionResidual, fit_friction_through
@@ -298,7 +299,7 @@ def _quadratic_at_bound(fit: FrictionFit) -> None:
             "linearly with speed (it saturates), which fq >= 0 cannot follow; there the law "
             "is the classical one (a saturating law follows it: sigmoid, smooth, stribeck)",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
 
 
@@ -319,5 +320,5 @@ def _say_not_dissipative(fit: FrictionFit, dq_max: NDArray[np.float64]) -> None:
             + f"): {v}; the friction pushes the arm there (--friction-model auto sets "
             "such a law aside)",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )

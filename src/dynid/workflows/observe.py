@@ -75,6 +75,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
+from .._checks import caller_level
 from ..exceptions import DataError, DynidError, DynidWarning, OptionError, ShapeError
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
@@ -645,7 +646,7 @@ def _given_thresholds(
             f"model ({fingerprint}): thresholds fit the residual of their own model; "
             "calibrate again with this one",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
     return given
 
@@ -669,9 +670,9 @@ def _warn_mismatches(
     thresholds of the file ``name`` were calibrated on."""
     for path, log in zip(paths, logs, strict=True):
         if (other := rate_mismatch(log_rate(log.t), given, name)) is not None:
-            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=3)
+            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=caller_level())
         if (other := velocity_mismatch(bool(log.dq_derived), given, name)) is not None:
-            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=3)
+            warnings.warn(f"{path.name}: {other}", DynidWarning, stacklevel=caller_level())
 
 
 def model_fingerprint(opts: ObserveOptions) -> ModelFingerprint:
@@ -810,7 +811,7 @@ def _judge_sign(name: str, sign: TorqueSign, noise: GainNoiseTally, names: Seque
     found = noise.result()
     gain_noise = None if found is None else found.predicted
     if (unexplained := unexplained_finding(sign, names, gain_noise)) is not None:
-        warnings.warn(f"{name}: {unexplained}", DynidWarning, stacklevel=3)
+        warnings.warn(f"{name}: {unexplained}", DynidWarning, stacklevel=caller_level())
 
 
 def _calibrated(

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
@@ -137,7 +138,7 @@ def true_torques(prep: PreparedLog, model: ObserverModel, mapped: bool) -> NDArr
             f"align with the {log_t.shape[0]} rows kept: no score and no RMS r - tau_ext "
             "against them",
             DynidWarning,
-            stacklevel=2,
+            stacklevel=caller_level(),
         )
         return None
     return ext[rows]
@@ -270,7 +271,7 @@ def _detected_once(
     events = [e for e in events if not at_load_edge(e.start, e.end, carried)]
     if (opposite := opposite_finding(sign, model.robot.joint_names)) is not None:
         warnings.warn(  # a whole-log "collision" on each such joint follows
-            f"{prep.path.name}: {opposite}", DynidWarning, stacklevel=3
+            f"{prep.path.name}: {opposite}", DynidWarning, stacklevel=caller_level()
         )
     unexplained = None
     if frame is not None and fits is not None:
@@ -482,7 +483,7 @@ def _off_frame(
         force_peaks(t, events, pushed),
     )  # fmt: skip
     if said is not None:
-        warnings.warn(said, DynidWarning, stacklevel=4)
+        warnings.warn(said, DynidWarning, stacklevel=caller_level())
     return shares
 
 

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from .._times import said_times, stamp_text
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
@@ -148,7 +149,7 @@ def prepared_log(
     log, turned = unwrapped(side, wrappable(model.robot))
     if turned:
         said = wrapped_finding(sorted(turned), robot=model.robot, log=side)
-        warnings.warn(f"{path.name}: {said}", DynidWarning, stacklevel=4)
+        warnings.warn(f"{path.name}: {said}", DynidWarning, stacklevel=caller_level())
     starts = _pieces(path, log, max_gap)
     fc = _derived_cutoff(path, log)
     dq = _piece_velocities(log, starts, fc)  # of a log of positions: from the unwrapped ones
@@ -383,7 +384,7 @@ def _observed_spans(
         + "; the low-pass is zero-phase (it sees ahead), so detection delays are shorter "
         "than an online observer's",
         DynidWarning,
-        stacklevel=4,
+        stacklevel=caller_level(),
     )
     return spans
 
@@ -411,7 +412,7 @@ def _pieces(path: Path, log: TorqueLog, max_gap: float | None) -> list[int]:
         warnings.warn(
             f"{path.name}: cut at {why}: the observer starts again at {at} (no event spans a cut)",
             DynidWarning,
-            stacklevel=4,
+            stacklevel=caller_level(),
         )
     return starts
 
@@ -468,6 +469,6 @@ def _cut_at_jumps(
             f"{path.name}: position jumps more than the recorded velocity explains "
             f"({listed}{more}): {what}",
             DynidWarning,
-            stacklevel=4,
+            stacklevel=caller_level(),
         )
     return cut

@@ -63,6 +63,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..identification.angle_time_units import GivenUnits
 from ..identification.derivative_columns import (
@@ -320,7 +321,7 @@ def despiked_recordings(
         )
         found = spike_finding(name, log, tuple(joint_names), before=before, kept=kept)
         if found is not None:
-            warnings.warn(found, DynidWarning, stacklevel=3)
+            warnings.warn(found, DynidWarning, stacklevel=caller_level())
         if kept is not None:
             logs.append(log)
             counts.append(0)
@@ -431,7 +432,7 @@ def usable_velocities(logs: Sequence[TorqueLog], names: Sequence[str]) -> tuple[
             f"{name}: {said}: velocities derived from the positions instead, as --columns "
             "dq=none reads the log (its acceleration columns left out too)",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
         positions = TorqueLog(log.t, log.q, log.dq, log.tau, None, log.cleaning)
         out.append(with_derived_velocities(positions, DEFAULT_CUTOFF_HZ))
@@ -687,7 +688,7 @@ def warn_signs(
     as :func:`sign_findings`."""
     found = _sign_findings(rec, robot, skip, reference)
     for f in found:
-        warnings.warn(f"{f.name}: {f.text}", DynidWarning, stacklevel=3)
+        warnings.warn(f"{f.name}: {f.text}", DynidWarning, stacklevel=caller_level())
     return found
 
 
@@ -948,7 +949,7 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
                 f"{robot.q_max[j]:.4g}]{also}: a recording of another robot, or in other "
                 f"units?{_counts_hint(read.q[:, bad])}",
                 DynidWarning,
-                stacklevel=3,
+                stacklevel=caller_level(),
             )
     if (said := effort_limit_finding(robot, [log.tau for log in sides])) is not None:
         _log.log(NOTE, "%s", said)

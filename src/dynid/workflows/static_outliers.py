@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import caller_level
 from ..exceptions import DynidWarning
 from ..identification.data import StaticDataset
 from ..identification.static_outliers import outlying_configurations
@@ -88,7 +89,7 @@ def without_outlying(
         f"{done}; hint: check {'that line' if k == 1 else 'those lines'} of the file "
         "(delete or correct it) and identify again",
         DynidWarning,
-        stacklevel=3,
+        stacklevel=caller_level(),
     )
     record = {
         "rows": list(found.rows),

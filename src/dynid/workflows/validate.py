@@ -53,6 +53,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks
+from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.delay_check import validations_delay
 from ..friction.fit import model_drive, same_drive, torques_through
@@ -781,7 +782,7 @@ def _said_signs(
     units = None if opt.columns is None else opt.columns[1]
     found = recorded_sign_map_findings(rec, ref, recorded, units)
     for text in found.values():
-        warnings.warn(text, DynidWarning, stacklevel=3)
+        warnings.warn(text, DynidWarning, stacklevel=caller_level())
     opposite = warn_signs(rec, ref, skip=tuple(found), reference=_model_friction(model, rec.drive))
     return "; ".join(found.values()) or None, opposite
 
@@ -835,7 +836,7 @@ def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> 
             "predicts efforts read through the same drive, and its torques at the joints "
             "carry the factor (payload --model withholds setLoad values)",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
     if same := model.info.fitted_on(names):
         warnings.warn(
@@ -844,7 +845,7 @@ def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> 
             "training errors, not a held-out judgement; hint: validate on a recording the "
             "fit did not see (identify's held-out verdict judges its own recordings)",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
     if odd := model.info.left_out_of(names):
         warnings.warn(
@@ -853,7 +854,7 @@ def _say_training_data(model: IdentifiedModel | Robot, names: Sequence[str]) -> 
             "errors below are what it holds beyond the others (a payload, contacts?), not "
             "the model's error on data like its own",
             DynidWarning,
-            stacklevel=3,
+            stacklevel=caller_level(),
         )
 
 

@@ -156,8 +156,10 @@ def kept_elsewhere(
     -------
     str
         ``the MJCF export (robot.xml) holds them as armature, the TOML export (robot.toml)
-        as its [drive] table``; a format not written as ``a TOML export (--out r.toml, not
-        written) would hold it exactly``, after those written with ``, and``.
+        as its [drive] table``; a format not written as ``a TOML export (r.toml, not
+        written) would hold it exactly`` (each one so), after those written with ``, and``:
+        the file's name, not how it is asked for (``path`` of
+        :func:`~dynid.io.export.save_robot`, ``--out`` of a command).
     """
     stem = Path(path).stem
     named = source and options.source is not None
@@ -184,8 +186,7 @@ def kept_elsewhere(
         if f not in options.beside and _EXPORT_NAMES[f][1] != own  # the source's own format
     ]
     others = [
-        f"{_article(_EXPORT_NAMES[f][0])} export (--out {stem}{_EXPORT_NAMES[f][1]}"
-        + (", not written)" if k == 0 else ")")
+        f"{_article(_EXPORT_NAMES[f][0])} export ({stem}{_EXPORT_NAMES[f][1]}, not written)"
         + (f" would hold {what} {how}" if k == 0 else f" {how}")
         for k, (f, how) in enumerate(unwritten)
     ]

@@ -70,6 +70,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import __version__
+from ..._checks import caller_level
 from ...dynamics.terms import mass_matrix
 from ...exceptions import DynidWarning, ModelError, ShapeError
 from ...friction.model import FrictionModel, FrictionSum, robot_friction, sigmoid_parameters
@@ -537,7 +538,7 @@ def mjcf_from_robot(
         robot, friction, drive, kept, frictionloss, along
     )
     if notes:  # one line: what MJCF cannot hold
-        warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
+        warnings.warn(f"MJCF export: {'; '.join(notes)}", DynidWarning, stacklevel=caller_level())
     text = comment or _comment(robot, friction, approx, armature, notes)
     lines = [
         '<?xml version="1.0"?>',

@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import _checks, spatial
+from ..._checks import caller_level
 from ...exceptions import DataError, DynidError, DynidWarning, ModelError
 from ...friction.model import (
     Friction,
@@ -244,7 +245,7 @@ def _inertial(
             f"{source}: key '{at}.inertial': the inertial is physically inconsistent: "
             f"{'; '.join(problems)}; {READ_AS_GIVEN}",
             DynidWarning,
-            stacklevel=2,
+            stacklevel=caller_level(),
         )
     return mass, com, inertia
 

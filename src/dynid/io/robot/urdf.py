@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import __version__, spatial
+from ..._checks import caller_level
 from ...dynamics.terms import mass_matrix
 from ...exceptions import DynidWarning, ModelError, ShapeError
 from ...friction.model import Friction, FrictionSum, robot_friction, sigmoid_parameters
@@ -460,12 +461,12 @@ def export_urdf(path: str | Path, robot: Robot, options: ExportOptions) -> Path:
         caveat=caveat,
     )
     if notes:  # one line, once written: what URDF cannot hold of the friction
-        warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=2)
+        warnings.warn(f"URDF export: {'; '.join(notes)}", DynidWarning, stacklevel=caller_level())
     rotors = _rotor_warning(drive, robot, Path(path), options)
     if rotors is not None:  # a line of its own: it costs far more than the friction's
-        warnings.warn(rotors, DynidWarning, stacklevel=2)
+        warnings.warn(rotors, DynidWarning, stacklevel=caller_level())
     if spring is not None:  # said in the file too (a comment at its top)
-        warnings.warn(spring, DynidWarning, stacklevel=2)
+        warnings.warn(spring, DynidWarning, stacklevel=caller_level())
     return out
 
 

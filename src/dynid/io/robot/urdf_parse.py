@@ -67,6 +67,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from ..._checks import caller_level
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...friction.model import ClassicalFriction, Friction
 from ...model.inertia import READ_AS_GIVEN, inertial_problems, phi_from_inertial
@@ -141,7 +142,7 @@ def _warn_if_inconsistent(link: str, mass: float, I: NDArray[np.float64]) -> Non
             f"link {link!r} has a physically inconsistent inertial: {'; '.join(problems)}; "
             + READ_AS_GIVEN,
             DynidWarning,
-            stacklevel=7,
+            stacklevel=caller_level(),
         )
 
 
@@ -166,7 +167,7 @@ def _limits(joint: _Joint) -> tuple[float, float, float, float]:
             warnings.warn(
                 f"joint {joint.name!r} has {attr} limit {v}; treated as unbounded",
                 DynidWarning,
-                stacklevel=6,
+                stacklevel=caller_level(),
             )
             v = None
         out.append(np.inf if v is None else v)
@@ -493,7 +494,7 @@ def _robot_from_text(
         _log.log(NOTE, "%s", lumped)
     if (left := found.left_out) is not None:
         if found.mass_left_out > 0.0:  # a mass the model misses
-            warnings.warn(left, DynidWarning, stacklevel=3)
+            warnings.warn(left, DynidWarning, stacklevel=caller_level())
         else:
             _log.info("%s", left)
     if (hanging := found.hanging_line) is not None:
@@ -508,7 +509,7 @@ def _robot_from_text(
             snapped = _read_chain(text, base_link, tip_link, source, AngleRounding(snap=True))[0]
         msg, harmful = rounding_message(source, angles.found, robot, snapped)
         if harmful:
-            warnings.warn(msg, DynidWarning, stacklevel=3)
+            warnings.warn(msg, DynidWarning, stacklevel=caller_level())
         elif note_angles:
             _log.log(NOTE, "%s", msg)
     fr = robot.friction

@@ -59,6 +59,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ... import _checks, spatial
+from ..._checks import caller_level
 from ...exceptions import DynidWarning, ModelError
 from ...model.inertia import inertia6_from_matrix, inertial_from_phi, phi_from_inertial
 from ...model.robot import Robot
@@ -256,7 +257,7 @@ def patch_urdf_inertials(
         raise ModelError("the patched inertials do not read back as the robot's", file=source)
     if merged != "keep" and (said := _branches_line(off.branches, chain, source, new_xml)):
         if any(x in new_xml and new_xml[x] is None for b in off.lumped for x in b.links):
-            warnings.warn(said, DynidWarning, stacklevel=2)
+            warnings.warn(said, DynidWarning, stacklevel=caller_level())
         else:
             _log.log(NOTE, "%s", said)
     return out
