@@ -24,6 +24,7 @@ from dynid.io.friction_json import save_friction_json
 from dynid.io.model_json import load_model_json, save_model_json
 from dynid.io.observer_files import save_thresholds
 from dynid.io.torque_log import load_torque_log, save_torque_log
+from dynid.model.drive import Drive
 from dynid.model.robot import Robot
 from dynid.observer import from_identified
 from dynid.observer.residual import DEFAULT_OPTIONS, MomentumObserver
@@ -140,3 +141,23 @@ def test_the_tutorials_control_loop_runs_as_written(folder, monkeypatch, capsys)
     exec(compile(code.group(1), str(DOCS), "exec"), {})
     said = re.search(r"contact at t = ([0-9.]+) s", capsys.readouterr().out)
     assert said is not None and ONSET <= float(said.group(1)) < ONSET + 0.02
+
+
+def test_a_motor_side_current_log_is_read_at_the_joints(folder, tmp_path):
+    """A model recorded with a drive (gears 10, 20, 5 at the motors, currents through
+    torque constants 0.1, 0.2, 0.05 N m/A) reads the log of motor angles and currents at
+    the joints: ``q = q_m / G``, ``dq = dq_m / G``, ``tau = G k i`` (closed form of a
+    diagonal drive), as the observer's step takes them; joint 2's current still negated
+    back by the recorded ``tau2=-1``."""
+    gears, kt = np.array([10.0, 20.0, 5.0]), np.array([0.1, 0.2, 0.05])
+    drive = Drive.from_gears(gears, side="motor", effort="current", torque_constant=kt)
+    model = load_model_json(folder / "id" / "identification.json")
+    save_model_json(tmp_path / "identification.json", dataclasses.replace(model, drive=drive))
+    geared = load_model_json(tmp_path / "identification.json")
+    (log,) = recordings(_arm(), (9,), friction=None, duration=1.0)
+    current = log.tau / (gears * kt) * [1.0, -1.0, 1.0]  # joint 2 logged negated
+    motor = dataclasses.replace(log, q=log.q * gears, dq=log.dq * gears, tau=current, ddq=None)
+    read = read_log_as_identified(save_torque_log(tmp_path / "motor.csv", motor), geared)
+    np.testing.assert_allclose(read.q, log.q, atol=1e-8)
+    np.testing.assert_allclose(read.dq, log.dq, atol=1e-7)
+    np.testing.assert_allclose(read.tau, log.tau, rtol=1e-7, atol=1e-8)
