@@ -774,7 +774,9 @@ def read_log_as_identified(
 
     A log without velocity columns has ``dq`` from the positions through a zero-phase
     low-pass, which uses later samples: an online loop cannot have it (its own velocity
-    estimate, causal, is noisier and needs thresholds calibrated on it).
+    estimate, causal, is noisier and needs thresholds calibrated on it). What ``observe``
+    does after reading is left to the loop: the log is not cut at its gaps, its torque
+    spikes are kept and a model's torque delay is not applied.
 
     Parameters
     ----------
