@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dynid.exceptions import DataError
+from dynid.exceptions import DataError, WrongTypeError
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure
@@ -161,3 +161,11 @@ def test_a_motor_side_current_log_is_read_at_the_joints(folder, tmp_path):
     np.testing.assert_allclose(read.q, log.q, atol=1e-8)
     np.testing.assert_allclose(read.dq, log.dq, atol=1e-7)
     np.testing.assert_allclose(read.tau, log.tau, rtol=1e-7, atol=1e-8)
+
+
+def test_the_observer_model_in_place_of_the_identified_one_is_refused_by_name(folder):
+    """The observer's model holds no column map: given in place of the identified model,
+    one WrongTypeError naming the argument and what it takes."""
+    model = load_model_json(folder / "id" / "identification.json")
+    with pytest.raises(WrongTypeError, match="model.*IdentifiedModel.*ObserverModel"):
+        read_log_as_identified(folder / "hit.csv", from_identified(model))  # type: ignore[arg-type]
