@@ -258,7 +258,11 @@ def load_torque_log(
     drop_invalid: bool = False,
     joints: int | None = None,
 ) -> TorqueLog:
-    """Read a torque log from a ``.csv`` or ``.npz`` file, strictly.
+    """Read a torque log from a ``.csv`` or ``.npz`` file, strictly, as the file holds it.
+
+    A log read for an identified model, through the column map, units, torque signs and
+    drive its data were read with (``--units tau3=-1``), is read by
+    :func:`dynid.workflows.observe.read_log_as_identified`; this reads none of that.
 
     Parameters
     ----------

@@ -80,7 +80,7 @@ from ..exceptions import DataError, DynidError, DynidWarning, OptionError, Shape
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
-from ..identification.log import TorqueLog
+from ..identification.log import TorqueLog, joint_side_log
 from ..identification.model import IdentifiedModel
 from ..identification.spikes import SPIKES_BEFORE_OBSERVER
 from ..io.columns import ColumnMap
@@ -164,6 +164,7 @@ __all__ = [
     "model_fingerprint",
     "observe_files",
     "observer_drive",
+    "read_log_as_identified",
 ]
 
 _log = logging.getLogger(__name__)
@@ -554,9 +555,11 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     )
     wants_margin = opts.standstill if given is None else given.standstill
     files = data_files(opts.data)
-    columns = recorded_columns(recorded, *opts.columns, files)  # (names, units), said once
-    cmap = column_map(*columns, drive=model.drive, robot=model.robot)
-    read = _read_logs(files, model, cmap, opts, recorded, columns[1])
+    columns, cmap = _model_columns(model, recorded, opts.columns, files)  # said once
+    read = _read_logs(
+        files, model, cmap, _Reading(opts.drop_invalid, opts.q_start, opts.max_gap),
+        among=opts.calibrate, recorded=recorded, units=(columns[1], opts.columns[1]),
+    )  # fmt: skip
     read, _ = despiked_recordings(
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )
@@ -752,26 +755,109 @@ def friction_source(opts: ObserveOptions) -> str | None:
     return None if spec.lower().endswith(".json") else Path(spec).name
 
 
+def read_log_as_identified(
+    path: str | Path, model: IdentifiedModel, *, drop_invalid: bool = False
+) -> TorqueLog:
+    """The torque log ``path`` read as ``dynid observe --model`` reads a log for ``model``
+    (the same reading and checks), at the joints: ``q, dq, tau`` as
+    :meth:`~dynid.observer.residual.MomentumObserver.step` takes them.
+
+    * Through the column map the model's data were read with (``info.column_map``: its
+      ``--columns``, and its ``--units``: units, factors and torque signs such as
+      ``tau3=-1``), said in a note (:func:`~dynid.workflows.data_files.recorded_columns`).
+    * Rows with NaN/inf or a repeated timestamp dropped where ``drop_invalid``, or where
+      the identification dropped them (a note: :func:`~dynid.workflows.as_identified.
+      read_as_identified`); refused otherwise, the row named.
+    * Checked as a detection log: units, joint limits, torques of the opposite sign to the
+      model's or in mN m (:mod:`dynid.workflows.recordings`).
+    * Brought to the joints through the model's drive (a motor-side log's motor angles,
+      velocities and torques or currents).
+
+    A log without velocity columns has ``dq`` from the positions through a zero-phase
+    low-pass, which uses later samples: an online loop cannot have it (its own velocity
+    estimate, causal, is noisier and needs thresholds calibrated on it). What ``observe``
+    does after reading is left to the loop: the log is not cut at its gaps, its torque
+    spikes are kept and a model's torque delay is not applied.
+
+    Parameters
+    ----------
+    path : str or Path
+        A torque log (``.csv``/``.npz``), or another tool's file the model's column map
+        reads.
+    model : IdentifiedModel
+        The model the log is read for (``load_model_json``).
+    drop_invalid : bool
+        Drop invalid rows (counted in a warning) even where the identification did not.
+
+    Returns
+    -------
+    TorqueLog
+        ``t`` (N,) [s], ``q``, ``dq``, ``tau`` (N, n) at the joints [rad, rad/s, N m].
+
+    Raises
+    ------
+    DataError
+        A bad file, invalid rows unless dropped, another joint count, a log in degrees or
+        of the opposite torque sign (each names the file and the ``--units`` that reads it).
+    """
+    _checks.of_type("model", model, IdentifiedModel, "an IdentifiedModel (load_model_json)")
+    obs = from_identified(model, None)
+    drop, gap = read_as_identified(obs.logs_read, drop_invalid, None)
+    recorded = model.info.column_map
+    files = [Path(path)]
+    columns, cmap = _model_columns(obs, recorded, (None, None), files)
+    read = _read_logs(
+        files, obs, cmap, _Reading(drop, None, gap), recorded=recorded, units=(columns[1], None)
+    )
+    return joint_side_log(read.logs[0], obs.drive)
+
+
+def _model_columns(
+    model: ObserverModel,
+    recorded: Mapping[str, str | None] | None,
+    given: ColumnSpec,
+    files: Sequence[Path],
+) -> tuple[ColumnSpec, ColumnMap | None]:
+    """The ``--columns``/``--units`` the ``files`` are read with for ``model`` (``given``,
+    else the ``recorded`` ones, said once: :func:`~dynid.workflows.data_files.
+    recorded_columns`) and their column map."""
+    columns = recorded_columns(recorded, *given, files)
+    return columns, column_map(*columns, drive=model.drive, robot=model.robot)
+
+
+@dataclass(frozen=True, slots=True)
+class _Reading:
+    """How logs are read: invalid rows dropped, the joint positions [rad] at a wrapped
+    motor-side log's first sample, the longest gap bridged [s] (None: the rule)."""
+
+    drop_invalid: bool
+    q_start: tuple[float, ...] | None
+    max_gap: float | None
+
+
 def _read_logs(
-    paths: list[Path],
+    paths: Sequence[Path],
     model: ObserverModel,
     cmap: ColumnMap | None,
-    opts: ObserveOptions,
+    how: _Reading,
+    *,
+    among: bool = False,
     recorded: Mapping[str, str | None] | None = None,
-    units: str | None = None,
+    units: tuple[str | None, str | None] = (None, None),
 ) -> Recorded:
     """The logs ``paths`` read strictly for the model through ``cmap`` (of the ``--units``
-    text ``units``, for the unit findings' hint); a log in other
-    units than the others, with joints in degrees, with torques of the opposite sign to the
-    model's or in mN m read as N m refused (the model's ``recorded`` column map, when it
-    looks wrong for a file, named first), and one far outside the joint limits warned
-    about, each naming the file (:mod:`dynid.workflows.recordings`)."""
+    text ``units[0]``, for the unit findings' hint; ``units[1]`` the one given); a log in
+    other units than the others, with joints in degrees, with torques of the opposite sign
+    to the model's (``among``: calibration logs, judged against each other) or in mN m
+    read as N m refused (the model's ``recorded`` column map, when it looks wrong for a
+    file, named first), and one far outside the joint limits warned about, each naming the
+    file (:mod:`dynid.workflows.recordings`)."""
     logs = [
         read_torque_log(
             p,
             model.n,
             columns=cmap,
-            drop_invalid=opts.drop_invalid,
+            drop_invalid=how.drop_invalid,
             owner="the model",
             robot=model.robot,
             drive=model.drive,
@@ -779,19 +865,17 @@ def _read_logs(
         for p in map(Path, paths)
     ]
     names = [Path(p).name for p in paths]
-    logs = list(given_start(logs, names, model.robot, model.drive, opts.q_start, opts.max_gap))
+    logs = list(given_start(logs, names, model.robot, model.drive, how.q_start, how.max_gap))
     read = Recorded(tuple(logs), tuple(map(Path, paths)), model.drive)  # mapped once
-    checked = unwrapped_recorded(read, model.robot, opts.max_gap)  # as prepared_log reads
-    check_unit_findings(checked, model.robot, given_units(cmap, units))
+    checked = unwrapped_recorded(read, model.robot, how.max_gap)  # as prepared_log reads
+    check_unit_findings(checked, model.robot, given_units(cmap, units[0]))
     check_limits(checked, model.robot)
-    read, checked = usable_recorded(read, checked, model.robot, opts.max_gap)
+    read, checked = usable_recorded(read, checked, model.robot, how.max_gap)
     check_units(checked)
     check_derived_velocities(read, cmap)
     note_unread_columns(read, cmap)
     # detection logs hold contacts; a model's recorded sign map judged first
-    check_signs(
-        checked, model.robot, among=opts.calibrate, recorded=recorded, units=opts.columns[1]
-    )
+    check_signs(checked, model.robot, among=among, recorded=recorded, units=units[1])
     check_torque_unit(checked, model.robot, cmap)
     return read
 
