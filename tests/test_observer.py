@@ -498,3 +498,13 @@ def test_the_std_filter_kernel_gives_lfilters_numbers_bit_for_bit(monkeypatch):
                 first_order_filtered(gam, x, z, got)
             assert np.array_equal(got, want, equal_nan=True), kernels
             assert np.array_equal(z, zw, equal_nan=True), kernels
+
+
+def test_another_friction_keeps_every_other_field():
+    """ObserverModel.with_friction replaces the friction alone: the torque delay and the
+    logs' reading the model was identified with stay (a copy field by field dropped them)."""
+    read = object()  # the identification's LogInfo, opaque here
+    model = dataclasses.replace(from_robot(dynid.panda()), torque_delay_s=0.003, logs_read=read)
+    other = model.with_friction(None)
+    assert other.friction is None and other.torque_delay_s == 0.003
+    assert other.logs_read is read and other.robot is model.robot

@@ -15,7 +15,7 @@ a URDF, TOML or MJCF robot, with a drive's rotor inertias and a friction model).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -117,12 +117,9 @@ class ObserverModel:
         return self.robot.n
 
     def with_friction(self, friction: FrictionModel | FrictionSum | None) -> ObserverModel:
-        """The same model with another friction (None: none)."""
-        return ObserverModel(
-            self.robot, self.rotor_mass, friction, self.base, self.beta, self.covariance,
-            self.drive, self.source, self.base_terms, self.position_terms,
-            self.position_covariance,
-        )  # fmt: skip
+        """The same model with another friction (None: none); every other field kept (the
+        torque delay and the logs' reading too, which a copy field by field dropped)."""
+        return replace(self, friction=friction)
 
     def position_torques(self, q: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """The torques (N, n) [N m] of :attr:`position_terms` at the positions ``q`` (N, n)
