@@ -40,7 +40,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,6 +51,9 @@ from ...model.inertia import phi_from_inertial
 from ...model.robot import Frame, Robot
 from ...model.stiffness import JointStiffness
 from ...progress import NOTE
+
+if TYPE_CHECKING:
+    from ...friction.laws.base import Friction
 
 __all__ = ["RAMP_WIDTH", "frictionloss_slopes", "load_mjcf", "mjcf_drive"]
 
@@ -237,7 +240,7 @@ def frictionloss_slopes(m: Any, dofs: NDArray[np.intp]) -> NDArray[np.float64]:
 
 def _friction_as_applied(
     m: Any, dofs: NDArray[np.intp], fv: NDArray[np.float64], fc: NDArray[np.float64], name: str
-) -> Any:
+) -> Friction:
     """The joints' ``damping`` ``fv`` and ``frictionloss`` ``fc`` (n,) as MuJoCo applies
     them (module docstring): the smooth law of width ``RAMP_WIDTH fc / S``
     (:func:`frictionloss_slopes`), the plain sign where ``fc`` is zero; said in a note."""
