@@ -11,7 +11,8 @@ The pipeline, in the order data flows (each name is re-exported here):
 * identification: :func:`identify_static` (Gaz et al. 2019, Sec. IV-A),
   :func:`identify_from_log` (a torque log: its terms chosen on held-out data, as ``dynid
   identify`` chooses them), :class:`IdentifiedModel`
-* friction: :func:`fit_friction`, :func:`sigmoid_friction`, :func:`validate_torques`
+* friction: :func:`fit_friction`, :func:`sigmoid_friction`, :func:`validate_torques`,
+  :func:`model_torques` (a model's whole torques: links, rotors, spring and friction)
 * simulation: trajectories (:func:`sinusoid_trajectory`, :func:`random_fourier`,
   :func:`check_limits`), :class:`SimulatedController`, :func:`acquire_static`,
   :func:`simulate_measurement`,
@@ -65,7 +66,7 @@ if TYPE_CHECKING:  # the names as static imports, for type checkers and editors
         classical_friction,
         sigmoid_friction,
     )
-    from .friction.validation import Validation, validate_torques
+    from .friction.validation import Validation, model_torques, validate_torques
     from .identification.classical import identify_from_log
     from .identification.data import StaticDataset
     from .identification.least_squares import LeastSquaresFit, fit_least_squares
@@ -153,6 +154,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "joint_transforms": ("kinematics.forward", "joint_transforms"),
     "link_poses": ("kinematics.forward", "link_poses"),
     "mass_matrix": ("dynamics.terms", "mass_matrix"),
+    "model_torques": ("friction.validation", "model_torques"),
     "optimise_excitation": ("simulation.excitation", "optimise_excitation"),
     "panda": ("model.panda", "panda"),
     "param_labels": ("model.inertia", "param_labels"),
@@ -238,6 +240,7 @@ __all__ = [
     "joint_transforms",
     "link_poses",
     "mass_matrix",
+    "model_torques",
     "optimise_excitation",
     "panda",
     "param_labels",

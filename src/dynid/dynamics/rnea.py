@@ -151,9 +151,18 @@ def rnea(
     *,
     gravity: ArrayLike | None = None,
 ) -> NDArray[np.float64]:
-    """Inverse dynamics: joint torques for given positions, velocities and accelerations.
+    """Inverse dynamics of the links: joint torques for given positions, velocities and
+    accelerations.
 
     .. math:: \\tau = M(q) \\ddot q + c(q, \\dot q) + g(q)
+
+    of the links' standard parameters ``robot.phi`` alone. Not included, even where the
+    robot holds them: its friction (``robot.friction``, offsets included), its joint spring
+    (``robot.spring``, ``k (q - q0)``), rotor inertias (a drive's ``rotor_inertia``, an
+    MJCF's ``armature``), nor an identified model's other terms. A model's whole torques,
+    as ``validate`` and ``identify`` predict them (a ``feasible.json`` or robot file read
+    back, an :class:`~dynid.identification.model.IdentifiedModel`), are
+    :func:`dynid.model_torques` (:func:`dynid.friction.validation.model_torques`).
 
     Parameters
     ----------
@@ -168,7 +177,7 @@ def rnea(
     Returns
     -------
     tau : ndarray, shape (..., n)
-        Joint torques [N m] (forces [N] for prismatic joints), friction not included.
+        Joint torques [N m] (forces [N] for prismatic joints) of the links alone.
 
     Raises
     ------

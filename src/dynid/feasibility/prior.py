@@ -19,11 +19,14 @@ on a 10.8 kg 7-joint arm, 3.7 times its last link's mass, where the data could n
 the generic one when it has none.
 
 Every prior is checked before use: a link whose pseudo-inertia is not positive definite
-with the margin ``lambda_min(J) >= margin tr(J)`` (a CAD inertia violating the triangle
-inequality, a massless link) is repaired by flooring the eigenvalues of ``J``
-(:func:`~dynid.feasibility.lmi.repair_pseudo_inertia`; a massless link gets the generic
-cylinder), and a total mass outside the band is reported. Nothing is repaired silently:
-:attr:`Prior.notes` says what was done, one line each.
+with the margin ``lambda_min(J) >= margin tr(J)`` gets the eigenvalues of ``J`` floored to
+it (:func:`~dynid.feasibility.lmi.repair_pseudo_inertia`), and a total mass outside the
+band is reported. A link that violates a physical condition (``lambda_min(J) < 0``: a CAD
+inertia breaking the triangle inequality, a negative principal moment; a mass at or below
+zero, which gets the generic cylinder) is *repaired* (:attr:`Prior.repaired`); a
+physically valid link only within the margin is *held at the margin*
+(:attr:`Prior.held`: a Unitree Z1's link05 at ``0.000199 tr(J)`` against ``0.0002``).
+Nothing is changed silently: :attr:`Prior.notes` says what was done, one line each.
 """
 
 from __future__ import annotations
@@ -49,8 +52,9 @@ __all__ = [
     "prior_scales",
 ]
 
-#: A prior's links are repaired up to ``lambda_min(J) >= DEFAULT_PRIOR_MARGIN tr(J)``
-#: (the published Panda's links lie between 2e-4 and 2e-3).
+#: A prior's links are held at or repaired up to ``lambda_min(J) >= DEFAULT_PRIOR_MARGIN
+#: tr(J)`` (the published Panda's links lie between 1.3e-6 and 1.3e-3: links 2, 3, 5 and 6
+#: are held at it).
 DEFAULT_PRIOR_MARGIN = 2e-4
 #: Generic cylinder: radius as a fraction of the link's length, and its floor [m].
 GENERIC_RADIUS_FRACTION = 0.2
@@ -76,15 +80,20 @@ class Prior:
     source : str
         Where it came from (``"panda"``, a file name, :data:`GENERIC_SOURCE`).
     repaired : tuple of int
-        Links (1-based) whose parameters were repaired.
+        Links (1-based) whose parameters violated a physical condition and were repaired
+        (``lambda_min(J) < 0``, a mass at or below zero).
     notes : tuple of str
         One line per repair or warning (also the total mass against the band).
+    held : tuple of int
+        Links (1-based) physically valid (``lambda_min(J) >= 0``) but within the margin,
+        their eigenvalues floored to ``margin tr(J)``: held at the margin, not repaired.
     """
 
     phi: NDArray[np.float64]
     source: str
     repaired: tuple[int, ...] = ()
     notes: tuple[str, ...] = ()
+    held: tuple[int, ...] = ()
 
     @property
     def n(self) -> int:
@@ -228,14 +237,10 @@ def prior_from_robot(
             repaired.append(int(i) + 1)
     before = pseudo_inertia_margin(phi)
     phi, changed = repair_pseudo_inertia(phi, margin)
-    if np.any(changed):
-        idx = np.flatnonzero(changed)
-        links = ", ".join(f"{i + 1} ({robot.link_names[i + 1]}: {before[i]:.3g})" for i in idx)
-        notes.append(
-            f"prior {name}: lambda_min(J)/tr(J) below {margin:g} on link(s) {links}; their "
-            "pseudo-inertia eigenvalues were floored to it"
-        )
-        repaired += [int(i) + 1 for i in idx]
+    violated = changed & (before < 0) & ~massless
+    held = changed & ~violated & ~massless
+    notes += _margin_notes(robot, name, margin, before, violated, held)
+    repaired += [int(i) + 1 for i in np.flatnonzero(violated)]
     if total_mass is not None:
         M = float(phi[:, 0].sum())
         lo, hi = (float(x) for x in total_mass)
@@ -249,7 +254,47 @@ def prior_from_robot(
             f"prior {name}: its joint spring (k = {k} N m/rad) is not used; a prior holds the "
             "links' inertials only, and the stiffnesses come from the data (spring in --terms)"
         )
-    return Prior(phi=phi, source=name, repaired=tuple(sorted(set(repaired))), notes=tuple(notes))
+    return Prior(
+        phi=phi,
+        source=name,
+        repaired=tuple(sorted(set(repaired))),
+        notes=tuple(notes),
+        held=tuple(int(i) + 1 for i in np.flatnonzero(held)),
+    )
+
+
+def _margin_notes(
+    robot: Robot,
+    name: str,
+    margin: float,
+    before: NDArray[np.float64],
+    violated: NDArray[np.bool_],
+    held: NDArray[np.bool_],
+) -> list[str]:
+    """The lines saying which links' pseudo-inertia eigenvalues were floored to ``margin
+    tr(J)``: those that ``violated`` physical consistency (``lambda_min(J) < 0``,
+    repaired) and those ``held`` at the margin (valid, ``0 <= lambda_min(J) / tr(J) <
+    margin``), each with its ``before`` ratio (n,)."""
+
+    def links(mask: NDArray[np.bool_]) -> str:
+        idx = np.flatnonzero(mask)
+        return ", ".join(f"{i + 1} ({robot.link_names[i + 1]}: {before[i]:.3g})" for i in idx)
+
+    notes = []
+    if np.any(violated):
+        notes.append(
+            f"prior {name}: link(s) {links(violated)} not physically consistent "
+            "(lambda_min(J)/tr(J) below 0: the triangle inequality or a principal moment "
+            f"broken); repaired: their pseudo-inertia eigenvalues floored to {margin:g} tr(J)"
+        )
+    if np.any(held):
+        notes.append(
+            f"prior {name}: link(s) {links(held)} physically valid, lambda_min(J)/tr(J) "
+            f"within the margin {margin:g}; held at the margin: their pseudo-inertia "
+            f"eigenvalues floored to it (a change of at most "
+            f"{float(np.max(margin - before[held])):.2g} tr(J))"
+        )
+    return notes
 
 
 def default_prior(robot: Robot, total_mass: tuple[float, float] | None = None) -> Prior:
@@ -276,6 +321,7 @@ def default_prior(robot: Robot, total_mass: tuple[float, float] | None = None) -
         f"prior: the link inertials of the robot's description ({robot.name}), total mass "
         f"{float(pr.phi[:, 0].sum()):.4g} kg"
         + (f"; link(s) {', '.join(map(str, pr.repaired))} repaired" if pr.repaired else "")
+        + (f"; link(s) {', '.join(map(str, pr.held))} held at the margin" if pr.held else "")
         + " (--prior names another)"
     )
-    return Prior(pr.phi, pr.source, pr.repaired, (note, *pr.notes))
+    return Prior(pr.phi, pr.source, pr.repaired, (note, *pr.notes), pr.held)

@@ -14,7 +14,11 @@ in part (a UR5 tilted 0.3 deg, its torques in step, read as 0.37 ms late, +- 0.1
 the tilt's columns, -0.007 ms +- 0.014 ms).
 :func:`logs_delay` prepares whole logs first, as the identification cut them (``identify``
 reads the fit's residual on its own recordings), or takes them as its held-out prediction
-of each recording prepared them.
+of each recording prepared them. Torques whose scale is grossly off the prediction's
+(:func:`torque_scale` outside ``1 / SCALE_OFF .. SCALE_OFF``: another unit, currents read
+as torques) give no delay: the residual is then the prediction's own shape, and its
+projection on the prediction's derivative is no lag (an xArm's currents validated against
+its torques read as leading by 143 ms, +- 31 ms).
 """
 
 from __future__ import annotations
@@ -36,12 +40,29 @@ from .fit import model_drive
 from .heldout_torques import beside_columns
 from .validation import Validation, own_friction, validate_torques, validated
 
-__all__ = ["ROWS", "logs_delay", "validations_delay"]
+__all__ = ["ROWS", "SCALE_OFF", "logs_delay", "torque_scale", "validations_delay"]
 
 #: The most rows the delay is fitted on: a longer log gives every k-th sample (its
 #: derivative taken at the full rate first), so that the check's columns stay a few tens
 #: of MB beside a streamed fit of any length.
 ROWS = 10_000
+
+#: The factor beyond which the torques' scale against the prediction is grossly off
+#: (:func:`torque_scale`): no delay is read from such a residual.
+SCALE_OFF = 3.0
+
+
+def torque_scale(parts: Sequence[Validation]) -> float:
+    """``a`` of ``tau ~ a tau_hat`` [1], least squares over every sample and joint of
+    ``parts``: the logged torques against the prediction with the model's friction (1:
+    the same scale; 0.01: currents of torque constant times gear ratio 100 read as N m;
+    nan: no prediction)."""
+    num = den = 0.0
+    for v in parts:
+        hat = v.tau_model if v.tau_friction is None else v.tau_model + v.tau_friction
+        num += float(np.sum(v.log.tau * hat))
+        den += float(np.sum(hat * hat))
+    return num / den if den > 0 else float("nan")
 
 
 def validations_delay(
@@ -49,9 +70,14 @@ def validations_delay(
 ) -> TorqueDelay | None:
     """The delay of the torques behind the positions in ``parts`` (one
     :class:`~dynid.friction.validation.Validation` per prepared piece, of ``model``), or
-    None when it cannot be read (too few samples, no prediction that changes). Fitted
+    None when it cannot be read (too few samples, no prediction that changes) or the
+    torques' scale is grossly off the prediction's (:func:`torque_scale` outside
+    ``1 / SCALE_OFF .. SCALE_OFF``, or of the opposite sign). Fitted
     beside the tilt of the gravity vector's columns and, of an identified model, its own
     (module docstring)."""
+    scale = torque_scale(parts)
+    if not 1.0 / SCALE_OFF <= scale <= SCALE_OFF:  # nan too
+        return None
     t, predicted, error, columns = [], [], [], []
     every = max(-(-sum(v.log.n_samples for v in parts) // ROWS), 1)  # every k-th row fitted
     robot = model.description if isinstance(model, IdentifiedModel) else model

@@ -34,7 +34,7 @@ from ..exceptions import DynidWarning, OptionError, ShapeError, WrongTypeError
 from ..identification.input_noise import exact_to_round_off
 from ..identification.log import DEFAULT_CUTOFF_HZ, TorqueLog, checked_log, joint_side_log
 from ..identification.metrics import TorqueErrors, torque_errors
-from ..identification.model import IdentifiedModel
+from ..identification.model import IdentifiedModel, checked_model
 from ..identification.model_sign import anticorrelated
 from ..identification.prepare import (
     Preprocessing,
@@ -66,6 +66,7 @@ __all__ = [
     "errors_from_sums",
     "own_friction",
     "holds_cutoff",
+    "model_torques",
     "recorded_cutoff",
     "validate_newton_euler",
     "validate_torques",
@@ -104,6 +105,70 @@ def own_friction(
     if isinstance(model, Robot):
         return robot_friction(model, drive)
     return None
+
+
+def model_torques(
+    model: IdentifiedModel | Robot,
+    q: ArrayLike,
+    dq: ArrayLike,
+    ddq: ArrayLike,
+    *,
+    drive: Drive | None = None,
+) -> NDArray[np.float64]:
+    """A model's whole joint torques [N m] (N for a prismatic joint): what ``validate``
+    and ``identify`` predict, where :func:`~dynid.dynamics.rnea.rnea` gives the links alone.
+
+    .. math:: \\tau = M(q) \\ddot q + c(q, \\dot q) + g(q) + K^T \\mathrm{diag}(I_a) K
+              \\ddot q + k (q - q_0) + \\tau_f(\\dot q)
+
+    the links' inverse dynamics, the rotor inertias ``I_a`` through the transmission ``K``
+    (an identified model's, or ``drive``'s known ``rotor_inertia`` for a robot), a joint
+    spring (:attr:`~dynid.model.robot.Robot.spring`, an identified model's ``spring``
+    term) and the model's own friction with its offsets, acting where it acts
+    (:func:`own_friction`: at the motors of a drive, ``K^T f(K dq)``).
+
+    Parameters
+    ----------
+    model : IdentifiedModel or Robot
+        An identified model (``identification.json``), or a robot with its own friction
+        and spring (a ``feasible.json``, robot TOML, URDF or MJCF read back).
+    q, dq, ddq : array_like, shape (..., n)
+        Joint positions [rad], velocities [rad/s], accelerations [rad/s^2] (m, m/s, m/s^2
+        for prismatic joints), at the joints. Batch shapes broadcast.
+    drive : Drive, optional
+        The drive a robot's torques are read through (its rotor inertias and where its
+        friction acts); an identified model's own when None (another one is refused).
+
+    Returns
+    -------
+    tau : ndarray, shape (..., n)
+        Joint torques [N m].
+
+    Raises
+    ------
+    WrongTypeError
+        ``model`` is neither an identified model nor a robot.
+    ShapeError
+        An input does not end in ``n`` or the batch shapes do not broadcast.
+    DataError
+        ``drive`` differs from the one the identified model was identified with.
+    """
+    model = checked_model(model)
+    n = model.robot.n if isinstance(model, IdentifiedModel) else model.n
+    arrays = [_checks.as_batch(k, x, (n,)) for k, x in (("q", q), ("dq", dq), ("ddq", ddq))]
+    try:
+        a, b, c = np.broadcast_arrays(*arrays)
+    except ValueError as exc:
+        shapes = ", ".join(str(x.shape) for x in arrays)
+        raise ShapeError(f"q, dq, ddq: batch shapes do not broadcast; got {shapes}") from exc
+    shape = a.shape
+    a, b, c = (np.ascontiguousarray(x.reshape(-1, n)) for x in (a, b, c))
+    d = drive if isinstance(model, Robot) else model_drive(model, drive)
+    tau = np.array(torques_through(model, d, a, b, c), dtype=np.float64)
+    friction = own_friction(model, drive)
+    if friction is not None:
+        tau = tau + friction.torques(b)
+    return tau.reshape(shape)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -103,8 +103,8 @@ class ConsistentResult(FeasibleResult):
 
     def report_fields(self) -> dict[str, Any]:
         """``report.json``'s entries of the convex method: ``fit``, ``prior`` (source,
-        repaired links, mass [kg] per link), ``prior_weight``, ``weight_search``
-        (``[w, residual_ratio]``), ``residual_ratio``, ``divergence`` per link,
+        repaired links, links held at the margin, mass [kg] per link), ``prior_weight``,
+        ``weight_search`` (``[w, residual_ratio]``), ``residual_ratio``, ``divergence`` per link,
         ``distance_to_prior`` (mass [kg], CoM [m] per link), ``solver``, ``status``,
         ``on_bound`` and ``options``."""
         pm, pc, _ = inertial_from_phi(self.prior.phi)
@@ -114,6 +114,7 @@ class ConsistentResult(FeasibleResult):
             "prior": {
                 "source": self.prior.source,
                 "repaired_links": list(self.prior.repaired),
+                "held_links": list(self.prior.held),
                 "mass": [float(x) for x in pm],
             },
             "prior_weight": float(self.prior_weight),

@@ -182,15 +182,46 @@ def _soft(
         invweight0(robot, armature),
         MJCF_TIMESTEP,
     )
-    smooth = any(
-        p.kind in ("smooth", "smooth_stribeck") and np.any(np.asarray(p.band) > 0)
+    smooth = [
+        p
         for p in (model.parts if isinstance(model, FrictionSum) else (model,))
-    )
+        if p.kind in ("smooth", "smooth_stribeck") and np.any(np.asarray(p.band) > 0)
+    ]
     if not smooth or np.max(soft.rms_error) < ROUND_OFF_NM:
         return soft, ()
-    return soft, (
-        f"{model.kind} friction: written with its rounding fc tanh(dq / width) as the "
-        "slope at rest of MuJoCo's soft frictionloss (solreffriction, solimpfriction)",
+    return soft, (_rounding_note(model.kind, smooth[0], approx.coulomb, soft),)
+
+
+def _span(x: NDArray[np.float64]) -> str:
+    """``x``'s range as a warning says it: ``0.02`` or ``0.0189-0.0198``."""
+    lo, hi = f"{float(np.min(x)):.3g}", f"{float(np.max(x)):.3g}"
+    return lo if lo == hi else f"{lo}-{hi}"
+
+
+def _rounding_note(
+    kind: str, law: FrictionModel, coulomb: NDArray[np.float64], soft: SoftFrictionLoss
+) -> str:
+    """The line naming the smooth ``law`` (its width [rad/s], at the motors where it acts
+    there, over the gear ratio at the joints) and what MuJoCo applies in its place: a ramp
+    of the velocity up to ``frictionloss`` ``coulomb`` (n,) [N m], its slope at rest
+    ``soft.slope``, the joint velocity it reaches ``fc`` at and its RMS against the law.
+    ``kind``: the friction model's (the sentence's head,
+    :func:`~dynid.io.robot.export_options.friction_losses`)."""
+    band = np.asarray(law.band)
+    held = coulomb > 0
+    corner = coulomb[held] / soft.slope[held]
+    where = ""
+    if law.at_motors and law.drive is not None:  # fc tanh(G dq / w): w / G at the joint
+        gear = np.abs(np.diag(law.drive.transmission))
+        at_joints = (band / np.where(gear > 0, gear, 1.0))[band > 0]
+        where = f" at the motors, {_span(at_joints)} rad/s at the joints"
+    return (
+        f"{kind} friction: written with its rounding fc tanh(dq / width) (width "
+        f"{_span(band[band > 0])} rad/s{where}) as the ramp of the velocity MuJoCo applies "
+        f"in its place (frictionloss is no tanh): slope {_span(soft.slope[held])} N m s/rad "
+        "at rest (solreffriction, solimpfriction), reaching fc at "
+        f"|dq| = {_span(corner)} rad/s at the joints (RMS {np.max(soft.rms_error):.2g} N m "
+        "off the law, each joint alone), which dynid reads the file's frictionloss back as"
     )
 
 

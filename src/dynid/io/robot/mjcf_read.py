@@ -17,9 +17,14 @@ compiled model is read at ``qpos = 0`` in world coordinates:
   one joint times its gear, the torque limit; velocity and acceleration limits are
   unknown (``inf``); ``<option gravity>`` is the gravity;
 * the joints' ``damping`` [N m s/rad] and ``frictionloss`` [N m] are read as viscous and
-  Coulomb friction (``fv dq + fc sign(dq)``, the classical law without offsets, as
-  :mod:`dynid.io.robot.mjcf` writes them); their ``armature`` [kg m^2], a direct drive's
-  rotor inertias (:func:`mjcf_drive`).
+  Coulomb friction as MuJoCo applies them: ``frictionloss`` is a soft constraint, a ramp
+  of the velocity of slope ``S`` at rest saturating at ``fc``
+  (:mod:`dynid.friction.mujoco_soft`; ``S`` from the joint's ``solreffriction``,
+  ``solimpfriction`` and MuJoCo's inverse weight, :func:`frictionloss_slopes`), read as the
+  smooth law ``fv dq + fc tanh(dq / width)`` with the width whose ``tanh`` is closest to
+  that ramp, ``width = RAMP_WIDTH fc / S`` (the ramp's acceleration term, ``ddq d
+  timeconst / 2`` in velocity, left out), said in one note; their ``armature``
+  [kg m^2], a direct drive's rotor inertias (:func:`mjcf_drive`).
 
 * the joints' ``stiffness`` [N m/rad] about ``springref`` [rad], MuJoCo's passive spring
   ``qfrc_spring = -k (q - q0)``, is the robot's joint spring
@@ -32,9 +37,10 @@ free joints, a body with several joints, a tree with branches.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,10 +50,22 @@ from ...model.drive import Drive
 from ...model.inertia import phi_from_inertial
 from ...model.robot import Frame, Robot
 from ...model.stiffness import JointStiffness
+from ...progress import NOTE
 
-__all__ = ["load_mjcf", "mjcf_drive"]
+if TYPE_CHECKING:
+    from ...friction.laws.base import Friction
+
+__all__ = ["RAMP_WIDTH", "frictionloss_slopes", "load_mjcf", "mjcf_drive"]
+
+_log = logging.getLogger(__name__)
 
 _HINGE, _SLIDE = 3, 2  # mjtJoint
+
+#: The ``tanh`` closest to a ramp ``fc min(|dq| / c, 1)`` (RMS over velocities past the
+#: corner ``c = fc / S``) has the width ``RAMP_WIDTH c``: MuJoCo's dry friction read as the
+#: smooth law (the MJCF export writes a smooth law of width ``w`` as the slope closest to
+#: it, about ``0.8 fc / w``, so an export reads back near its own width).
+RAMP_WIDTH = 0.7546
 
 
 @dataclass(frozen=True)
@@ -133,8 +151,6 @@ def load_mjcf(path: str | Path) -> Robot:
     """
     import mujoco
 
-    from ...friction.model import ClassicalFriction
-
     path = Path(path)
     c = _compiled(path)
     m, d = c.model, c.data
@@ -173,7 +189,8 @@ def load_mjcf(path: str | Path) -> Robot:
     frames.pop(base, None)
     frames.pop("", None)
     limited = np.asarray(m.jnt_limited[jnt], dtype=bool)
-    fv, fc = np.asarray(m.dof_damping[m.jnt_dofadr[jnt]]), m.dof_frictionloss[m.jnt_dofadr[jnt]]
+    dofs = np.asarray(m.jnt_dofadr[jnt])
+    fv, fc = np.asarray(m.dof_damping[dofs]), np.asarray(m.dof_frictionloss[dofs])
     try:
         robot = Robot(
             name=bytes(m.names).split(b"\0", 1)[0].decode() or path.stem,
@@ -196,12 +213,62 @@ def load_mjcf(path: str | Path) -> Robot:
     except DynidError as exc:
         raise DataError(str(exc), file=path.name) from exc
     if np.any(fv != 0.0) or np.any(fc != 0.0):
-        robot = robot.with_friction(ClassicalFriction(fv, fc, np.zeros(n)))
+        robot = robot.with_friction(_friction_as_applied(m, dofs, fv, fc, path.name))
     k = np.asarray(m.jnt_stiffness[jnt], dtype=np.float64)
     if np.any(k != 0.0):
         q0 = np.asarray(m.qpos_spring[m.jnt_qposadr[jnt]], dtype=np.float64)
         robot = robot.with_spring(JointStiffness(k, q0))
     return robot
+
+
+def frictionloss_slopes(m: Any, dofs: NDArray[np.intp]) -> NDArray[np.float64]:
+    """MuJoCo's dry friction torque per velocity at rest [N m s/rad] of the compiled
+    model ``m``'s dofs ``dofs``: ``b / R`` of the soft constraint (MuJoCo's documentation,
+    Computation), ``R = (1 - d) / d A_0`` with ``d`` solimp's ``dmin`` (a friction row's
+    violation is zero) and ``A_0`` the dof's ``dof_invweight0``; ``b = 2 / (dmax tc)`` for
+    solref's standard form (``tc`` raised to two timesteps, as MuJoCo does), ``-solref[1] /
+    dmax`` for its direct form. Equal to ``mj_inverse``'s slope at zero acceleration."""
+    from ...friction.mujoco_soft import MAX_IMPEDANCE, MIN_IMPEDANCE
+
+    ref, imp = np.asarray(m.dof_solref[dofs]), np.asarray(m.dof_solimp[dofs])
+    dmin, dmax = (np.clip(imp[:, k], MIN_IMPEDANCE, MAX_IMPEDANCE) for k in (0, 1))
+    tc = np.maximum(ref[:, 0], 2.0 * float(m.opt.timestep))
+    b = np.where(ref[:, 0] > 0, 2.0 / (dmax * tc), -ref[:, 1] / dmax)
+    R = (1.0 - dmin) / dmin * np.asarray(m.dof_invweight0[dofs])
+    return np.asarray(b / R, dtype=np.float64)
+
+
+def _friction_as_applied(
+    m: Any, dofs: NDArray[np.intp], fv: NDArray[np.float64], fc: NDArray[np.float64], name: str
+) -> Friction:
+    """The joints' ``damping`` ``fv`` and ``frictionloss`` ``fc`` (n,) as MuJoCo applies
+    them (module docstring): the smooth law of width ``RAMP_WIDTH fc / S``
+    (:func:`frictionloss_slopes`), the plain sign where ``fc`` is zero; said in a note."""
+    from ...friction.laws import LAWS
+
+    n = fv.shape[0]
+    slope = frictionloss_slopes(m, dofs)
+    held = fc > 0
+    width = np.where(held, RAMP_WIDTH * fc / np.where(held, slope, 1.0), 0.0)
+    if np.any(held):
+        _log.log(
+            NOTE,
+            "%s: frictionloss read as MuJoCo applies it, a ramp of the velocity up to fc of "
+            "slope %s N m s/rad at rest (its solreffriction and solimpfriction), not a sharp "
+            "Coulomb: as fc tanh(dq / width), width %s rad/s, the tanh closest to the ramp "
+            "(joint(s) %s)",
+            name,
+            _span(slope[held]),
+            _span(width[held]),
+            ", ".join(str(j + 1) for j in np.flatnonzero(held)),
+        )
+    return LAWS["smooth"].model(np.stack([fv, fc, np.zeros(n)], axis=1), width)
+
+
+def _span(x: NDArray[np.float64]) -> str:
+    """``x``'s range as a note says it: ``0.0201`` or ``0.0201-0.0284``."""
+    lo, hi = float(np.min(x)), float(np.max(x))
+    return f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g}-{hi:.3g}"
 
 
 def _torque_limits(m: Any, jnt: list[int]) -> NDArray[np.float64]:
