@@ -49,7 +49,9 @@ def _selected(vst: np.ndarray, per_joint: bool = True):
         panda, (81, 82, 83), friction=LawFriction(LAWS["stribeck"], P), duration=4.0, noise=noisy
     )
     data = prepare_recordings(panda, logs)
-    out = [select_structure(panda, data, candidates=_CANDIDATES, per_joint=p) for p in (False, True)]
+    out = [
+        select_structure(panda, data, candidates=_CANDIDATES, per_joint=p) for p in (False, True)
+    ]
     return panda, logs, P, out
 
 

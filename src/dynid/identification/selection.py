@@ -269,7 +269,8 @@ def select_structure(
         A separate recording to judge on instead of the folds.
     per_joint : bool
         Also judge per-joint structures: a smooth Coulomb's width per joint
-        (:func:`~dynid.identification.widths.per_joint_widths`), single joints' friction
+        (:func:`~dynid.identification.widths.per_joint_widths`), a Stribeck velocity per
+        joint (:func:`~dynid.identification.stribeck_joints.per_joint_vst`), single joints' friction
         coefficients left out within one standard error of the lowest held-out error,
         none the fit determines (:attr:`~dynid.identification.structure.Structure.drop`).
 
@@ -335,12 +336,7 @@ def select_structure(
         judged += _widths_per_joint(judged, by_group, robot.n, fit_rtol, where)
     off = _OffGrid(fit, groups, by_group, where, skip, fit_rtol)
     judged += _smooth_bumps(judged, cands, off)
-    judged += _refined_width(judged, off, notes)
-    if per_joint:
-        judged += _per_joint(judged, by_group, robot.n, fit_rtol, where)
-    chosen = _refined_stribeck(judged, off, notes)
-    if per_joint:
-        chosen = _stribeck_joints(chosen, judged, off, robot.n, notes)
+    chosen = _shaped_choice(judged, off, robot.n, per_joint, notes)
     chosen = _without_pushing(chosen, judged, by_group, robot.n, where, notes, fit_rtol)
     notes[:0] = [lo.note(chosen, where.get(chosen)) for lo in left_out]
     best = min(_physical(judged), key=lambda c: c.score)
@@ -359,6 +355,21 @@ def select_structure(
         determined=determined,
         cut=tuple((data.names[i], c) for i, c in cut.items()),
     )
+
+
+def _shaped_choice(
+    judged: list[Candidate], off: _OffGrid, n: int, per_joint: bool, notes: list[str]
+) -> Structure:
+    """The structure chosen once the shapes are refined: the smooth width of one for
+    every joint (:func:`_refined_width`), per-joint structures (``per_joint``,
+    :func:`_per_joint`), the Stribeck velocity of the choice (:func:`_refined_stribeck`)
+    and (``per_joint``) one per joint (:func:`_stribeck_joints`); every candidate judged
+    appended to ``judged``, ``notes`` saying the shapes refined."""
+    judged += _refined_width(judged, off, notes)
+    if per_joint:
+        judged += _per_joint(judged, off.by_group, n, off.rtol, off.where)
+    chosen = _refined_stribeck(judged, off, notes)
+    return _stribeck_joints(chosen, judged, off, n, notes) if per_joint else chosen
 
 
 def _kept_determined(
