@@ -17,7 +17,7 @@ import pytest
 import dynid
 from dynid.exceptions import DynidWarning
 from dynid.friction.laws import LAWS
-from dynid.friction.model import LawFriction
+from dynid.friction.model import LawFriction, friction_of
 from dynid.identification.recordings import prepare_recordings
 from dynid.identification.selection import identify_recordings, select_structure
 from dynid.identification.structure import STRIBECK_VELOCITIES, Structure
@@ -126,7 +126,14 @@ def test_per_joint_velocities_are_written_and_read_back(split, tmp_path):
     back = load_model_json(path)
     want = mine.chosen.vsts(7)
     assert back.terms["friction"].term.vst == want
-    np.testing.assert_allclose(back.friction.params[:, 3], want)
+    fr = back.friction
+    assert fr is not None
+    np.testing.assert_allclose(fr.params[:, 3], want)
+    # the friction model validate, observe and the exports evaluate: each joint at its own
+    dq = np.full((1, 7), 0.07)  # rad/s, beyond the standstill band
+    fv, fc, fs, vst, fo = fr.params.T
+    law = fv * dq + fc + (fs - fc) * np.exp(-((dq / np.array(want)) ** 2)) + fo
+    np.testing.assert_allclose(friction_of(fr).torques(dq), law, rtol=1e-9, atol=1e-12)
     doc = json.loads(path.read_text())
     term = next(t for t in doc["terms"] if t["name"] == "friction")
     assert term["definition"]["vst"] == list(want)
