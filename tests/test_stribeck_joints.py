@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import dynid
+from dynid.cli.summaries import format_identification
 from dynid.exceptions import DynidWarning
 from dynid.friction.laws import LAWS
 from dynid.friction.model import LawFriction, friction_of
@@ -116,12 +117,15 @@ def test_the_per_joint_column_is_the_closed_form():
 
 
 def test_per_joint_velocities_are_written_and_read_back(split, tmp_path):
-    """identification.json records the velocity of each joint; a file written with one
-    number (before velocities per joint) still loads, every joint at it."""
+    """identification.json records the velocity of each joint and the summary says them;
+    a file written with one number (before velocities per joint) still loads, every joint
+    at it."""
     panda, logs, _, (_, mine) = split
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(panda, logs, structure=mine.chosen)
+    said = "/".join(f"{v:.3g}" for v in mine.chosen.vsts(7))
+    assert f"vst = {said} rad/s (per joint)" in format_identification(model)
     path = save_model_json(tmp_path / "identification.json", model)
     back = load_model_json(path)
     want = mine.chosen.vsts(7)
