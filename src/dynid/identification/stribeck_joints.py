@@ -6,10 +6,13 @@ neighbours: :mod:`~dynid.identification.shape_refinement`). Joints differ (a sho
 gearbox and a wrist's): a simulated TALOS arm with bumps at 0.08 rad/s on joints 1-2 and
 0.1 on the others got 0.0955 for all, its Stribeck peaks on joints 1-2 5 % low.
 
-:func:`per_joint_vst` searches each joint's velocity in turn, the others held at the
-common one, between the grid neighbours of the common velocity, by the same successive
-parabolic interpolation (:func:`~.shape_refinement.shape_search`) on the held-out error
-(each joint's torques in units of its own noise: the whitened error the choice reads). Given
+:func:`per_joint_vst` judges each joint's velocity in turn, the others held at the
+common one, at the grid's :data:`SIDE_STEPS` velocities each side of the common one
+(further out while the lowest error is at the end, :data:`MAX_WALK`), then refines it
+between the judged neighbours of the lowest by the same successive parabolic interpolation
+(:func:`~.shape_refinement.shape_search`, :data:`MAX_ROUNDS` steps), all on the held-out
+error (each joint's torques in units of its own noise: the whitened error the choice
+reads). Given
 the velocities the law is linear, and a joint's Stribeck column depends on that joint's
 velocity alone: the columns of every joint's trial velocity and those of the common one
 are one regressor (:func:`~.structure.vst_layers`), so each round of the joints' searches
@@ -26,24 +29,32 @@ from collections.abc import Callable, Generator, Sequence
 
 from ..regressors.terms import PART_LABELS
 from .candidates import Candidate
-from .shape_refinement import MAX_FITS, TOLERANCE, shape_search
+from .shape_refinement import TOLERANCE, shape_search
 from .structure import STRIBECK_VELOCITIES, Structure
 
-__all__ = ["MAX_WALK", "per_joint_vst", "vst_neighbours"]
+__all__ = ["MAX_ROUNDS", "MAX_WALK", "SIDE_STEPS", "per_joint_vst", "vst_neighbours"]
 
-#: The grid's steps a joint's search walks beyond the common velocity's neighbours at
-#: most (while its lowest held-out error is at the end of the velocities judged).
-MAX_WALK = 2
+#: The grid's velocities each side of the common one every joint is judged at first (in
+#: one fit): a joint two grid steps off is bracketed without a walk.
+SIDE_STEPS = 2
+#: The grid's steps a joint's search walks beyond those at most (while its lowest
+#: held-out error is at the end of the velocities judged), a fit each.
+MAX_WALK = 1
+#: The rounds of parabolic steps between the grid's velocities at most, a fit each: the
+#: first vertex lands within a few % of a joint's own velocity, the second within 1-3 %.
+MAX_ROUNDS = 2
 
 _Search = Generator[float, float | None, None]
 
 
-def vst_neighbours(vst: float, grid: Sequence[float] = STRIBECK_VELOCITIES) -> tuple[float, ...]:
-    """The grid's velocities [rad/s] next to ``vst`` each side (the grid point's own
-    neighbours where ``vst`` is one; one side at the grid's end)."""
-    below = [g for g in grid if math.log(vst / g) > TOLERANCE]
-    above = [g for g in grid if math.log(g / vst) > TOLERANCE]
-    return tuple(([max(below)] if below else []) + ([min(above)] if above else []))
+def vst_neighbours(
+    vst: float, grid: Sequence[float] = STRIBECK_VELOCITIES, steps: int = SIDE_STEPS
+) -> tuple[float, ...]:
+    """The grid's ``steps`` velocities [rad/s] nearest ``vst`` each side, not ``vst``
+    itself (fewer at the grid's ends)."""
+    below = sorted(g for g in grid if math.log(vst / g) > TOLERANCE)
+    above = sorted(g for g in grid if math.log(g / vst) > TOLERANCE)
+    return tuple(below[-steps:] + above[:steps])
 
 
 def per_joint_vst(
@@ -97,7 +108,7 @@ def per_joint_vst(
     both = s
     for j, c in kept.items():
         both = both.with_vst(j, c.structure.vsts(n)[j], n)
-    (together,) = judged([both], MAX_FITS + 1)
+    (together,) = judged([both], -1)
     if together is None:
         return start, every
     every.append(together)
@@ -155,12 +166,14 @@ def _scores(tried: Sequence[Candidate], j: int, n: int) -> dict[float, float]:
 
 def _search(tried: list[Candidate], j: int, n: int) -> _Search | None:
     """Joint ``j``'s search from the scores of ``tried`` (the common velocity and the
-    joint alone at grid velocities), between the neighbours of the lowest; None when
-    they are too few."""
+    joint alone at grid velocities), between the judged neighbours of the lowest (also
+    where the lowest is the common velocity: a joint at 0.08 rad/s beside a common
+    0.0934 scored best there among the grid's 0.07 and 0.1, and its search reached
+    0.0824); None when they are too few."""
     scores = _scores(tried, j, n)
     if len(scores) < 2:
         return None
-    return shape_search(scores, min(scores, key=lambda v: scores[v]))
+    return shape_search(scores, min(scores, key=lambda v: scores[v]), MAX_ROUNDS)
 
 
 def _rounds(
@@ -176,7 +189,7 @@ def _rounds(
     score; the candidates judged, also appended to ``tried`` per joint."""
     out: list[Candidate] = []
     step = {j: next(g, None) for j, g in searches.items() if g is not None}
-    for r in range(first, first + MAX_FITS):
+    for r in range(first, first + MAX_ROUNDS):
         want = {j: v for j, v in step.items() if v is not None}
         if not want:
             break
