@@ -32,7 +32,8 @@ armatures at 31 % and 23 % had been left out, its ``M44`` and ``M66`` 53 % and 7
 A smooth Coulomb's width is then chosen per joint (:mod:`dynid.identification.widths`),
 and the Stribeck bump on the smooth sign judged at the width of the best smooth law
 (:mod:`dynid.identification.bumps`); the chosen Stribeck velocity is refined between its
-grid neighbours on the same held-out error (:mod:`dynid.identification.shape_refinement`).
+grid neighbours on the same held-out error (:mod:`dynid.identification.shape_refinement`),
+then chosen per joint where that predicts better (:mod:`dynid.identification.stribeck_joints`).
 The folds leave one recording out at a time when there are several, contiguous time
 blocks otherwise (:meth:`~dynid.identification.recordings.Recordings.fold_labels`), or
 judge on a separate recording. A recording that holds what no candidate models is left
