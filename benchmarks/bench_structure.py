@@ -7,16 +7,23 @@
   the chosen one fitted. Target: under 3 s.
 * reference: ``identify_from_log`` with the paper's fixed structure (viscous, Coulomb and
   offset friction) on the same log, the route the default replaces.
+* ``--stribeck``: the simulated friction a Stribeck law whose velocity differs per joint
+  (0.08 rad/s on joints 1-2, 0.1 on the others; ``fs = 2 fc``) with sensor noise instead,
+  whose search also refines the Stribeck velocity and chooses one per joint
+  (:mod:`dynid.identification.stribeck_joints`).
 
 Before timing, the chosen structure is checked to be the simulated one (armature and
-viscous friction). Timing: ``timeit`` autorange (>= 0.2 s per repeat), >= 5 repeats,
-median with min and max (``common.measure_pair``, the two interleaved).
+viscous friction; with ``--stribeck``, a Stribeck law with its velocity per joint).
+Timing: ``timeit`` autorange (>= 0.2 s per repeat), >= 5 repeats, median with min and max
+(``common.measure_pair``, the two interleaved).
 
-usage: python benchmarks/bench_structure.py [--duration 20] [--rate 1000] [--repeats 5] [--json]
+usage: python benchmarks/bench_structure.py [--duration 20] [--rate 1000] [--stribeck]
+       [--repeats 5] [--json]
 """
 
 from __future__ import annotations
 
+import re
 import sys
 import warnings
 from pathlib import Path
@@ -29,11 +36,16 @@ from common import Case, bench_parser, measure_pair, report  # noqa: E402
 
 import dynid  # noqa: E402
 from dynid.exceptions import DynidWarning  # noqa: E402
-from dynid.friction.model import ClassicalFriction  # noqa: E402
+from dynid.friction.laws import LAWS  # noqa: E402
+from dynid.friction.model import ClassicalFriction, LawFriction  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
 from dynid.identification.selection import identify_recordings  # noqa: E402
 from dynid.identification.structure import candidate_structures  # noqa: E402
-from dynid.simulation.measurement import sample_times, simulate_measurement  # noqa: E402
+from dynid.simulation.measurement import (  # noqa: E402
+    SensorNoise,
+    sample_times,
+    simulate_measurement,
+)
 from dynid.simulation.trajectories import random_fourier  # noqa: E402
 from dynid.simulation.unmodelled import UnmodelledEffects  # noqa: E402
 
@@ -42,23 +54,18 @@ def main(argv: list[str] | None = None) -> int:
     p = bench_parser(__doc__)
     p.add_argument("--duration", type=float, default=20.0, help="log length [s] (default 20)")
     p.add_argument("--rate", type=float, default=1000.0, help="sample rate [Hz] (default 1000)")
+    p.add_argument("--stribeck", action="store_true", help="a Stribeck law per joint instead")
     args = p.parse_args(argv)
     warnings.simplefilter("ignore", DynidWarning)
     robot = dynid.panda()
     t = sample_times(args.duration, args.rate)
-    log = simulate_measurement(
-        robot,
-        random_fourier(robot, np.random.default_rng(1))(t),
-        rng=np.random.default_rng(2),
-        friction=ClassicalFriction(np.linspace(0.3, 0.1, 7), np.zeros(7), np.zeros(7)),
-        effects=UnmodelledEffects(
-            rotor_inertia=np.linspace(0.3, 0.05, 7), torque_offset=np.zeros(7)
-        ),
-    )
+    log = _log(robot, t, args.stribeck)
     chosen = identify_recordings(robot, [log])
     name = (chosen.info.selection or {}).get("chosen")
-    if name != "links + armature + viscous":
-        print(f"structure chosen: {name!r}, simulated: links + armature + viscous", file=sys.stderr)
+    want = "links + armature + viscous"
+    if (name != want) if not args.stribeck else not re.search(r"stribeck:[0-9.]+/", str(name)):
+        want = "a Stribeck law per joint" if args.stribeck else want
+        print(f"structure chosen: {name!r}, simulated: {want}", file=sys.stderr)
         return 1
     ours, ref = measure_pair(
         lambda: identify_recordings(robot, [log]),
@@ -76,8 +83,36 @@ def main(argv: list[str] | None = None) -> int:
             note=f"chosen: {name}",
         )
     ]
-    report("model structure", cases, args, {"duration_s": args.duration, "rate_hz": args.rate})
+    extra = {"duration_s": args.duration, "rate_hz": args.rate, "stribeck": args.stribeck}
+    report("model structure", cases, args, extra)
     return 0
+
+
+def _log(robot: dynid.Robot, t: np.ndarray, stribeck: bool) -> dynid.TorqueLog:
+    """The simulated log: armature and viscous friction, exact; or (``stribeck``) a
+    Stribeck law whose velocity differs per joint, with sensor noise."""
+    trajectory = random_fourier(robot, np.random.default_rng(1))(t)
+    if not stribeck:
+        return simulate_measurement(
+            robot,
+            trajectory,
+            rng=np.random.default_rng(2),
+            friction=ClassicalFriction(np.linspace(0.3, 0.1, 7), np.zeros(7), np.zeros(7)),
+            effects=UnmodelledEffects(
+                rotor_inertia=np.linspace(0.3, 0.05, 7), torque_offset=np.zeros(7)
+            ),
+        )
+    fc = np.linspace(0.8, 0.3, 7)
+    vst = [0.08, 0.08, 0.1, 0.1, 0.1, 0.1, 0.1]
+    P = np.column_stack([np.linspace(0.6, 0.1, 7), fc, 2.0 * fc, vst, np.zeros(7)])
+    return simulate_measurement(
+        robot,
+        trajectory,
+        rng=np.random.default_rng(2),
+        friction=LawFriction(LAWS["stribeck"], P),
+        noise=SensorNoise(tau_std=0.05, q_std=2e-5, dq_std=2e-3),
+        with_ddq=False,
+    )
 
 
 if __name__ == "__main__":

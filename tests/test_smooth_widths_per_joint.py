@@ -101,12 +101,13 @@ def test_per_joint_widths_parse_print_and_collapse():
     [
         ("viscous,smooth:0.3/-1", "positive number"),
         ("viscous,smooth:0.3/x", "positive number"),
-        ("coulomb,stribeck:0.02/0.05", "only smooth takes one per joint"),
+        ("coulomb,stribeck:0.02/0", "positive number"),
+        ("viscous,coulomb:1/2", "only smooth and stribeck take one per joint"),
     ],
 )
 def test_bad_per_joint_widths_are_refused(text, match):
-    """A per-joint width that is not a positive number, or per-joint Stribeck velocities,
-    are refused in one line naming the term."""
+    """A per-joint width or Stribeck velocity that is not a positive number, or per-joint
+    shapes of another term, are refused in one line naming the term."""
     with pytest.raises(OptionError, match=match):
         Structure.parse(text)
 

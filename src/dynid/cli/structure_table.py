@@ -152,13 +152,15 @@ def _best_of_shapes(
 ) -> tuple[set[str], int, int]:
     """The names of the candidates the table shows, how many it leaves out and how many
     of those are ``marked`` (skipped, x): of the candidates that differ only in a shape
-    (``smooth:0.3`` and ``smooth:1``, ``stribeck:0.05`` and ``stribeck:0.1``), the one with
+    (``smooth:0.3`` and ``smooth:1``, ``stribeck:0.05``, ``stribeck:0.1`` and
+    ``stribeck:0.08/0.1/...``, one per joint), the one with
     the lowest held-out error, among those skipped and among the others apart (an iiwa's
     table showed 37 rows marked x of 57, seven shapes each of six laws); every other
     candidate, and the one chosen."""
     best: dict[tuple[str, bool], dict[str, Any]] = {}
     for c in cands:
-        family = re.sub(r"(smooth|stribeck):[0-9.eE+-]+", r"\1:*", str(c["name"]))
+        family = re.sub(r"smooth:[0-9.eE+-]+", "smooth:*", str(c["name"]))
+        family = re.sub(r"stribeck:[0-9.eE+/-]+", "stribeck:*", family)
         key = (family, str(c["name"]) in marked)
         if key not in best or c["heldout_error_percent"] < best[key]["heldout_error_percent"]:
             best[key] = c

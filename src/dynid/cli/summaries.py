@@ -348,11 +348,19 @@ def _shape_line(term: Any, model: IdentifiedModel) -> list[str]:
     shape = "the Stribeck velocity" + (" and the widths" if "smooth" in parts else "")
     return [
         f"  fsp: the Stribeck bump fsp exp(-(dq / vst)^2) times the Coulomb part's sign, vst = "
-        f"{float(term.vst):.3g} rad/s "
+        f"{_vst_text(term.vst)} "
         + ("as given" if given else "chosen on held-out data")
         + f"; the std % hold {shape} fixed at these values (a vst a few % off moves fsp by "
         "more than its std)"
     ]
+
+
+def _vst_text(vst: float | tuple[float, ...]) -> str:
+    """A Stribeck velocity as the summary says it: ``0.1 rad/s``, or one per joint where
+    they differ (``0.08/0.08/0.1/... rad/s (per joint)``, joint 1 first)."""
+    if isinstance(vst, (int, float)):
+        return f"{float(vst):.3g} rad/s"
+    return "/".join(f"{float(v):.3g}" for v in vst) + " rad/s (per joint)"
 
 
 def _coefficient(value: float, std: float, kept: bool, holder: str) -> str:

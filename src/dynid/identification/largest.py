@@ -397,7 +397,7 @@ def _left_out(
 ) -> LeftOut:
     """The shaped candidates of ``mine`` left out of ``group`` (those of ``apart`` judged in
     regressors of their own)."""
-    vst = sorted({c.vst for c in mine if c not in group and c.vst})
+    vst = sorted({c.vst for c in mine if c not in group and isinstance(c.vst, float) and c.vst})
     alone = {c.width for c in apart if isinstance(c.width, float)}
     widths = sorted(
         {

@@ -26,9 +26,9 @@ taken instead, and the parabolas from there reached 18.3.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Generator, Mapping
 
-__all__ = ["MAX_FITS", "TOLERANCE", "refined_shape"]
+__all__ = ["MAX_FITS", "TOLERANCE", "refined_shape", "shape_search"]
 
 #: The fits at new shapes at most.
 MAX_FITS = 3
@@ -73,29 +73,49 @@ def refined_shape(
         ``start`` has no grid neighbour or the parabola points at a shape judged already
         (without ``probe``).
     """
+    tried: list[float] = []
+    search = shape_search(scores, start, max_fits, probe)
+    try:
+        v = next(search)
+        while True:
+            tried.append(v)
+            v = search.send(judged(v))
+    except StopIteration:
+        pass
+    return tuple(tried)
+
+
+def shape_search(
+    scores: Mapping[float, float],
+    start: float,
+    max_fits: int = MAX_FITS,
+    probe: bool = False,
+) -> Generator[float, float | None, None]:
+    """:func:`refined_shape`'s search as a generator: it yields each shape to judge and is
+    sent its held-out error [%] (None: it cannot be judged, the search stops), so that the
+    searches of several joints' shapes advance together, each round's shapes judged in
+    one fit (:mod:`~dynid.identification.stribeck_joints`). Parameters as
+    :func:`refined_shape`."""
     grid = sorted(scores)
     if start not in scores or len(grid) < 2:
-        return ()
+        return
     k = grid.index(start)
     lo, hi = math.log(grid[max(k - 1, 0)]), math.log(grid[min(k + 1, len(grid) - 1)])
     points = {math.log(v): s for v, s in scores.items() if lo <= math.log(v) <= hi}
-    tried: list[float] = []
     for _ in range(max_fits):
         v = _rounded(_next(points))
         x = math.log(v)
         if not lo < x < hi or _near(x, points):  # the parabola ends there
             if not probe:
-                break
+                return
             v = _rounded(_toward_lower(points))
             x = math.log(v)
             if not lo < x < hi or _near(x, points):
-                break
-        tried.append(v)
-        s = judged(v)
+                return
+        s = yield v
         if s is None or not math.isfinite(s):
-            break
+            return
         points[x] = s
-    return tuple(tried)
 
 
 def _rounded(x: float) -> float:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
@@ -58,6 +59,7 @@ __all__ = [
     "smooth_width",
     "smooth_width_grid",
     "structure_terms",
+    "vst_layers",
     "width_key",
     "width_text",
 ]
@@ -133,8 +135,10 @@ class Structure:
         With ``smooth``: its width in multiples of each joint's (motor's) standstill band,
         one for every joint, or one per joint (motor) in order (a tuple whose widths are
         all equal is the one width: ``(3, 3)`` is ``3``).
-    vst : float
-        With ``stribeck``: the Stribeck velocity [rad/s].
+    vst : float or tuple of float
+        With ``stribeck``: the Stribeck velocity [rad/s], one for every joint, or one per
+        joint (motor) in order (a tuple whose velocities are all equal is the one:
+        :mod:`dynid.identification.stribeck_joints` chooses them).
     at : {"", "motor", "joint", "both"}
         Where the friction acts: ``""`` where the drive says (the joints without a drive),
         else at the drive's motors (``K^T f(K dq)``), at the joints (``f(dq)``), or
@@ -159,7 +163,7 @@ class Structure:
     armature: bool = False
     friction: tuple[str, ...] = _CLASSICAL
     width: float | tuple[float, ...] = 0.0
-    vst: float = 0.0
+    vst: float | tuple[float, ...] = 0.0
     at: str = ""
     drop: tuple[str, ...] = ()
     spring: bool = False
@@ -181,7 +185,8 @@ class Structure:
         object.__setattr__(self, "width", _one_or_per_joint(self.width))
         if "smooth" in parts and not self.width:
             object.__setattr__(self, "width", 1.0)
-        if "stribeck" in parts and not self.vst > 0:
+        object.__setattr__(self, "vst", _one_or_per_joint(self.vst, "stribeck"))
+        if "stribeck" in parts and not self.vst:
             object.__setattr__(self, "vst", 0.05)
         if "stribeck" in parts and not {"coulomb", "smooth"} & set(parts):
             parts = tuple(p for p in FRICTION_PARTS if p in parts + ("coulomb",))
@@ -278,6 +283,30 @@ class Structure:
         w[joint] = float(width)
         return replace(self, width=tuple(w))
 
+    def vsts(self, n: int) -> tuple[float, ...]:
+        """The Stribeck velocity [rad/s] of each of ``n`` joints (motors).
+
+        Raises
+        ------
+        OptionError
+            Velocities per joint given for another number of joints.
+        """
+        if isinstance(self.vst, float):
+            return (self.vst,) * n
+        if len(self.vst) != n:
+            raise OptionError(
+                f"--terms stribeck:{width_text(self.vst)}: {len(self.vst)} Stribeck velocities "
+                f"for {n} joints (motors); give one, or one per joint separated by '/'"
+            )
+        return self.vst
+
+    def with_vst(self, joint: int, vst: float, n: int) -> Structure:
+        """The same structure with the Stribeck velocity of ``joint`` (0-based, of ``n``)
+        at ``vst`` [rad/s], the other joints' as they are."""
+        v = list(self.vsts(n))
+        v[joint] = float(vst)
+        return replace(self, vst=tuple(v))
+
     def armature_mask(self, n: int) -> tuple[bool, ...]:
         """Which of the ``n`` rotor inertias the armature holds: all but :attr:`drop`
         (``Ia3``); empty when every one is.
@@ -347,7 +376,10 @@ class Structure:
     @property
     def terms(self) -> tuple[str, ...]:
         """The term names held, e.g. ``("armature", "viscous", "smooth:3")``."""
-        shape = {"smooth": f"smooth:{width_text(self.width)}", "stribeck": f"stribeck:{self.vst:g}"}
+        shape = {
+            "smooth": f"smooth:{width_text(self.width)}",
+            "stribeck": f"stribeck:{width_text(self.vst)}",
+        }
         where = (f"at:{self.at}",) if self.at and self.friction else ()
         return (
             (("armature",) if self.armature else ())
@@ -368,7 +400,8 @@ class Structure:
     def parse(cls, text: str) -> Structure:
         """From ``"armature,viscous,coulomb"`` (``"links"`` or ``""`` for none);
         ``smooth:W`` gives the smooth Coulomb's width in standstill bands (``smooth:W1/W2/..``
-        one per joint or motor), ``stribeck:V`` the Stribeck velocity [rad/s], ``at:joint``
+        one per joint or motor), ``stribeck:V`` the Stribeck velocity [rad/s]
+        (``stribeck:V1/V2/..`` one per joint or motor), ``at:joint``
         or ``at:motor`` where the friction acts; ``spring`` a stiffness per joint.
 
         Raises
@@ -398,7 +431,7 @@ class Structure:
             armature="armature" in names,
             friction=tuple(w for w in names if w not in ("armature", "spring")),
             width=shapes["smooth"] if "smooth" in shapes else 0.0,
-            vst=shapes.get("stribeck", (0.0,))[0],
+            vst=shapes.get("stribeck", 0.0),
             at=at,
             drop=tuple(drop),
             spring="spring" in names,
@@ -407,16 +440,19 @@ class Structure:
 
 def _shape(word: str, name: str, value: str) -> tuple[float, ...]:
     """The shape of the term ``word`` (``smooth:0.3/1``): positive numbers, one or (a
-    smooth width) one per joint separated by ``/``.
+    smooth width, a Stribeck velocity) one per joint separated by ``/``.
 
     Raises
     ------
     OptionError
-        A shape that is not a positive number, or several but of a smooth width.
+        A shape that is not a positive number, or several but of a smooth width or a
+        Stribeck velocity.
     """
     parts = value.split("/")
-    if len(parts) > 1 and name != "smooth":
-        raise OptionError(f"{word}: one shape; only smooth takes one per joint", field="terms")
+    if len(parts) > 1 and name not in ("smooth", "stribeck"):
+        raise OptionError(
+            f"{word}: one shape; only smooth and stribeck take one per joint", field="terms"
+        )
     try:
         out = tuple(float(x) for x in parts)
     except ValueError:
@@ -430,15 +466,17 @@ def _shape(word: str, name: str, value: str) -> tuple[float, ...]:
     return out
 
 
-def _one_or_per_joint(width: float | Sequence[float]) -> float | tuple[float, ...]:
-    """A smooth width as :attr:`Structure.width` holds it: one float, or a tuple of floats
-    when they differ."""
+def _one_or_per_joint(
+    width: float | Sequence[float], name: str = "smooth"
+) -> float | tuple[float, ...]:
+    """A smooth width (a Stribeck velocity, ``name``) as :attr:`Structure.width`
+    (:attr:`Structure.vst`) holds it: one float, or a tuple of floats when they differ."""
     if isinstance(width, (int, float, np.floating, np.integer)):
         return float(width)
     w = tuple(float(x) for x in width)
     if not all(x > 0 and math.isfinite(x) for x in w) or not w:
         raise OptionError(
-            f"smooth:{width_text(w)}: the widths must be positive numbers", field="terms"
+            f"{name}:{width_text(w)}: the shapes must be positive numbers", field="terms"
         )
     return w[0] if len(set(w)) == 1 else w
 
@@ -718,23 +756,32 @@ def largest_terms(
             name=f"friction smooth {w:g}",
         )
         out.append((t, ("smooth", w)))
-    for v in sorted({c.vst for c in mine if _banded_stribeck(c)}):
-        t = LinearFriction(
-            at, ("stribeck",), band=_times(b, gain), vst=v, name=f"friction stribeck {v:g}"
-        )
-        out.append((t, ("stribeck", v)))
-    bumps = {(c.width, c.vst) for c in mine if _smooth_stribeck(c)}
-    for bw, v in sorted(bumps, key=lambda wv: (width_key(wv[0]), wv[1])):
+    for v in vst_layers([c.vsts(n) for c in mine if _banded_stribeck(c)]):
         t = LinearFriction(
             at,
-            ("smooth", "stribeck"),
+            ("stribeck",),
             band=_times(b, gain),
-            width=smooth_width(_times(b, gain), bw),
-            vst=v,
-            name=f"friction smooth {width_text(bw)} stribeck {v:g}",
-            mask=(False, True) * n,  # the bump alone: the smooth Coulomb is the term above
+            vst=_positive(v),
+            name=f"friction stribeck {width_text(v)}",
+            mask=() if isinstance(v, float) else tuple(x > 0 for x in v),
         )
-        out.append((t, ("smooth_stribeck", (bw, v))))
+        out.append((t, ("stribeck", v)))
+    bump_widths = {c.width for c in mine if _smooth_stribeck(c)}
+    for bw in sorted(bump_widths, key=width_key):
+        mine_w = [c.vsts(n) for c in mine if _smooth_stribeck(c) and c.width == bw]
+        for v in vst_layers(mine_w):
+            on = (True,) * n if isinstance(v, float) else tuple(x > 0 for x in v)
+            t = LinearFriction(
+                at,
+                ("smooth", "stribeck"),
+                band=_times(b, gain),
+                width=smooth_width(_times(b, gain), bw),
+                vst=_positive(v),
+                name=f"friction smooth {width_text(bw)} stribeck {width_text(v)}",
+                # the bump alone: the smooth Coulomb is the term above
+                mask=tuple(x for h in on for x in (False, h)),
+            )
+            out.append((t, ("smooth_stribeck", (bw, v))))
     if drop:
         out = [(t if what is None else _without(t, drop), what) for t, what in out]
     return model_drive, out
@@ -791,14 +838,62 @@ def candidate_columns(structure: Structure, model: Any, terms: list[tuple[ModelT
             widths = structure.widths(len(t.labels)) if held else ()
             on = np.array([held and w == shape for w in widths or (0.0,) * len(t.labels)])
         elif kind == "stribeck":
-            on = np.full(len(t.labels), _banded_stribeck(structure) and structure.vst == shape)
+            on = _at_vst(_banded_stribeck(structure), structure, shape, t)
         else:
-            mine = _smooth_stribeck(structure) and (structure.width, structure.vst) == shape
-            on = np.full(len(t.labels), mine)
+            bw, v = shape
+            on = _at_vst(_smooth_stribeck(structure) and structure.width == bw, structure, v, t)
         if structure.drop:
             on &= np.array([lab not in structure.drop for lab in t.labels])
         use.append(on)
     return np.concatenate(use)
+
+
+def _at_vst(
+    held: bool, structure: Structure, layer: float | tuple[float, ...], t: Any
+) -> NDArray[np.bool_]:
+    """Which columns of the Stribeck term ``t`` (of velocities ``layer`` [rad/s], one or
+    one per joint) ``structure`` uses: none unless ``held``, else those of the joints
+    whose Stribeck velocity ``layer`` holds."""
+    n = t.drive.n
+    if not held:
+        return np.zeros(len(t.labels), dtype=bool)
+    mine, theirs = structure.vsts(n), _per_joint(layer, n)
+    return np.array([mine[_joint_of(lab)] == theirs[_joint_of(lab)] for lab in t.labels])
+
+
+def _joint_of(label: str) -> int:
+    """``fsp3`` -> 2: the 0-based joint (motor) of a coefficient's label."""
+    return int(label[len(label.rstrip("0123456789")) :]) - 1
+
+
+def _per_joint(v: float | tuple[float, ...], n: int) -> tuple[float, ...]:
+    """One shape for every of ``n`` joints, or one per joint: one per joint."""
+    return (v,) * n if isinstance(v, float) else v
+
+
+def _positive(v: float | tuple[float, ...]) -> float | tuple[float, ...]:
+    """A layer of :func:`vst_layers` with its empty places (0) at another joint's
+    velocity: the term needs one everywhere, its mask leaves those columns out."""
+    return v if isinstance(v, float) else tuple(x if x > 0 else max(v) for x in v)
+
+
+def vst_layers(vsts: Sequence[tuple[float, ...]]) -> list[float | tuple[float, ...]]:
+    """The Stribeck columns a regressor holds for candidates of Stribeck velocities
+    ``vsts`` [rad/s] (one tuple per candidate, one per joint), as layers of velocities:
+    layer ``k`` holds each joint's ``k``-th velocity (ascending) among the candidates',
+    0 where a joint has fewer (its column left out); one number where every joint's is
+    the same (the grid's laws: one layer per velocity, as many columns as joints). A
+    candidate's columns are those of its own velocity on each joint
+    (:func:`candidate_columns`)."""
+    if not vsts:
+        return []
+    n = len(vsts[0])
+    per = [sorted({v[j] for v in vsts}) for j in range(n)]
+    out: list[float | tuple[float, ...]] = []
+    for k in range(max(len(p) for p in per)):
+        layer = tuple(p[k] if k < len(p) else 0.0 for p in per)
+        out.append(layer[0] if len(set(layer)) == 1 else layer)
+    return out
 
 
 def column_labels(model: Any, terms: list[tuple[ModelTerm, Any]]) -> tuple[str, ...]:

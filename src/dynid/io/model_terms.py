@@ -156,7 +156,7 @@ def older_terms(
         parts=parts,
         band=() if smooth else band,
         width=band if smooth else (),
-        vst=float(np.max(P[:, 3])) if law.endswith("stribeck") else 0.0,
+        vst=_vsts(P[:, 3]) if law.endswith("stribeck") else 0.0,
         mask=() if all(mask) else mask,
     )
     p = len(term.labels)
@@ -165,6 +165,13 @@ def older_terms(
     if len(std) != p or len(kept) != p:
         raise fault(source, "metadata.friction_std", f"expected {p} entries (friction_labels)")
     return {term.name: IdentifiedTerm(term, term.values_of(P), np.array(std), np.array(kept))}
+
+
+def _vsts(v: Any) -> tuple[float, ...]:
+    """The Stribeck velocity [rad/s] of each joint of a law's parameters, a joint left
+    unidentified (0: it never moved) at the largest."""
+    v = np.asarray(v, dtype=np.float64)
+    return tuple(float(x) for x in np.where(v > 0, v, np.max(v)))
 
 
 def _float(x: Any) -> float:

@@ -310,8 +310,9 @@ class LinearFriction:
         it; empty for none (the plain ``sign``).
     width : tuple of float
         The smooth Coulomb's width ``w`` [rad/s] per motor (joint), with ``smooth``.
-    vst : float
-        The Stribeck velocity [rad/s], with ``stribeck``.
+    vst : float or tuple of float
+        The Stribeck velocity [rad/s], with ``stribeck``: one for every motor (joint), or
+        one per motor (joint) in order (a tuple whose velocities are all equal is the one).
     name : str
         The term's name (``"friction"``; another for a second friction term of a model).
     mask : tuple of bool
@@ -327,7 +328,7 @@ class LinearFriction:
     parts: tuple[str, ...] = ("viscous", "coulomb", "offset")
     band: tuple[float, ...] = ()
     width: tuple[float, ...] = ()
-    vst: float = 0.0
+    vst: float | tuple[float, ...] = 0.0
     name: str = "friction"
     in_base: bool = False
     mask: tuple[bool, ...] = ()
@@ -348,7 +349,12 @@ class LinearFriction:
                 raise OptionError(f"{key} must have {self.drive.n} entries; got {len(v)}")
         if "smooth" in self.parts and not self.width:
             raise OptionError("the smooth Coulomb part needs its width (one per joint)")
-        if "stribeck" in self.parts and not self.vst > 0:
+        if not isinstance(self.vst, float):
+            v = tuple(float(x) for x in np.ravel(self.vst))
+            if len(v) != self.drive.n and len(v) != 1:
+                raise OptionError(f"vst must have 1 or {self.drive.n} entries; got {len(v)}")
+            object.__setattr__(self, "vst", v[0] if len(set(v)) == 1 else v)
+        if "stribeck" in self.parts and not min(self.vsts) > 0:
             raise OptionError(f"the Stribeck part needs a Stribeck velocity > 0; got {self.vst}")
         order = tuple(p for p in FRICTION_PARTS if p in self.parts)
         if self.mask:
@@ -360,6 +366,13 @@ class LinearFriction:
             index = [self.parts.index(p) for p in order]  # the mask in the parts' order
             object.__setattr__(self, "mask", tuple(bool(x) for x in grid[:, index].ravel()))
         object.__setattr__(self, "parts", order)
+
+    @property
+    def vsts(self) -> tuple[float, ...]:
+        """The Stribeck velocity [rad/s] of each motor (joint)."""
+        if isinstance(self.vst, float):
+            return (self.vst,) * self.drive.n
+        return self.vst
 
     @property
     def _held(self) -> NDArray[np.bool_]:
@@ -458,7 +471,7 @@ class LinearFriction:
             "quadratic": lambda: v * np.abs(v),
             "coulomb": lambda: standstill_sign(v, band),
             "smooth": lambda: smooth_sign(v, np.asarray(self.width)),
-            "stribeck": lambda: sign() * stribeck_decay(v, self.vst),
+            "stribeck": lambda: sign() * stribeck_decay(v, np.asarray(self.vsts)),
             "offset": lambda: np.ones_like(v),
         }
         return np.stack([col[p]() for p in self.parts], axis=-1)
@@ -490,7 +503,7 @@ class LinearFriction:
         z = np.zeros(n)
         fc = c.get("coulomb", c.get("smooth", z))
         if "stribeck" in self.parts:
-            cols = [c.get("viscous", z), fc, fc + c["stribeck"], np.full(n, self.vst)]
+            cols = [c.get("viscous", z), fc, fc + c["stribeck"], np.array(self.vsts)]
             return np.column_stack(cols + [c.get("offset", z)])
         if self.law == "quadratic":
             return np.column_stack([c.get("viscous", z), c["quadratic"], fc, c.get("offset", z)])
@@ -562,13 +575,14 @@ class LinearFriction:
         return None
 
     def definition(self) -> dict[str, Any]:
-        """``parts``, ``band``, ``width``, ``vst``, ``mask``, ``at`` (``"motor"`` or
-        ``"joint"``: where it acts) and ``prefix``."""
+        """``parts``, ``band``, ``width``, ``vst`` (one number, or a list of one per motor
+        or joint), ``mask``, ``at`` (``"motor"`` or ``"joint"``: where it acts) and
+        ``prefix``."""
         return {
             "parts": list(self.parts),
             "band": list(self.band),
             "width": list(self.width),
-            "vst": self.vst,
+            "vst": self.vst if isinstance(self.vst, float) else list(self.vst),
             "mask": list(self.mask),
             "at": self.drive.friction_place,
             "prefix": self.prefix,
@@ -589,11 +603,19 @@ class LinearFriction:
             parts=tuple(str(p) for p in d.get("parts", ("viscous", "coulomb", "offset"))),
             band=tuple(float(x) for x in d.get("band", ())),
             width=tuple(float(x) for x in d.get("width", ())),
-            vst=float(d.get("vst", 0.0)),
+            vst=_vst_of(d.get("vst", 0.0)),
             name=name,
             mask=tuple(bool(x) for x in d.get("mask", ())),
             prefix=str(d.get("prefix", "")),
         )
+
+
+def _vst_of(value: Any) -> float | tuple[float, ...]:
+    """A Stribeck velocity [rad/s] as a file holds it: one number (every file before the
+    velocity per joint), or a list of one per motor (joint)."""
+    if isinstance(value, (list, tuple)):
+        return tuple(float(x) for x in value)
+    return float(value)
 
 
 def drive_terms(drive: Drive | None, n: int, *, friction: bool = True) -> tuple[ModelTerm, ...]:
