@@ -414,3 +414,21 @@ def test_payload_static_data_stay_one_file(tmp_path):
         )
     with pytest.raises(DataError, match=r"s1.csv holds static data: give one static data file"):
         identify_payload_files(panda, [tmp_path / "s1.csv", tmp_path / "s2.csv"])
+
+
+def test_recordings_at_other_rates_say_each_rate(panda, files, tmp_path, capsys):
+    """A recording at 125 Hz (a UR's RTDE default) beside one at 500 Hz: each line of the
+    summary says its rate and the record holds each one's (the identification's
+    metadata kept the first file's alone)."""
+    slow = _recording(panda, 5, "robot", cut=None)
+    save_torque_log(tmp_path / "slow.csv", slow.select(np.arange(slow.t.size) % 4 == 0))
+    argv = ["identify", "--data", str(files / "rec1.csv"), str(tmp_path / "slow.csv")]
+    assert (
+        main([*argv, "--terms", "viscous,coulomb", "--out", str(tmp_path / "id"), "--no-figures"])
+        == 0
+    )
+    out = capsys.readouterr().out
+    assert re.search(r"recording rec1\.csv: .*, at 500 Hz", out), out
+    assert re.search(r"recording slow\.csv: .*, at 125 Hz", out), out
+    recs = json.loads((tmp_path / "id" / "identification.json").read_text())["metadata"]
+    assert [r["sample_rate_hz"] for r in recs["recordings"]] == pytest.approx([500.0, 125.0])

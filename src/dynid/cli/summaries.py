@@ -379,18 +379,21 @@ _LEFT_OUT = "left out of the fit (outlying; --keep-outlying fits it): "
 
 def recordings_lines(recordings: Any) -> list[str]:
     """One line per recording when there are several or one was cut into pieces, with
-    where each was cut (the time stamp before each gap and its length); a recording left
-    out of the fit as outlying (``left_out``) says so."""
+    where each was cut (the time stamp before each gap and its length), each one's rate
+    where they differ; a recording left out of the fit as outlying (``left_out``) says
+    so."""
     recs = list(recordings or ())
     if len(recs) < 2 and all(r.get("pieces", 1) == 1 for r in recs):
         return []
     each = len(_decimations(recs)) > 1  # recordings at other rates: each its own
+    rates = {round(float(r["sample_rate_hz"]), 3) for r in recs if "sample_rate_hz" in r}
     return [
         f"recording {r['file']}: "
         + (_LEFT_OUT if r.get("left_out") else "")
         + f"{r['pieces']} piece(s), {r['samples']} samples "
         + ("prepared " if r.get("left_out") else "used ")
         + f"({r['duration_s']:.4g} s"
+        + (f", at {r['sample_rate_hz']:.4g} Hz" if len(rates) > 1 else "")
         + (f", 1 in {r['decimate']}" if each else "")
         + ")"
         + _gaps(r)

@@ -390,10 +390,10 @@ class Recordings(TorqueRoute):
     def summary(self) -> tuple[dict[str, Any], ...]:
         """Per recording: ``file``, ``pieces``, ``samples`` used and ``duration_s`` used,
         ``decimate`` (every k-th sample kept: at its own rate, 10 times the cut-off or
-        more), the ``gaps`` it was cut at (``[t_before, length]`` [s] each, when any,
-        with ``start_s``, the recording's first time stamp [s]), where the others went
-        (:meth:`SampleCounts.as_dict`) when counted, and the ``sha256`` of its samples as
-        read when taken (:attr:`digests`)."""
+        more), ``sample_rate_hz`` (its rate as recorded [Hz]), the ``gaps`` it was cut at
+        (``[t_before, length]`` [s] each, when any, with ``start_s``, the recording's
+        first time stamp [s]), where the others went (:meth:`SampleCounts.as_dict`) when
+        counted, and the ``sha256`` of its samples as read when taken (:attr:`digests`)."""
         out = []
         for r, name in enumerate(self.names):
             mine = [p for p, k in zip(self.pieces, self.recording, strict=True) if k == r]
@@ -403,6 +403,7 @@ class Recordings(TorqueRoute):
                 "samples": sum(p.log.n_samples for p in mine),
                 "duration_s": float(sum(p.log.duration for p in mine)),
                 "decimate": max(p.decimate for p in mine),
+                "sample_rate_hz": float(mine[0].sample_rate_hz),
             }
             gaps = self.gaps[r] if r < len(self.gaps) else ()
             start = self.starts[r] if r < len(self.starts) else None
