@@ -98,15 +98,19 @@ def test_a_descriptions_friction_stays_at_the_joints_unless_the_drive_file_says_
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         mjcf = load_mjcf(path)
-        urdf = load_urdf(export_urdf(tmp_path / "arm.urdf", mjcf, ExportOptions(friction=True)))
+        hard = mjcf.with_friction(ClassicalFriction(fv, fc, np.zeros(2)))  # the law given
+        urdf = load_urdf(export_urdf(tmp_path / "arm.urdf", hard, ExportOptions(friction=True)))
     dq = np.array([[0.3, -0.2], [-0.05, 0.4]])
     for robot in (mjcf, urdf):
         placed = robot_friction(robot, _drive())
-        np.testing.assert_allclose(placed.torques(dq), fv * dq + fc * np.sign(dq), atol=1e-12)
+        # MJCF: MuJoCo's frictionloss is read as the ramp it applies (a smooth law about
+        # 1e-3 rad/s wide at its default solreffriction), saturated at these speeds
+        tol = 1e-4 if robot is mjcf else 1e-12
+        np.testing.assert_allclose(placed.torques(dq), fv * dq + fc * np.sign(dq), rtol=tol)
         assert own_at_motors_note(robot, _drive()) is None
         moved = robot_friction(robot, _drive(friction_at="motor"))
         v = dq * GEARS
-        np.testing.assert_allclose(moved.torques(dq), GEARS * (fv * v + fc * np.sign(v)))
+        np.testing.assert_allclose(moved.torques(dq), GEARS * (fv * v + fc * np.sign(v)), rtol=tol)
         said = own_at_motors_note(robot, _drive(friction_at="motor"))
         assert said is not None and 'friction_at = "motor"' in said and "\n" not in said
 
@@ -139,8 +143,10 @@ def test_an_export_of_motor_friction_read_back_with_its_drive_file_validates_at_
             errors[name] = validate_files(robot, csv, opts).validation.errors
         wrong = dataclasses.replace(drive, friction_at="motor")
         moved = validate_files(load_mjcf(xml), csv, dataclasses.replace(opts, drive=wrong))
-    for name, e in errors.items():
-        assert abs(e.relative_error_percent - truth) < 1e-6, (name, e, truth)
+    # the URDF holds the law exactly; the MJCF the ramp MuJoCo applies in its place (read
+    # back as that ramp), within 1 % of the law's error
+    assert abs(errors["urdf"].relative_error_percent - truth) < 1e-6, (errors["urdf"], truth)
+    assert abs(errors["mjcf"].relative_error_percent - truth) < 0.01 * truth, (errors, truth)
     assert moved.validation.errors.relative_error_percent > 100 * truth
 
 
