@@ -58,6 +58,7 @@ import re
 import warnings
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any, Literal, TypeVar
 
 import numpy as np
@@ -124,6 +125,7 @@ from .outlying_spans import Span
 from .recordings import Recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
+from .spring_candidate import with_spring
 from .structural import absorbed_by
 from .structure import (
     Structure,
@@ -1072,6 +1074,7 @@ def identify_recordings(
     base: BaseParameters | None = None,
     torque_delay_s: float = 0.0,
     keep_outlying: bool = False,
+    spring_joints: Sequence[int] = (),
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
@@ -1123,6 +1126,10 @@ def identify_recordings(
     keep_outlying : bool
         Fit the recordings found outlying (structure chosen or given) and the bursts of one
         or two whole (default: left out or cut, in their ``info.recordings`` entry, warned).
+    spring_joints : sequence of int
+        With the structure chosen: the joints (0-based) whose spring a held-out residual
+        names; a spring on them is judged as a candidate on the same folds
+        (:func:`~.spring_candidate.with_spring`). Default none.
 
     Returns
     -------
@@ -1151,6 +1158,13 @@ def identify_recordings(
         robot, logs, data, validation, validate_on, drive, friction, keep_outlying, structure,
         exact, estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
     )  # fmt: skip
+    if spring_joints and selection is not None:  # a spring the held-out residual names
+        again = partial(
+            select_structure, robot, fitted, drive=drive, estimator=est or OLS(), folds=folds,
+            validation=validation, rtol=rtol, keep=True,
+        )  # fmt: skip
+        selection = with_spring(selection, spring_joints, robot.n, drive, again)
+        structure = _fitted_structure(robot, fitted, selection, friction)
     kw: dict[str, Any] = dict(std=std, base=base, rtol=rtol, max_std_percent=max_std_percent)
     kw["advise"] = False  # the final fit's advice alone (_warned), not the fits before it
     model, terms, fitted, odd, given = _fitted_chosen(
