@@ -1087,12 +1087,11 @@ def identify_recordings(
     ----------
     robot : Robot
         Kinematics and gravity; its inertial parameters are not used.
-    logs : sequence of TorqueLog
-        The recordings.
-    names : sequence of str, optional
-        Their names (file names) for messages and the record.
+    logs, names : sequence of TorqueLog, sequence of str (optional)
+        The recordings, and their names (file names) for messages and the record.
     structure : Structure or "auto"
-        The terms beside the links; ``"auto"`` (default) chooses them on held-out data.
+        The terms beside the links; ``"auto"`` (default) chooses them on held-out data,
+        a spring on ``spring_joints`` (0-based) judged too (:mod:`.spring_candidate`).
     cutoff_hz : float, "auto" or None
         Zero-phase low-pass cut-off [Hz] of every recording; ``"auto"`` (default) read from
         their motion (:func:`~.trim.common_cutoff`), none for logs exact to round-off;
@@ -1126,10 +1125,6 @@ def identify_recordings(
     keep_outlying : bool
         Fit the recordings found outlying (structure chosen or given) and the bursts of one
         or two whole (default: left out or cut, in their ``info.recordings`` entry, warned).
-    spring_joints : sequence of int
-        With the structure chosen: the joints (0-based) whose spring a held-out residual
-        names; a spring on them is judged as a candidate on the same folds
-        (:func:`~.spring_candidate.with_spring`). Default none.
 
     Returns
     -------
@@ -1156,15 +1151,8 @@ def identify_recordings(
     est = None if estimator == "auto" else estimator_named(estimator)  # None: chosen
     selection, structure, fitted, validation, gone = _choose(
         robot, logs, data, validation, validate_on, drive, friction, keep_outlying, structure,
-        exact, estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
+        exact, estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep, spring=spring_joints,
     )  # fmt: skip
-    if spring_joints and selection is not None:  # a spring the held-out residual names
-        again = partial(
-            select_structure, robot, fitted, drive=drive, estimator=est or OLS(), folds=folds,
-            validation=validation, rtol=rtol, keep=True,
-        )  # fmt: skip
-        selection = with_spring(selection, spring_joints, robot.n, drive, again)
-        structure = _fitted_structure(robot, fitted, selection, friction)
     kw: dict[str, Any] = dict(std=std, base=base, rtol=rtol, max_std_percent=max_std_percent)
     kw["advise"] = False  # the final fit's advice alone (_warned), not the fits before it
     model, terms, fitted, odd, given = _fitted_chosen(
@@ -1304,6 +1292,7 @@ def _choose(
     folds: int,
     rtol: float | None,
     prep: dict[str, Any],
+    spring: Sequence[int] = (),
 ) -> tuple[Selection | None, Structure, Recordings, Recordings | None, _Gone]:
     """The structure chosen on ``data`` (:func:`select_structure`, the notes ``exact``
     first) and fitted with ``friction``, and the recordings it is fitted on: with
@@ -1311,7 +1300,8 @@ def _choose(
     prepared alone, those whose spans are cut out with them (:func:`_chosen_without`);
     returns the selection, the structure, the recordings fitted, the separate validation
     prepared as they are, and the outlying ones (:data:`_Gone`). A structure ``given``
-    (not ``"auto"``): no selection, it and ``data`` as they are."""
+    (not ``"auto"``): no selection, it and ``data`` as they are. With ``spring`` (joints,
+    0-based), a spring on them judged against the choice (:mod:`.spring_candidate`)."""
     if given != "auto":
         return None, given, data, validation, {}
     selection = select_structure(
@@ -1321,13 +1311,19 @@ def _choose(
     selection = selection and replace(selection, notes=(*exact, *selection.notes))
     structure = _fitted_structure(robot, data, selection, friction)
     gone = {} if selection is None or keep_outlying else _outlying(data, selection)
-    if not gone or selection is None:
-        return selection, structure, data, validation, {}
-    fitted, validation, chosen, structure = _chosen_without(
-        robot, logs, data, gone, selection, validate_on, drive, friction,
-        estimator=estimator, folds=folds, rtol=rtol, **prep,
-    )  # fmt: skip
-    return chosen, structure, fitted, validation, gone
+    if gone and selection is not None:
+        data, validation, selection, structure = _chosen_without(
+            robot, logs, data, gone, selection, validate_on, drive, friction,
+            estimator=estimator, folds=folds, rtol=rtol, **prep,
+        )  # fmt: skip
+    if spring and selection is not None:  # a spring the held-out residual names
+        again = partial(
+            select_structure, robot, data, drive=drive, estimator=estimator, folds=folds,
+            validation=validation, rtol=rtol, keep=True,
+        )  # fmt: skip
+        selection = with_spring(selection, spring, robot.n, drive, again)
+        structure = _fitted_structure(robot, data, selection, friction)
+    return selection, structure, data, validation, gone
 
 
 def _chosen_without(
