@@ -70,6 +70,7 @@ def test_a_spring_the_residual_names_is_chosen_and_recovered():
     err = held.validation.errors.relative_error_percent
     assert err < 1.1 * held.noise_floor_percent, (err, held.noise_floor_percent)
     assert any("spring" in c["name"] for c in model.info.selection["candidates"])
+    assert any(n.startswith("a spring on joint(s) 2") for n in model.info.selection["notes"])
 
 
 @pytest.mark.parametrize("added", [None, _bump], ids=["no spring", "stribeck bump"])
@@ -109,6 +110,8 @@ def test_the_spring_is_kept_only_beyond_one_standard_error(spring_folds, kept):
     assert (out.chosen == sprung) is kept
     assert {c.structure for c in out.candidates} == {plain, sprung}
     assert dict(out.spring)["chosen"] is kept
+    said = "chosen;" if kept else "not chosen (within one standard error)"
+    assert any(n.startswith("a spring on joint(s) 2") and said in n for n in out.notes)
 
 
 def test_a_spring_on_some_joints_has_their_columns_alone():

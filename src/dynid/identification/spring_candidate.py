@@ -54,6 +54,22 @@ def _against_best(cands: Sequence[Candidate]) -> tuple[Candidate, ...]:
     return tuple(replace(c, se_vs_best_percent=paired_se(c, best)) for c in cands)
 
 
+def _note(record: dict[str, Any], plain: Candidate, sprung: Candidate) -> str:
+    """The trial in words: the joints (from 1), the two choices' held-out errors [%] and
+    the difference in standard errors."""
+    se = float(record["se_vs_spring_percent"])
+    gap = plain.score - sprung.score
+    apart = f"{gap / se:.1f} standard errors" if se > 0 else "no standard error"
+    joints = ", ".join(str(j) for j in record["joints"])
+    how = "chosen" if record["chosen"] else "not chosen (within one standard error)"
+    with_it, without = sprung.heldout_error_percent, plain.heldout_error_percent
+    return (
+        f"a spring on joint(s) {joints}, which the held-out residual of the choice without "
+        f"one names, judged on the same folds: {how}; held out {with_it:.3g} % against "
+        f"{without:.3g} % without it ({apart} apart)"
+    )
+
+
 def with_spring(
     first: Selection,
     joints: Sequence[int],
@@ -87,12 +103,15 @@ def with_spring(
         "chosen": kept,
     }
     spring = tuple(record.items())
+    note = _note(record, plain, sprung)
     if not kept:  # the spring's choice shown beside the others
-        return replace(first, candidates=_against_best([*first.candidates, sprung]), spring=spring)
+        cands = _against_best([*first.candidates, sprung])
+        return replace(first, candidates=cands, notes=(*first.notes, note), spring=spring)
+    mine = tuple(f"with the spring: {m}" for m in second.notes if m not in first.notes)
     return replace(
         second,
         candidates=_against_best([*first.candidates, *second.candidates]),
-        notes=(*first.notes, *(m for m in second.notes if m not in first.notes)),
+        notes=(*first.notes, *mine, note),
         outlying=first.outlying,
         cut=first.cut,
         spring=spring,
