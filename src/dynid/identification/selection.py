@@ -125,7 +125,7 @@ from .outlying_spans import Span
 from .recordings import Recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
-from .spring_candidate import with_spring
+from .spring_candidate import tried_joints, with_spring
 from .structural import absorbed_by
 from .structure import (
     Structure,
@@ -1230,10 +1230,16 @@ def _cut_refit(
     are, the record of a structure given, the model and its terms."""
     cut = tuple((data.names[k], c) for k, c in cuts.items())
     if selection is not None:
+        joints = tried_joints(selection)  # a spring tried before the cut: tried again
         fitted, validation, selection, structure = _chosen_without(
             robot, logs, data, cuts, replace(selection, cut=cut), validate_on, drive,
             friction, estimator=estimator or OLS(), folds=folds, rtol=kw.get("rtol"), **prep,
         )  # fmt: skip
+        if joints:
+            sel = (selection, joints, estimator or OLS(), folds, kw.get("rtol"))
+            selection, structure = _spring_searched(
+                robot, fitted, validation, drive, friction, *sel
+            )
     else:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # said when all were prepared
@@ -1317,13 +1323,32 @@ def _choose(
             estimator=estimator, folds=folds, rtol=rtol, **prep,
         )  # fmt: skip
     if spring and selection is not None:  # a spring the held-out residual names
-        again = partial(
-            select_structure, robot, data, drive=drive, estimator=estimator, folds=folds,
-            validation=validation, rtol=rtol, keep=True,
-        )  # fmt: skip
-        selection = with_spring(selection, spring, robot.n, drive, again)
-        structure = _fitted_structure(robot, data, selection, friction)
+        sel = (selection, spring, estimator, folds, rtol)
+        selection, structure = _spring_searched(robot, data, validation, drive, friction, *sel)
     return selection, structure, data, validation, gone
+
+
+def _spring_searched(
+    robot: Robot,
+    data: Recordings,
+    validation: Recordings | None,
+    drive: Drive | None,
+    friction: tuple[str, ...] | None,
+    selection: Selection,
+    joints: Sequence[int],
+    estimator: Estimator,
+    folds: int,
+    rtol: float | None,
+) -> tuple[Selection, Structure]:
+    """``selection`` judged against the search with a spring on ``joints`` (0-based) on
+    the same recordings and folds (:func:`~.spring_candidate.with_spring`), and the
+    structure it keeps, fitted with ``friction`` (:func:`_fitted_structure`)."""
+    again = partial(
+        select_structure, robot, data, drive=drive, estimator=estimator, folds=folds,
+        validation=validation, rtol=rtol, keep=True,
+    )  # fmt: skip
+    selection = with_spring(selection, joints, robot.n, drive, again)
+    return selection, _fitted_structure(robot, data, selection, friction)
 
 
 def _chosen_without(

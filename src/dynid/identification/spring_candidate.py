@@ -30,7 +30,7 @@ from ..regressors.spring import SPRING_LABEL
 from .candidates import Candidate, Selection, paired_se, within_best
 from .structure import Structure, candidate_structures, friction_placements
 
-__all__ = ["spring_structures", "with_spring"]
+__all__ = ["spring_structures", "tried_joints", "with_spring"]
 
 
 def spring_structures(
@@ -40,6 +40,12 @@ def spring_structures(
     other joint (their stiffnesses left out: ``-k1``)."""
     others = tuple(f"{SPRING_LABEL}{j + 1}" for j in range(n) if j not in joints)
     return tuple(replace(s, spring=True, drop=s.drop + others) for s in structures)
+
+
+def tried_joints(selection: Selection) -> tuple[int, ...]:
+    """The joints (0-based) of the spring ``selection`` tried (:func:`with_spring`); empty
+    when it tried none."""
+    return tuple(int(j) - 1 for j in dict(selection.spring).get("joints", ()))
 
 
 def _chosen_candidate(selection: Selection) -> Candidate | None:
