@@ -285,6 +285,10 @@ class Selection:
         The outlying recordings whose residual stands off in short spans, each with the
         intervals [s] cut out of it for the final fit (the spans with the filter's edge
         beside them) in place of leaving it out whole.
+    spring : tuple of (str, Any)
+        The spring candidate tried where the chosen structure's held-out residual names a
+        joint spring (:mod:`~dynid.identification.spring_candidate`): its joints, the
+        structure, its held-out error and whether it was chosen; empty when none was tried.
     """
 
     candidates: tuple[Candidate, ...]
@@ -296,6 +300,7 @@ class Selection:
     outlying: tuple[str, ...] = ()
     determined: tuple[tuple[str, float], ...] = ()
     cut: tuple[tuple[str, tuple[tuple[float, float], ...]], ...] = ()
+    spring: tuple[tuple[str, Any], ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready (``identification.json``'s ``metadata.selection``)."""
@@ -313,7 +318,7 @@ class Selection:
                 {"coefficient": lab, "std_percent": r} for lab, r in self.determined
             ],
             "cut_out_spans": cut_record(self.cut),
-        }
+        } | ({"spring_candidate": dict(self.spring)} if self.spring else {})
 
 
 def cut_record(

@@ -39,7 +39,14 @@ from .structure import (
     width_text,
 )
 
-__all__ = ["Fitted", "LeftOut", "SMOOTH_THINNING", "fit_largest", "recording_bands"]
+__all__ = [
+    "Fitted",
+    "LeftOut",
+    "SMOOTH_THINNING",
+    "fit_largest",
+    "limits_middle",
+    "recording_bands",
+]
 
 #: A regressor fitted with the held-out judge: its family (the third item of
 #: :func:`~dynid.identification.structure.regressor_group`, ``smooth:W`` for a width
@@ -50,6 +57,16 @@ Fitted = tuple[str, IdentifiedModel, list[tuple[ModelTerm, Any]], list[Structure
 def recording_bands(data: Recordings) -> dict[str, tuple[float, ...]]:
     """The standstill bands at a drive's motors and joints, as tuples."""
     return {at: tuple(float(x) for x in b) for at, b in data.bands.items()}
+
+
+def limits_middle(robot: Robot) -> tuple[float, ...]:
+    """The middle of each joint's limits [rad], zero for a joint without finite limits: a
+    spring's rest position, whose true value the offset absorbs."""
+    lo, hi = np.asarray(robot.q_min, dtype=np.float64), np.asarray(robot.q_max, dtype=np.float64)
+    finite = np.isfinite(lo) & np.isfinite(hi)  # a continuous joint: -inf .. inf
+    mid = np.zeros(lo.shape)
+    mid[finite] = (lo[finite] + hi[finite]) / 2
+    return tuple(float(x) for x in mid)
 
 
 def fit_largest(
@@ -164,8 +181,9 @@ def _fit_group(
         The data do not identify those columns.
     """
     model_drive, terms = largest_terms(
-        group, arm, drive, robot.n, tuple(data.band), recording_bands(data), data.band_gain, drop
-    )
+        group, arm, drive, robot.n, tuple(data.band), recording_bands(data), data.band_gain, drop,
+        limits_middle(robot),
+    )  # fmt: skip
     with warnings.catch_warnings():  # the candidates' fits: only the chosen one speaks
         warnings.simplefilter("ignore", DynidWarning)
         model = identify(

@@ -59,6 +59,7 @@ import re
 import warnings
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any, Literal, TypeVar
 
 import numpy as np
@@ -126,6 +127,7 @@ from .outlying_spans import Span
 from .recordings import Recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
+from .spring_candidate import tried_joints, with_spring
 from .stribeck_joints import per_joint_vst
 from .structural import absorbed_by
 from .structure import (
@@ -1133,6 +1135,7 @@ def identify_recordings(
     base: BaseParameters | None = None,
     torque_delay_s: float = 0.0,
     keep_outlying: bool = False,
+    spring_joints: Sequence[int] = (),
 ) -> IdentifiedModel:
     """Identify the base parameters and the model's terms from one or more torque logs.
 
@@ -1145,12 +1148,11 @@ def identify_recordings(
     ----------
     robot : Robot
         Kinematics and gravity; its inertial parameters are not used.
-    logs : sequence of TorqueLog
-        The recordings.
-    names : sequence of str, optional
-        Their names (file names) for messages and the record.
+    logs, names : sequence of TorqueLog, sequence of str (optional)
+        The recordings, and their names (file names) for messages and the record.
     structure : Structure or "auto"
-        The terms beside the links; ``"auto"`` (default) chooses them on held-out data.
+        The terms beside the links; ``"auto"`` (default) chooses them on held-out data,
+        a spring on ``spring_joints`` (0-based) judged too (:mod:`.spring_candidate`).
     cutoff_hz : float, "auto" or None
         Zero-phase low-pass cut-off [Hz] of every recording; ``"auto"`` (default) read from
         their motion (:func:`~.trim.common_cutoff`), none for logs exact to round-off;
@@ -1210,7 +1212,7 @@ def identify_recordings(
     est = None if estimator == "auto" else estimator_named(estimator)  # None: chosen
     selection, structure, fitted, validation, gone = _choose(
         robot, logs, data, validation, validate_on, drive, friction, keep_outlying, structure,
-        exact, estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep,
+        exact, estimator=est or OLS(), folds=folds, rtol=rtol, prep=prep, spring=spring_joints,
     )  # fmt: skip
     kw: dict[str, Any] = dict(std=std, base=base, rtol=rtol, max_std_percent=max_std_percent)
     kw["advise"] = False  # the final fit's advice alone (_warned), not the fits before it
@@ -1289,10 +1291,16 @@ def _cut_refit(
     are, the record of a structure given, the model and its terms."""
     cut = tuple((data.names[k], c) for k, c in cuts.items())
     if selection is not None:
+        joints = tried_joints(selection)  # a spring tried before the cut: tried again
         fitted, validation, selection, structure = _chosen_without(
             robot, logs, data, cuts, replace(selection, cut=cut), validate_on, drive,
             friction, estimator=estimator or OLS(), folds=folds, rtol=kw.get("rtol"), **prep,
         )  # fmt: skip
+        if joints:
+            sel = (selection, joints, estimator or OLS(), folds, kw.get("rtol"))
+            selection, structure = _spring_searched(
+                robot, fitted, validation, drive, friction, *sel
+            )
     else:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # said when all were prepared
@@ -1351,6 +1359,7 @@ def _choose(
     folds: int,
     rtol: float | None,
     prep: dict[str, Any],
+    spring: Sequence[int] = (),
 ) -> tuple[Selection | None, Structure, Recordings, Recordings | None, _Gone]:
     """The structure chosen on ``data`` (:func:`select_structure`, the notes ``exact``
     first) and fitted with ``friction``, and the recordings it is fitted on: with
@@ -1358,7 +1367,8 @@ def _choose(
     prepared alone, those whose spans are cut out with them (:func:`_chosen_without`);
     returns the selection, the structure, the recordings fitted, the separate validation
     prepared as they are, and the outlying ones (:data:`_Gone`). A structure ``given``
-    (not ``"auto"``): no selection, it and ``data`` as they are."""
+    (not ``"auto"``): no selection, it and ``data`` as they are. With ``spring`` (joints,
+    0-based), a spring on them judged against the choice (:mod:`.spring_candidate`)."""
     if given != "auto":
         return None, given, data, validation, {}
     selection = select_structure(
@@ -1368,13 +1378,38 @@ def _choose(
     selection = selection and replace(selection, notes=(*exact, *selection.notes))
     structure = _fitted_structure(robot, data, selection, friction)
     gone = {} if selection is None or keep_outlying else _outlying(data, selection)
-    if not gone or selection is None:
-        return selection, structure, data, validation, {}
-    fitted, validation, chosen, structure = _chosen_without(
-        robot, logs, data, gone, selection, validate_on, drive, friction,
-        estimator=estimator, folds=folds, rtol=rtol, **prep,
+    if gone and selection is not None:
+        data, validation, selection, structure = _chosen_without(
+            robot, logs, data, gone, selection, validate_on, drive, friction,
+            estimator=estimator, folds=folds, rtol=rtol, **prep,
+        )  # fmt: skip
+    if spring and selection is not None:  # a spring the held-out residual names
+        sel = (selection, spring, estimator, folds, rtol)
+        selection, structure = _spring_searched(robot, data, validation, drive, friction, *sel)
+    return selection, structure, data, validation, gone
+
+
+def _spring_searched(
+    robot: Robot,
+    data: Recordings,
+    validation: Recordings | None,
+    drive: Drive | None,
+    friction: tuple[str, ...] | None,
+    selection: Selection,
+    joints: Sequence[int],
+    estimator: Estimator,
+    folds: int,
+    rtol: float | None,
+) -> tuple[Selection, Structure]:
+    """``selection`` judged against the search with a spring on ``joints`` (0-based) on
+    the same recordings and folds (:func:`~.spring_candidate.with_spring`), and the
+    structure it keeps, fitted with ``friction`` (:func:`_fitted_structure`)."""
+    again = partial(
+        select_structure, robot, data, drive=drive, estimator=estimator, folds=folds,
+        validation=validation, rtol=rtol, keep=True,
     )  # fmt: skip
-    return chosen, structure, fitted, validation, gone
+    selection = with_spring(selection, joints, robot.n, drive, again)
+    return selection, _fitted_structure(robot, data, selection, friction)
 
 
 def _chosen_without(

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import OptionError
 from ..model.drive import Drive
-from ..regressors.spring import JointSpring
+from ..regressors.spring import SPRING_LABEL, JointSpring, spring_mask
 from ..regressors.terms import (
     FRICTION_PARTS,
     PART_LABELS,
@@ -198,6 +198,8 @@ class Structure:
             held |= {JOINT_PREFIX + PART_LABELS[p] for p in self.joint_parts}
         if self.armature:
             held.add(ARMATURE_LABEL)
+        if self.spring:  # a joint's spring left out: -k3
+            held.add(SPRING_LABEL)
         drops = [ARMATURE_LABEL + d[2:] if d.lower().startswith("ia") else d for d in self.drop]
         object.__setattr__(self, "drop", tuple(drops))
         for lab in self.drop:
@@ -620,7 +622,8 @@ def structure_terms(
     """
     model_drive, terms = _rotor_terms(structure.armature, drive, n, structure.armature_mask(n))
     if structure.spring:
-        terms.append(JointSpring(tuple(float(x) for x in rest) if rest else (0.0,) * n))
+        q0 = tuple(float(x) for x in rest) if rest else (0.0,) * n
+        terms.append(JointSpring(q0, mask=spring_mask(structure.drop, n)))
     if structure.friction:
         model_drive, at, b = _placed(structure.at, model_drive, n, band, bands)
         terms.append(
@@ -714,6 +717,7 @@ def largest_terms(
     bands: Mapping[str, Sequence[float]] | None = None,
     gain: float = 1.0,
     drop: Collection[str] = (),
+    rest: Sequence[float] = (),
 ) -> tuple[Drive | None, list[tuple[ModelTerm, Any]]]:
     """The terms of every candidate with ``armature == arm`` at once (their friction at
     one place: :attr:`Structure.at`; bands as :func:`structure_terms`), each with what it
@@ -721,7 +725,8 @@ def largest_terms(
     ``("classical", parts)``, ``("smooth", width)``, ``("stribeck", vst)`` or
     ``("smooth_stribeck", (width, vst))`` (the bump alone: its smooth Coulomb term is the
     ``smooth`` one); a candidate is a choice of their columns. The friction coefficients
-    labelled in ``drop`` (``"fc3"``: every term's) are left out of every term."""
+    labelled in ``drop`` (``"fc3"``: every term's) are left out of every term. A spring
+    the candidates hold (``("spring", None)``) acts about ``rest`` [rad] (n,)."""
     mine = [c for c in cands if c.armature == arm]
     places = {c.at for c in mine if c.friction}
     if len(places) > 1:
@@ -784,6 +789,9 @@ def largest_terms(
             out.append((t, ("smooth_stribeck", (bw, v))))
     if drop:
         out = [(t if what is None else _without(t, drop), what) for t, what in out]
+    if any(c.spring for c in mine):  # a fixed part: every candidate of a search holds it
+        q0 = tuple(float(x) for x in rest) or (0.0,) * n
+        out.append((JointSpring(q0, mask=spring_mask(mine[0].drop, n)), ("spring", None)))
     return model_drive, out
 
 
@@ -837,6 +845,8 @@ def candidate_columns(structure: Structure, model: Any, terms: list[tuple[ModelT
             held = "smooth" in structure.friction
             widths = structure.widths(len(t.labels)) if held else ()
             on = np.array([held and w == shape for w in widths or (0.0,) * len(t.labels)])
+        elif kind == "spring":
+            on = np.full(len(t.labels), structure.spring)
         elif kind == "stribeck":
             on = _at_vst(_banded_stribeck(structure), structure, shape, t)
         else:

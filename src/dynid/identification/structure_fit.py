@@ -14,8 +14,6 @@ import copy
 from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
-
 from ..exceptions import RankDeficientError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -23,7 +21,7 @@ from ..regressors.terms import ModelTerm
 from .core import identify
 from .estimators import Estimator
 from .judge import heldout_judge
-from .largest import recording_bands
+from .largest import limits_middle, recording_bands
 from .log import TorqueLog
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
@@ -44,16 +42,6 @@ def _terms_of(
     )
 
 
-def _limits_middle(robot: Robot) -> tuple[float, ...]:
-    """The middle of each joint's limits [rad], zero for a joint without finite limits: a
-    spring's rest position, whose true value the offset absorbs."""
-    lo, hi = np.asarray(robot.q_min, dtype=np.float64), np.asarray(robot.q_max, dtype=np.float64)
-    finite = np.isfinite(lo) & np.isfinite(hi)  # a continuous joint: -inf .. inf
-    mid = np.zeros(lo.shape)
-    mid[finite] = (lo[finite] + hi[finite]) / 2
-    return tuple(float(x) for x in mid)
-
-
 def _fitted(
     robot: Robot,
     data: Recordings,
@@ -68,7 +56,7 @@ def _fitted(
     """``structure`` fitted on ``data`` (:func:`~.core.identify` with ``kw``), judged on
     its held-out folds (or ``validation``), and its terms; a rank deficiency with the hint
     of the terms that leave the unexcited coefficients out (:func:`_without_hint`)."""
-    model_drive, terms = _terms_of(structure, drive, robot.n, data, _limits_middle(robot))
+    model_drive, terms = _terms_of(structure, drive, robot.n, data, limits_middle(robot))
     judge, _, fold_labels = heldout_judge(robot, data, estimator, folds, validation)
     try:
         model = identify(

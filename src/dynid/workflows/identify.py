@@ -617,7 +617,9 @@ def _fit_logs(
     the torques' delay."""
 
     def search(robot: Robot) -> tuple[IdentifiedModel, HeldOutTorques | None, Any]:
-        def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
+        def fitted(
+            structure: Structure | Literal["auto"], drive: Drive | None, spring: Sequence[int] = ()
+        ) -> IdentifiedModel:
             return identify_recordings(
                 robot,
                 logs,
@@ -632,6 +634,7 @@ def _fit_logs(
                 std=opt.std or "hac",  # the consistent fit's data term is the residual itself
                 cutoff_hz=library_cutoff(opt.cutoff_hz, "auto"),
                 keep_outlying=opt.keep_outlying,
+                spring_joints=spring,
                 **heldout,
             )
 
@@ -836,7 +839,7 @@ def _static(robot: Robot, path: Path, data: Any, opt: IdentifyOptions) -> Identi
 
 
 def _searched(
-    fitted: Callable[[Structure | Literal["auto"], Drive | None], IdentifiedModel],
+    fitted: Callable[..., IdentifiedModel],
     structure: Structure | Literal["auto"],
     drive: Drive | None,
     logs: Sequence[TorqueLog],
@@ -853,7 +856,10 @@ def _searched(
     current = drive is not None and drive.effort == "current"
     if structure != "auto" or not current:
         model = fitted(structure, drive)
-        return model, _predicted_heldout(model, logs, separate), None
+        held = _predicted_heldout(model, logs, separate)
+        if structure == "auto":
+            model, held = _spring_judged(fitted, model, held, drive, logs, separate)
+        return model, held, None
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         model = fitted(structure, drive)
@@ -878,6 +884,26 @@ def _searched(
         gains = None if first.gains is None else dataclasses.replace(first.gains, applied=True)
         held = dataclasses.replace(held, gains=gains, springs=None, tilt=None)
     return model, held, first
+
+
+def _spring_judged(
+    fitted: Callable[..., IdentifiedModel],
+    model: IdentifiedModel,
+    held: HeldOutTorques | None,
+    drive: Drive | None,
+    logs: Sequence[TorqueLog],
+    separate: TorqueLog | None,
+) -> tuple[IdentifiedModel, HeldOutTorques | None]:
+    """The structure chosen again with a spring on the joints the held-out residual of
+    ``model`` names (``held.springs``) judged as a candidate on the same folds
+    (:func:`~dynid.identification.spring_candidate.with_spring`: kept only where the
+    choice without it predicts worse beyond one standard error), and its held-out
+    prediction; ``model`` and ``held`` as they are where none is named."""
+    named = () if held is None or held.springs is None else held.springs.named
+    if not named:
+        return model, held
+    model = fitted("auto", drive, named)
+    return model, _predicted_heldout(model, logs, separate)
 
 
 def _loose_at_floor(
