@@ -68,8 +68,9 @@ from ..identification.least_squares import LOOSE_ADVICE, STD_METHODS, StdMethod,
 from ..identification.log import TorqueLog, checked_log, checked_logs
 from ..identification.model import IdentifiedModel
 from ..identification.motor_constants import shared_gear_ratio
+from ..identification.recording_offsets import identify_with_offsets
 from ..identification.residual_dependence import outside_model_note, round_off_note
-from ..identification.selection import fitted_logs, identify_recordings
+from ..identification.selection import fitted_logs
 from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
@@ -618,7 +619,7 @@ def _fit_logs(
 
     def search(robot: Robot) -> tuple[IdentifiedModel, HeldOutTorques | None, Any]:
         def fitted(structure: Structure | Literal["auto"], drive: Drive | None) -> IdentifiedModel:
-            return identify_recordings(
+            return identify_with_offsets(
                 robot,
                 logs,
                 names,
