@@ -13,7 +13,7 @@ joint's in words.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,9 +80,10 @@ def recording_levels(
     torques: Sequence[NDArray[np.float64]],
     recording: Sequence[int],
     noise: NDArray[np.float64],
+    joints: Collection[int] | None = None,
 ) -> RecordingLevels | None:
-    """The joints whose residual is one steady constant over each recording (module
-    docstring); None where there is none.
+    """The joints (of ``joints``; None: every one) whose residual is one steady constant
+    over each recording (module docstring); None where there is none.
 
     Parameters
     ----------
@@ -94,6 +95,9 @@ def recording_levels(
         The recording of each piece (pieces of one recording in time order).
     noise : ndarray, shape (n,)
         The joints' torque noise [N m].
+    joints : collection of int, optional
+        The joints (0-based) judged: those whose model holds an offset, which a recording's
+        own differs from (a model without one misses the constant itself).
     """
     rec = list(recording)
     if not error or len(rec) != len(error):
@@ -108,8 +112,10 @@ def recording_levels(
     big = np.abs(levels) > NOISE_FRACTION * np.asarray(noise, dtype=np.float64)
     steady = np.array([_steady(e) for e in whole])
     offset = big.any(axis=0) & np.all(steady | ~big, axis=0)
-    joints = tuple(int(j) for j in np.flatnonzero(offset))
-    if not joints:
+    if joints is not None:
+        offset &= np.isin(np.arange(offset.size), list(joints))
+    found = tuple(int(j) for j in np.flatnonzero(offset))
+    if not found:
         return None
     e2 = own2 = 0.0
     for e, lv in zip(whole, levels, strict=True):
@@ -119,7 +125,7 @@ def recording_levels(
     if not t2 > 0:
         return None
     pct = 100 * float(np.sqrt(e2 / t2))
-    return RecordingLevels(joints, levels, pct, 100 * float(np.sqrt(own2 / t2)))
+    return RecordingLevels(found, levels, pct, 100 * float(np.sqrt(own2 / t2)))
 
 
 def level_clause(

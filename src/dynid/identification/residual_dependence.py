@@ -365,7 +365,7 @@ def _constant(
     offset); ``lacks``: the robot file the model was read from, which holds no offset
     (``"a URDF"``). ``level``: the constant per recording where it is one steady constant
     over each (:mod:`~.recording_level`): the recording's own torque offset, said so."""
-    if level is not None:
+    if level is not None and offset is not None:
         return level_clause(head, d.mean, d.rms, level, offset)
     said = f"{head}{abs(d.mean):.2g} of {d.rms:.2g} N m RMS residual is a constant"
     if offset is None:
