@@ -28,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import re
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -372,9 +372,11 @@ def identify_with_offsets(
     robot: Robot,
     logs: Sequence[TorqueLog],
     names: Sequence[str] | None = None,
+    *,
+    fit: Callable[..., IdentifiedModel] = identify_recordings,
     **kw: Any,
 ) -> IdentifiedModel:
-    """:func:`~.selection.identify_recordings` (``kw`` as it takes them), with one torque
+    """``fit`` (:func:`~.selection.identify_recordings`, ``kw`` as it takes them), with one torque
     offset per recording and joint where the recordings' offsets differ (module
     docstring): the first fit's warnings said only where it is the answer.
 
@@ -382,7 +384,7 @@ def identify_with_offsets(
     ``validate_on``) whose structure holds the offset."""
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
-        model = identify_recordings(robot, logs, names, **kw)
+        model = fit(robot, logs, names, **kw)
     names = list(names) if names is not None else [f"log{k + 1}" for k in range(len(logs))]
     found, which = None, _fitted_indices(model, len(logs))
     applies = kw.get("drive") is None and kw.get("validate_on") is None
@@ -392,7 +394,7 @@ def identify_with_offsets(
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return model
-    refit = identify_recordings(robot, shifted_logs(logs, which, found), names, **kw)
+    refit = fit(robot, shifted_logs(logs, which, found), names, **kw)
     again_which = _fitted_indices(refit, len(logs))
     if len(again_which) >= 3:
         data = _prepared(robot, refit, logs, names, again_which, kw)

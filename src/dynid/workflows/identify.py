@@ -70,7 +70,7 @@ from ..identification.model import IdentifiedModel
 from ..identification.motor_constants import shared_gear_ratio
 from ..identification.recording_offsets import identify_with_offsets
 from ..identification.residual_dependence import outside_model_note, round_off_note
-from ..identification.selection import fitted_logs
+from ..identification.selection import fitted_logs, identify_recordings
 from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
@@ -623,6 +623,7 @@ def _fit_logs(
                 robot,
                 logs,
                 names,
+                fit=identify_recordings,
                 structure=structure,
                 max_std_percent=opt.max_std_percent,
                 rtol=opt.rtol,
