@@ -20,7 +20,8 @@ offset the model keeps for a new recording is the sample-weighted mean. The held
 error of a recording left out (fitted on the others) is given twice: with the mean
 offset (a new recording's offset is unknown) and with the recording's own.
 
-Direct drives only (torques at the joints); a drive's logs are left as they are.
+Direct drives only (torques at the joints); a drive's logs, and recordings whose rows do
+not stack in memory, are left as they are.
 """
 
 from __future__ import annotations
@@ -41,13 +42,14 @@ from .log_rows import log_blocks
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
 from .selection import fitted_logs, identify_recordings
+from .streaming import streams
 
 #: A recording's offset differs where it lies this many standard errors from the mean.
 Z_SCORE = 4.0
 #: ... and by more than this share of the joint's torque noise (white-noise std).
 NOISE_FRACTION = 0.5
 #: ... and by more than this share of the joint's torque RMS (logs without noise).
-RMS_FRACTION = 1e-3
+RMS_FRACTION = 5e-3
 
 _OFFSET = re.compile(r"fo([0-9]+)")
 
@@ -143,14 +145,17 @@ def _rows(
 ) -> tuple[list[_Rows], NDArray[np.intp]] | None:
     """Per recording of ``data``, the rows of ``model``'s kept columns, and each column's
     joint where it is that joint's shared offset ``fo`` (-1 for the others); None when the
-    model's columns cannot be rebuilt (a drive, columns that do not match its fit)."""
+    model's columns cannot be rebuilt (a drive, columns that do not match its fit) or
+    their rows would not stack in memory (:func:`~.streaming.streams`, with one column per
+    recording and joint more)."""
     if model.drive is not None:
         return None
     columns = model_columns(
         robot, data, terms=tuple(t.term for t in model.terms.values()), base=model.base
     )
     fit = model.joint_fit or model.fit
-    if len(columns.labels) != len(fit.kept):
+    extra = len(data.names) * data.n
+    if len(columns.labels) != len(fit.kept) or streams(data.n_rows, len(fit.kept) + extra):
         return None
     kept = np.asarray(fit.kept, dtype=bool)
     labels = [lab for lab, k in zip(columns.labels, kept, strict=True) if k]
