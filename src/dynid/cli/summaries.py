@@ -126,6 +126,8 @@ def format_identification(
     head += [f"note: {unknown['finding']}"] if isinstance(unknown, dict) else []
     gravity = info.extra.get("gravity_fitted")  # the gravity vector a tilted base reads
     head += [f"note: {gravity['note']}"] if isinstance(gravity, dict) and "note" in gravity else []
+    offsets = info.extra.get("recording_offsets")  # one torque offset per recording
+    head += [f"note: {offsets['note']}"] if isinstance(offsets, dict) and "note" in offsets else []
     head += selection_lines(info.selection)
     head += estimator_lines(info.estimator_choice)
     lw = text_width("name", model.base.labels[: model.base.rank], 7)

@@ -39,6 +39,7 @@ from ..model.robot import Robot
 from ..model.units import joint_unit
 from ..regressors.terms import PART_LABELS, LinearFriction
 from .gravity_tilt import GravityTilt
+from .recording_level import level_clause
 from .residual_spring import ResidualSpring
 from .velocity_noise import MIN_MOTION, noise_band, velocity_noise_std
 from .verdict import ROUND_OFF_PERCENT, SYSTEMATIC_RATIO, Verdict, with_hint
@@ -350,7 +351,11 @@ _INERTIA_REMEDY = (
 
 
 def _constant(
-    d: Dependence, head: str, offset: tuple[str, bool] | None, lacks: str | None = None
+    d: Dependence,
+    head: str,
+    offset: tuple[str, bool] | None,
+    lacks: str | None = None,
+    level: Sequence[float] | None = None,
 ) -> str:
     """Joint ``d``'s residual that is a constant over the samples judged, in words, told
     with the model's own offset (``offset``: its label and whether the model holds it,
@@ -358,7 +363,10 @@ def _constant(
     the model holds, is no offset the fit missed but a level that changes along the motion
     (the Panda's last 1.1 s of a 5 s log: 0.21 N m on joint 4, whose true friction has no
     offset); ``lacks``: the robot file the model was read from, which holds no offset
-    (``"a URDF"``)."""
+    (``"a URDF"``). ``level``: the constant per recording where it is one steady constant
+    over each (:mod:`~.recording_level`): the recording's own torque offset, said so."""
+    if level is not None and offset is not None:
+        return level_clause(head, d.mean, d.rms, level, offset)
     said = f"{head}{abs(d.mean):.2g} of {d.rms:.2g} N m RMS residual is a constant"
     if offset is None:
         return f"{said} (an offset{'' if lacks is None else f', which {lacks} cannot hold'})"
@@ -385,6 +393,7 @@ def _sentence(
     inertia: str | None = None,
     still_as: str | None = None,
     lacks: str | None = None,
+    levels: Mapping[int, Sequence[float]] | None = None,
 ) -> str:
     """One joint's diagnosis in words (a residual that concentrates at standstill first:
     the holding torque at rest, its why said once, ``still_as`` the joint it was said
@@ -402,7 +411,9 @@ def _sentence(
     fc7, and its validation had suggested comparing the laws); ``lacks``: the robot file
     the model was read from, which holds no offset and no friction beyond viscous and
     Coulomb (``"a URDF"``), named with a constant residual and one that follows the
-    velocity (:func:`cannot_hold_note`)."""
+    velocity (:func:`cannot_hold_note`); ``levels``: per joint, the constant of each
+    recording where the residual is one steady constant over each (:mod:`~.recording_level`),
+    told as the recording's own torque offset."""
     head = f"{name}: "
     if still_led(d):
         said = (
@@ -469,7 +480,8 @@ def _sentence(
             "identify takes the one it chooses)"
         )
     if abs(d.mean) >= FOLLOWS * d.systematic:
-        return _constant(d, head, (offsets or {}).get(d.joint), lacks)
+        level = (levels or {}).get(d.joint)
+        return _constant(d, head, (offsets or {}).get(d.joint), lacks, level)
     return (
         f"{head}of {d.rms:.2g} N m RMS residual, {d.position:.2g} follows its position and "
         f"{d.velocity:.2g} its velocity: the rest depends on other joints' motion"
@@ -556,6 +568,7 @@ def dependence_hint(
     inertia: str | None = None,
     lacks: str | None = None,
     prismatic: Sequence[bool] | None = None,
+    levels: Mapping[int, Sequence[float]] | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -580,7 +593,9 @@ def dependence_hint(
     ``lacks``: the robot file the model was read from (``"a URDF"``), whose missing
     offsets and friction are named with the joints and said once after them
     (:func:`cannot_hold_note`); ``prismatic``: the joints' kinds, a prismatic joint's
-    clause in its own units (N, N/m: :func:`~dynid.model.units.joint_unit`)."""
+    clause in its own units (N, N/m: :func:`~dynid.model.units.joint_unit`); ``levels``:
+    per joint, each recording's constant where the residual is one steady constant over
+    each (:mod:`~.recording_level`), told as the recording's own offset."""
     if tilt is not None and tilt.named and tilt.rows.size == 0:
         return tilt.sentence()  # judged on other samples (a block's whole log): said alone
     if tilt is not None and tilt.named:
@@ -592,7 +607,7 @@ def dependence_hint(
         rest = dependence_hint(
             kept(q), kept(dq), [tilt.rest], noise_rms, joint_names, terms, offsets=offsets,
             left_out=left_out, ddq=None if ddq is None else kept(ddq), inertia=inertia,
-            lacks=lacks, prismatic=prismatic,
+            lacks=lacks, prismatic=prismatic, levels=levels,
         )  # fmt: skip
         return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
     found = residual_dependence(q, dq, error, noise_rms, ratios, ddq)
@@ -603,7 +618,7 @@ def dependence_hint(
     for d in worst[:NAMED]:
         remedy = inertia if first is None else f"as for {first}"
         name = joint_names[d.joint]
-        clause = _sentence(d, name, terms, springs, offsets, left_out, remedy, still, lacks)
+        clause = _sentence(d, name, terms, springs, offsets, left_out, remedy, still, lacks, levels)
         rail = prismatic is not None and d.joint < len(prismatic) and bool(prismatic[d.joint])
         clauses.append(joint_unit(clause, rail))  # its N m and rad said as N and m
         if first is None and acceleration_led(d) and not still_led(d):
@@ -679,6 +694,7 @@ def with_dependence_hint(
     inertia: str | None = None,
     lacks: str | None = None,
     prismatic: Sequence[bool] | None = None,
+    levels: Mapping[int, Sequence[float]] | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself; with the
@@ -692,14 +708,15 @@ def with_dependence_hint(
     friction coefficients left out per joint (:func:`friction_left_out`); ``ddq`` and
     ``inertia``: the accelerations and the remedy of a residual that follows them;
     ``lacks``: the robot file the model was read from; ``prismatic``: the joints' kinds
-    (:func:`dependence_hint`)."""
+    (:func:`dependence_hint`); ``levels``: each recording's constant per joint where it is
+    one (:mod:`~.recording_level`)."""
     if verdict.level == "good":
         return verdict
     if (exact := round_off(error, torques)) is not None:
         return with_hint(verdict, round_off_note(exact))
     said = dependence_hint(
         q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets, left_out,
-        ddq, inertia, lacks, prismatic,
+        ddq, inertia, lacks, prismatic, levels,
     )  # fmt: skip
     return with_hint(verdict, said)
 

@@ -68,6 +68,7 @@ from ..identification.least_squares import LOOSE_ADVICE, STD_METHODS, StdMethod,
 from ..identification.log import TorqueLog, checked_log, checked_logs
 from ..identification.model import IdentifiedModel
 from ..identification.motor_constants import shared_gear_ratio
+from ..identification.recording_offsets import identify_with_offsets
 from ..identification.residual_dependence import outside_model_note, round_off_note
 from ..identification.selection import fitted_logs, identify_recordings
 from ..identification.static import identify_static
@@ -620,10 +621,11 @@ def _fit_logs(
         def fitted(
             structure: Structure | Literal["auto"], drive: Drive | None, spring: Sequence[int] = ()
         ) -> IdentifiedModel:
-            return identify_recordings(
+            return identify_with_offsets(
                 robot,
                 logs,
                 names,
+                fit=identify_recordings,
                 structure=structure,
                 max_std_percent=opt.max_std_percent,
                 rtol=opt.rtol,

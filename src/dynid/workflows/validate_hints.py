@@ -13,7 +13,7 @@ one entry; ``dynid.workflows.validate`` judges the verdict and calls it.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +29,7 @@ from ..identification.gravity_tilt import GravityTilt
 from ..identification.log import TorqueLog
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.model import IdentifiedModel
+from ..identification.recording_level import RecordingLevels, recording_levels
 from ..identification.residual_dependence import (
     dependence_hint,
     friction_left_out,
@@ -199,11 +200,31 @@ def _dependence_said(
         verdict = with_hint(verdict, None if rest is None else f"what it leaves: {rest}")
         return ResidualHints(verdict, None, None, tilt, load)  # the load, not a spring
     tau = [v.log.tau for v in val.parts]
+    own = None if verdict.level == "good" else _own_offsets(val, error, tau, noise.sensor, offsets)
+    verdict = with_hint(verdict, None if own is None else own.sentence(names))
+    levels = None if own is None else {j: own.of(j) or () for j in own.joints}
     verdict = with_dependence_hint(
         verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
-        tau, offsets, left_out, ddq, inertia, lacks, kinds,
+        tau, offsets, left_out, ddq, inertia, lacks, kinds, levels,
     )  # fmt: skip
     return ResidualHints(verdict, springs, None, tilt, load)
+
+
+def _own_offsets(
+    val: RecordingsValidation,
+    error: Sequence[NDArray[np.float64]],
+    tau: Sequence[NDArray[np.float64]],
+    noise: NDArray[np.float64],
+    offsets: Mapping[int, tuple[str, bool]],
+) -> RecordingLevels | None:
+    """The joints whose model holds an offset (``offsets``) and whose residual is one
+    steady constant over each recording judged: the recordings' own torque offsets
+    (:func:`~dynid.identification.recording_level.recording_levels`), None where there is
+    none or the pieces' recordings are unknown."""
+    recording = getattr(val.pieces, "recording", ())
+    if len(recording) != len(error) or not offsets:
+        return None
+    return recording_levels(error, tau, recording, noise, tuple(offsets))
 
 
 def _fitted_load(
