@@ -98,3 +98,65 @@ def test_static_data_beside_a_torque_log_is_refused(tmp_path):
 
     with pytest.raises(DataError, match="validate judges one kind a call"):
         static_files([tmp_path / "s.csv", log])
+
+
+@pytest.mark.parametrize(
+    ("scale", "level", "said"),
+    [
+        (1.2, "poor", "the model's M and g miss what the data hold (another arm's links"),
+        (3.0, "unusable", "the model does not explain M and g: error 66.7 % (50 % or more"),
+    ],
+)
+def test_a_static_verdict_speaks_of_m_and_g_not_of_torques(tmp_path, scale, level, said):
+    """Static data of an arm whose every inertial is `scale` x the Panda's (Pinocchio's M
+    and g times `scale`, exactly): the Panda's model errs by 1 - 1 / scale of the data's
+    entries (16.7 %: poor; 66.7 %: unusable) and the reason names M and g, never
+    excitation, the drive or a log (no motion and no drive in static data)."""
+    q, M, g = pinocchio_panda_static(4, 30)
+    save_static_csv(tmp_path / "s.csv", StaticDataset(q, scale * M, scale * g))
+    got = validate_static_file(dynid.panda(), tmp_path / "s.csv")
+    assert got.relative_error_percent == pytest.approx(100 * (1 - 1 / scale), rel=1e-9)
+    reason = got.verdict.reason
+    assert got.verdict.level == level and said in reason, reason
+    for torque_word in ("torque", "excitation", "drive", "a log"):
+        assert torque_word not in reason
+
+
+def test_the_command_prints_each_joints_floor_and_what_no_noise_means(tmp_path, capsys):
+    """The table's floor per joint is the recorded relative noise (100 eps % on every
+    joint for a model without coefficients' error); a file that records none is judged
+    on the relative thresholds, and the line says so."""
+    save_static_csv(tmp_path / "s.csv", _acquired(dynid.panda(), 20, 2e-3, 2))
+    argv = ["validate", "--robot", "panda", "--data", str(tmp_path / "s.csv"), "--no-figures"]
+    assert main(argv + ["--out", str(tmp_path / "v")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = next(k for k, line in enumerate(lines) if line.startswith("joint"))
+    assert head >= 0 and lines[head].rstrip().endswith("noise floor [%]")
+    floors = [float(line.split()[-1]) for line in lines[head + 1 : head + 8]]
+    assert floors == pytest.approx([0.2] * 7, rel=1e-9)
+    q, M, g = pinocchio_panda_static(5, 10)
+    save_static_csv(tmp_path / "exact.csv", StaticDataset(q, M, g))
+    argv[4] = str(tmp_path / "exact.csv")
+    assert main(argv + ["--out", str(tmp_path / "w")]) == 0
+    out = capsys.readouterr().out
+    assert "the data record no noise: judged on the relative thresholds (below 5 % good" in out
+    assert "noise floor [%]" not in out
+
+
+def test_joints_judged_worse_than_the_pooled_level_are_named_in_static_words():
+    """A pooled 8 % (usable) with one joint at 30 % and one at 120 % of its entries: poor by
+    its worst joints, in words of M and g; the same numbers as torques keep the torque
+    log's words."""
+    from dynid.identification.verdict import judge_prediction
+
+    args = dict(joint_percent=[2.0, 30.0, 120.0], joint_names=["a", "b", "c"])
+    static = judge_prediction(8.0, None, kind="static", **args)
+    assert static.level == "poor", static.reason
+    assert "the model's M and g miss what the data hold there" in static.reason
+    assert "at 100 % or more: data of another robot, or other kinematics?" in static.reason
+    torques = judge_prediction(8.0, None, **args)
+    assert (
+        "the model misses effects the data show there (model terms, excitation, the drive)"
+        in (torques.reason)
+        and "a log of another robot" in torques.reason
+    )

@@ -109,6 +109,7 @@ from ..exceptions import DataError
 from ..friction.pooled import joined_validation
 from ..identification.model import IdentifiedModel
 from ..identification.static_validation import StaticValidation
+from ..identification.verdict import FAIR_PERCENT, GOOD_PERCENT, JOINT_FAIR, JOINT_GOOD
 from ..io.validation_json import save_static_validation_json, save_validation_json
 from ..model.robot import Robot
 from ..model.units import unit_said
@@ -264,18 +265,27 @@ def _run_static(
 def print_static_validation(
     console: Console, result: StaticValidation, robot: Robot, name: str, path: Path
 ) -> None:
-    """The table per joint (g and M errors), the errors of M and g, the verdict."""
+    """The table per joint (g and M errors, the noise floor when known), the errors of M
+    and g, the verdict."""
     cols = {
         f"RMS g [{unit_said(robot, 'N m')}]": result.g_rms,
         "RMS M row [kg m^2]": result.m_rms,
         "relative [%]": result.joint_percent,
     }
+    if result.joint_floor_percent is not None:
+        cols["noise floor [%]"] = result.joint_floor_percent
     floor = result.floor_percent
     console.print(
         format_rms_table(list(robot.joint_names), cols),
         f"{name}: {result.n_configurations} static configurations; relative error of M "
         f"{result.m_error_percent:.3g} %, of g {result.g_error_percent:.3g} %"
-        + (f"; noise floor {floor:.3g} %" if floor else "; the data record no noise"),
+        + (
+            f"; noise floor {floor:.3g} %"
+            if floor
+            else f"; the data record no noise: judged on the relative thresholds (below "
+            f"{GOOD_PERCENT:g} % good, {FAIR_PERCENT:g} % usable; per joint {JOINT_GOOD:g} "
+            f"and {JOINT_FAIR:g} %)"
+        ),
         f"relative error {result.relative_error_percent:.3g} %; wrote {path}",
         f"verdict: {result.verdict}",
     )

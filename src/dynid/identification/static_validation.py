@@ -22,7 +22,8 @@ identification fits):
   effect it lacks. Data that record no noise (a real controller's answers, its own
   model's): no floor, and the relative thresholds judge.
 
-The verdict is :func:`~dynid.identification.verdict.judge_prediction`'s, as for torques.
+The verdict is :func:`~dynid.identification.verdict.judge_prediction`'s, as for torques,
+in words of ``M`` and ``g`` (``kind="static"``: no excitation or drive to blame).
 """
 
 from __future__ import annotations
@@ -185,7 +186,7 @@ def static_validation(
     pooled = _percent(err, measured)
     verdict = judge_prediction(
         pooled, floor, joint_ratios=ratios, joint_percent=joint, joint_names=joint_names,
-        floor_parts=parts,
+        floor_parts=parts, kind="static",
     )  # fmt: skip
     return StaticValidation(
         relative_error_percent=pooled,

@@ -21,6 +21,11 @@ unusable      50 % or more (unless within 3 x a noise       check the data first
               sign)
 ============  ===========================================  ================================
 
+Static data (``kind="static"``: a controller's ``M`` and ``g`` at configurations, no
+motion and no drive) are judged by the same thresholds, and the reasons speak of ``M``
+and ``g``: a poor model's miss what the data hold (another arm's links, a tool the
+description lacks, other units), not model terms, excitation or the drive.
+
 Torques mostly noise (a floor of 33 % or more, :data:`NOISY_FLOOR_PERCENT`: a prediction
 of no torque at all is then within 3 x the floor) cannot tell a good model from a poor
 one: within 3 x such a floor the verdict is usable, with that said, never at the floor
@@ -76,6 +81,7 @@ __all__ = [
     "SYSTEMATIC_RATIO",
     "UNUSABLE_PERCENT",
     "Verdict",
+    "VerdictKind",
     "joint_levels",
     "joint_ratios",
     "judge_prediction",
@@ -122,6 +128,46 @@ ROUND_OFF_PERCENT = 1e-3
 #: noise estimate is next to nothing (a quantised or filtered sensor) must not outweigh
 #: every other (the whitened judgement of the structure choice and the verdict).
 NOISE_FLOOR_SHARE = 1e-2
+
+
+#: The data a verdict judges: torques (a log) or a controller's static ``M`` and ``g``.
+VerdictKind = Literal["torques", "static"]
+
+
+@dataclass(frozen=True, slots=True)
+class _Words:
+    """What a verdict's reasons name for one kind of data (:data:`VerdictKind`)."""
+
+    quantity: str  # what the model predicts
+    nothing: str  # the prediction of nothing
+    energy: str  # the quantity's square
+    misses: str  # a poor model's miss, "{there}" where the joints are named
+    check: str  # an unusable model's data to check
+    beyond: str  # a joint at 100 % or more
+    finer: str  # data that would tell, where they are mostly noise
+
+
+_WORDS: dict[str, _Words] = {
+    "torques": _Words(
+        "the torques",
+        "no torque",
+        "the torques' energy",
+        "the model misses effects the data show{there} (model terms, excitation, the drive)",
+        "a log of another robot, in other units or of another sign?",
+        "a log of another robot, or other kinematics?",
+        "a recording of larger torques or finer torque readings",
+    ),
+    "static": _Words(
+        "M and g",
+        "zero M and g",
+        "their square",
+        "the model's M and g miss what the data hold{there} (another arm's links, a tool "
+        "the description lacks, other units)",
+        "data of another robot, in other units, or a tool the description lacks?",
+        "data of another robot, or other kinematics?",
+        "data of finer readings",
+    ),
+}
 
 
 @dataclass(frozen=True, slots=True)
@@ -254,6 +300,7 @@ def judge_prediction(
     ratio: float | None = None,
     joint_rms: ArrayLike | None = None,
     joint_rough: ArrayLike | None = None,
+    kind: VerdictKind = "torques",
 ) -> Verdict:
     """The level of a prediction (module docstring): :func:`pooled_verdict`, made worse by
     the worst of :func:`joint_levels` (``joint_ratios``: each joint's RMS error over its
@@ -263,13 +310,15 @@ def judge_prediction(
     their RMS error ``joint_rms`` [N m] when given (``joint_rough``: the joints whose
     noise is mostly the states', :func:`joint_levels`); ``floor_parts`` and ``ratio`` as
     :func:`pooled_verdict`'s. Below :data:`NEGLIGIBLE_PERCENT` the joints are judged on
-    ``joint_percent`` alone."""
+    ``joint_percent`` alone. ``kind``: the data judged, whose words the reasons use (module
+    docstring)."""
     v = pooled_verdict(
         error_percent,
         floor_percent,
         opposite_sign=opposite_sign,
         floor_parts=floor_parts,
         ratio=ratio,
+        kind=kind,
     )
     negligible = float(error_percent) < NEGLIGIBLE_PERCENT
     if negligible and joint_percent is not None:  # a noise of round-off says nothing
@@ -289,14 +338,15 @@ def judge_prediction(
         list(joint_names) if joint_names is not None else [str(j + 1) for j in range(len(levels))]
     )
     which = _named_joints(bad, names, joint_ratios, joint_percent, joint_rms)
+    w = _WORDS[kind]
     what = (
         "effects outside the model remain there"
         if level == "fair"
-        else "the model misses effects the data show there (model terms, excitation, the drive)"
+        else w.misses.format(there=" there")
     )
     p = None if joint_percent is None else np.asarray(joint_percent, dtype=np.float64).ravel()
     if p is not None and any(p[j] >= 100.0 for j in bad):  # worse than no torque at all
-        what += "; at 100 % or more: a log of another robot, or other kinematics?"
+        what += f"; at 100 % or more: {w.beyond}"
     label = "usable" if level == "fair" else "poor"
     pooled = v.reason.split(":")[0]
     if LEVELS.index(level) > LEVELS.index(v.level):  # the help's pooled rule alone says better
@@ -343,6 +393,7 @@ def pooled_verdict(
     opposite_sign: bool = False,
     floor_parts: str | None = None,
     ratio: float | None = None,
+    kind: VerdictKind = "torques",
 ) -> Verdict:
     """The level of a prediction of relative error ``error_percent`` [%] (module docstring).
 
@@ -362,12 +413,15 @@ def pooled_verdict(
     ratio : float, optional
         The error over the floor when it is not ``error_percent / floor_percent``: weighed
         sample by sample against a noise that varies (default: that quotient).
+    kind : {"torques", "static"}
+        The data judged: a torque log's torques, or static data's ``M`` and ``g``, whose
+        words the reasons use (module docstring).
 
     Returns
     -------
     Verdict
     """
-    e = float(error_percent)
+    e, w = float(error_percent), _WORDS[kind]
     floor = float(floor_percent) if floor_percent is not None else 0.0
     known = math.isfinite(floor) and floor > 0
     r = e / floor if known and math.isfinite(e) else None
@@ -386,26 +440,23 @@ def pooled_verdict(
     explained = r is not None and r <= FLOOR_FAIR and e < 100.0  # by a floor that high
     if not math.isfinite(e) or (e >= UNUSABLE_PERCENT and not explained):
         what = (
-            "100 % or more: worse than predicting no torque"
+            f"100 % or more: worse than predicting {w.nothing}"
             if e >= 100.0
-            else f"{UNUSABLE_PERCENT:g} % or more: a quarter or more of the torques' energy "
-            "unexplained"
+            else f"{UNUSABLE_PERCENT:g} % or more: a quarter or more of {w.energy} unexplained"
         )
         return Verdict(
             "unusable",
             "unusable",
-            f"the model does not explain the torques: error {e:.3g} % ({what}); a log of "
-            "another robot, in other units or of another sign?",
+            f"the model does not explain {w.quantity}: error {e:.3g} % ({what}); {w.check}",
             r,
         )
     if r is not None and r <= FLOOR_FAIR and floor >= NOISY_FLOOR_PERCENT:
         return Verdict(
             "fair",
             "usable",
-            f"error {e:.3g} %{at}: the torques are mostly noise, {floor:.3g} % of them, so "
-            "these data cannot tell a good model from a poor one (a prediction of no torque "
-            f"would be {100.0 / floor:.3g} x the floor); judge it on a recording of larger "
-            "torques or finer torque readings",
+            f"error {e:.3g} %{at}: {w.quantity} are mostly noise, {floor:.3g} % of them, so "
+            f"these data cannot tell a good model from a poor one (a prediction of {w.nothing} "
+            f"would be {100.0 / floor:.3g} x the floor); judge it on {w.finer}",
             r,
         )
     if r is not None and r <= FLOOR_GOOD:
@@ -423,8 +474,7 @@ def pooled_verdict(
     return Verdict(
         "poor",
         "poor",
-        f"error {e:.3g} %{at}: the model misses effects the data show (model terms, "
-        "excitation, the drive)",
+        f"error {e:.3g} %{at}: {w.misses.format(there='')}",
         r,
     )
 

@@ -371,7 +371,13 @@ def _read_torque_log(
     else:
         if robot is not None and n in (None, robot.n):  # each unit for its joints' kind
             columns = columns.for_robot(robot.prismatic)
-        mapped = load_mapped_torque_log(path, columns, n=n)
+        try:
+            mapped = load_mapped_torque_log(path, columns, n=n)
+        except DataError as exc:  # a chain past the log's joints: say how to cut it
+            beyond = _chain_beyond(path, columns, n, owner, robot, exc)
+            if beyond is None:
+                raise
+            raise beyond from exc
         said_of = commanded_torques(columns.template("tau"), header_names(path), mapped.log.n)
         if said_of is not None:  # a controller's torque read as measured: once per run
             warnings.warn(said_of, DynidWarning, stacklevel=caller_level())
@@ -420,6 +426,35 @@ def _read_torque_log(
             file=path.name,
         )
     return log
+
+
+def _chain_beyond(
+    path: Path,
+    columns: ColumnMap,
+    n: int | None,
+    owner: str | None,
+    robot: Robot | None,
+    exc: DataError,
+) -> DataError | None:
+    """The error of a mapped log whose columns stop short of ``robot``'s ``n`` joints (a
+    6-joint log of an arm whose URDF chain runs on to a gripper joint: ``q7`` missing),
+    with the log's own count and the ``--tip`` or ``--base`` that cuts the chain to it
+    (:func:`_joint_count_hint`); None when the log read without a count has not fewer
+    joints, or ``exc`` gives a hint of its own (the columns numbered from 0)."""
+    if robot is None or robot.n != n or "hint:" in str(exc):
+        return None
+    try:
+        log = load_mapped_torque_log(path, columns).log
+    except DynidError:
+        return None
+    if not 0 < log.n < robot.n:
+        return None
+    said = str(exc).removeprefix(f"{exc.file}: ") if exc.file else str(exc)
+    return DataError(
+        f"the log has {log.n} joints; {owner or 'the robot'} has {n}: {said}; "
+        + _joint_count_hint(log, robot),
+        file=path.name,
+    )
 
 
 def _joint_count_hint(log: TorqueLog, robot: Robot | None) -> str:
