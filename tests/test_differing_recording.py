@@ -27,6 +27,7 @@ from dynid.friction.model import ClassicalFriction
 from dynid.identification.differing_recording import NOTE_Z, differing_recording
 from dynid.identification.recording_offsets import RecordingOffsets, identify_with_offsets
 from dynid.identification.selection import identify_recordings
+from dynid.report.identify import _structure_section
 from dynid.simulation.measurement import SensorNoise
 
 from conftest import planar_2r, recordings
@@ -85,6 +86,8 @@ def test_a_recording_whose_friction_differs_is_named_not_left_out(cold):
     assert f"{min(others):.3g} to {max(others):.3g} %" in note
     assert "identify without it" in note and "--keep-outlying is unrelated" in note
     assert not any(r.get("left_out") for r in cold.info.recordings)
+    report = _structure_section({"metadata": {"selection": sel}})
+    assert "(not outlying): fitted, named in a note" in report and "rec1.csv: held-out" in report
 
 
 def test_leaving_the_named_recording_out_brings_the_friction_back_to_the_truth(arm, cold):
@@ -101,6 +104,7 @@ def test_recordings_that_agree_get_no_note(arm):
     """Four recordings of one friction: no recording named."""
     sel = _identified(arm, _logs(arm)).info.selection
     assert sel["differing_recordings"] == []
+    assert "clearly above" not in _structure_section({"metadata": {"selection": sel}})
     assert not any("clearly above the other recordings" in n for n in sel["notes"])
 
 
@@ -167,6 +171,8 @@ def test_the_table_says_its_heldout_errors_hold_each_recordings_own_offset(shift
     assert sel["heldout_own_offsets"] == list(model.robot.joint_names)
     lines = selection_lines(sel)
     assert "held-out errors below with each held-out recording's own torque offset" in lines[1]
+    report = _structure_section({"metadata": {"selection": sel}})
+    assert "own torque offset on 2 joint(s) (fitted one per recording)" in report
 
 
 def test_identify_verdict_tells_a_recordings_constant_residual_as_its_own_offset(shifted):
