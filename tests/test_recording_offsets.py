@@ -93,10 +93,11 @@ def test_offsets_that_differ_are_recovered_per_recording(differing):
     assert own[differing.robot.joint_names[0]] == pytest.approx(got[2, 0])
     assert rec["own_offset_percent"] < rec["heldout_percent"]
     assert re.search(
-        r"^the torque offsets differ between recordings \(sensors re-zeroed at power-up\?\): "
-        r"joint1: rec1 \+0\.\d+, rec2 \+0\.\d+, .* N m; fitted one per recording; a new "
-        r"recording's offset is unknown to the model \(held-out error [0-9.]+ %; with each "
-        r"held-out recording's own offset [0-9.]+ %\)$",
+        r"^the torque offsets differ between recordings \(sensors re-zeroed at power-up\?\) on "
+        r"2 joint\(s\), most on joint\d [+-]0\.\d+ to [+-]0\.\d+, joint\d [+-]0\.\d+ to "
+        r"[+-]0\.\d+ N m over the recordings; fitted one per recording "
+        r"\(metadata\.recording_offsets\); a new recording's offset is unknown to the model "
+        r"\(held-out error [0-9.]+ %; with each held-out recording's own offset [0-9.]+ %\)$",
         rec["note"],
     )
 

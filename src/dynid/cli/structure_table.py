@@ -46,6 +46,7 @@ def selection_lines(selection: Any) -> list[str]:
     out = [
         f"model structure chosen on held-out data ({selection['validation']}): "
         f"{selection['chosen']} ({selection['rule']})",
+        *_own_offsets_line(selection.get("heldout_own_offsets") or ()),
         *_determined_line(selection.get("kept_determined") or ()),
         f"    {'structure':<{w}} {'params':>6} {'train %':>9} {'held-out %':>11}"
         + (f" {'whitened %':>11}" if white else "")
@@ -75,6 +76,19 @@ def selection_lines(selection: Any) -> list[str]:
     out += per_recording_lines(selection, "  ")
     out += [f"  note: {line}" for line in selection.get("notes", ())]
     return out
+
+
+def _own_offsets_line(joints: Sequence[str]) -> list[str]:
+    """Under the table's header, where the recordings' torque offsets were fitted one per
+    recording (``joints``: those whose offsets differ), that its held-out errors read each
+    held-out recording with its own offset there."""
+    if not joints:
+        return []
+    return [
+        "  held-out errors below with each held-out recording's own torque offset on "
+        f"{len(joints)} joint(s) (fitted one per recording: the note on the offsets above); "
+        "a new recording's offset is unknown to the model, its error higher"
+    ]
 
 
 def per_recording_lines(record: Any, indent: str = "", given: bool = False) -> list[str]:

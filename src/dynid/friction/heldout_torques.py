@@ -61,6 +61,7 @@ from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.model_sign import gravity_loaded
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
+from ..identification.recording_level import RecordingLevels, recording_levels
 from ..identification.residual_dependence import (
     BINS,
     MIN_PER_BIN,
@@ -180,6 +181,11 @@ class HeldOutTorques:
         (:mod:`~dynid.identification.fold_spread`: every recording predicted by the fit
         of the others); a part of the floor. None: not counted (the model itself
         predicts, or its columns are not the folds').
+    recording : ndarray of int, shape (N,), or None
+        Each held-out sample's recording, where every recording is predicted by the fit
+        of the others: a residual that is one steady constant over each is said as the
+        recordings' own torque offsets (:mod:`~dynid.identification.recording_level`),
+        as ``validate`` says it; None: one held-out block or log.
     """
 
     validation: Validation
@@ -200,6 +206,7 @@ class HeldOutTorques:
     gains: DriveGains | None = None
     robot: Robot | None = None
     fitted: tuple[tuple[int, NDArray[np.float64]], ...] | None = None
+    recording: NDArray[np.intp] | None = None
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -245,6 +252,8 @@ class HeldOutTorques:
         verdict, fl = self._judged()
         v = self.validation
         said = None if self.gains is None else self.gains.sentence()
+        own = None if said is not None else self._own_offsets(verdict)
+        verdict = with_hint(verdict, None if own is None else own.sentence(self.joint_names))
         verdict = (
             with_hint(verdict, said)
             if said is not None
@@ -263,6 +272,7 @@ class HeldOutTorques:
                 self.offsets,
                 self.left_out,
                 prismatic=None if self.robot is None else tuple(map(bool, self.robot.prismatic)),
+                levels=None if own is None else {j: own.of(j) or () for j in own.joints},
             )
         )
         if said is not None and verdict.level == "good":  # at the floor, the factors said
@@ -271,6 +281,28 @@ class HeldOutTorques:
         verdict = with_hint(verdict, self.low_speed, ", ")
         verdict = with_caveat(verdict, self.caveat)
         return with_replaced_spikes(verdict, self.spikes, ", as the fit replaced them")
+
+    def _own_offsets(self, verdict: Verdict) -> RecordingLevels | None:
+        """Above the floor, the joints whose model holds an offset and whose held-out
+        residual is one steady constant over each recording (:attr:`recording`): the
+        recordings' own torque offsets
+        (:func:`~dynid.identification.recording_level.recording_levels`); None where
+        there is none, the samples' recordings are not known or the verdict is good."""
+        rec = self.recording
+        v = self.validation
+        if verdict.level == "good" or rec is None or not self.offsets:
+            return None
+        if rec.size != v.log.tau.shape[0]:
+            return None
+        error = v.log.tau - v.tau_hat
+        ks = [int(k) for k in np.unique(rec)]
+        return recording_levels(
+            [error[rec == k] for k in ks],
+            [v.log.tau[rec == k] for k in ks],
+            ks,
+            self.noise_rms,
+            tuple(self.offsets),
+        )
 
     @property
     def systematic(self) -> tuple[Dependence, ...]:
@@ -615,6 +647,7 @@ def _held_out(
     held = HeldOutTorques(
         v, noise, block, names, read, given, caveat, spikes, inputs, held_terms(model),
         offsets=offsets_of(model), left_out=friction_left_out(model), robot=model.robot,
+        recording=folds if folds is not None and folds.size == v.log.q.shape[0] else None,
     )  # fmt: skip
     verdict, floor = held._judged()
     total = floor.total_rms

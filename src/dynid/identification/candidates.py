@@ -289,6 +289,10 @@ class Selection:
         The spring candidate tried where the chosen structure's held-out residual names a
         joint spring (:mod:`~dynid.identification.spring_candidate`): its joints, the
         structure, its held-out error and whether it was chosen; empty when none was tried.
+    differing : tuple of dict
+        The recordings, not outlying, whose held-out error over their noise floor stands
+        clearly above the others' (:mod:`~dynid.identification.differing_recording`):
+        named in a note, fitted still; each one's record.
     """
 
     candidates: tuple[Candidate, ...]
@@ -301,6 +305,7 @@ class Selection:
     determined: tuple[tuple[str, float], ...] = ()
     cut: tuple[tuple[str, tuple[tuple[float, float], ...]], ...] = ()
     spring: tuple[tuple[str, Any], ...] = ()
+    differing: tuple[dict[str, Any], ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready (``identification.json``'s ``metadata.selection``)."""
@@ -318,6 +323,7 @@ class Selection:
                 {"coefficient": lab, "std_percent": r} for lab, r in self.determined
             ],
             "cut_out_spans": cut_record(self.cut),
+            "differing_recordings": list(self.differing),
         } | ({"spring_candidate": dict(self.spring)} if self.spring else {})
 
 

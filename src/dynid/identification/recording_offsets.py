@@ -51,6 +51,9 @@ NOISE_FRACTION = 0.5
 #: ... and by more than this share of the joint's torque RMS (logs without noise).
 RMS_FRACTION = 5e-3
 
+#: The joints whose offsets differ most named in the note (the rest in the record).
+NAMED = 3
+
 _OFFSET = re.compile(r"fo([0-9]+)")
 
 
@@ -98,18 +101,24 @@ class RecordingOffsets:
         return bool(self.joints)
 
     def sentence(self, joint_names: Sequence[str]) -> str:
-        """One plain line: the offsets per joint and recording, and the held-out errors."""
-        short = [n.rsplit("/", 1)[-1].removesuffix(".csv") for n in self.names]
-        per = "; ".join(
-            f"{joint_names[j]}: "
-            + ", ".join(f"{s} {self.offsets[r, j]:+.3g}" for r, s in enumerate(short))
-            for j in self.joints
+        """One plain line: the :data:`NAMED` joints whose offsets differ most between the
+        recordings (their range [N m]; every offset in :meth:`as_dict`), and the held-out
+        errors."""
+        rng = {j: float(np.ptp(self.offsets[:, j])) for j in self.joints}
+        top = sorted(self.joints, key=lambda j: -rng[j])[:NAMED]
+        per = ", ".join(
+            f"{joint_names[j]} {self.offsets[:, j].min():+.2g} to {self.offsets[:, j].max():+.2g}"
+            for j in top
         )
+        more = len(self.joints) - len(top)
         return (
-            "the torque offsets differ between recordings (sensors re-zeroed at power-up?): "
-            f"{per} N m; fitted one per recording; a new recording's offset is unknown to the "
-            f"model (held-out error {self.heldout_percent:.3g} %; with each held-out "
-            f"recording's own offset {self.own_percent:.3g} %)"
+            "the torque offsets differ between recordings (sensors re-zeroed at power-up?) on "
+            f"{len(self.joints)} joint(s), most on {per} N m"
+            + (f" and {more} more joint(s)" if more > 0 else "")
+            + " over the recordings; fitted one per recording (metadata.recording_offsets); a "
+            "new recording's offset is unknown to the model (held-out error "
+            f"{self.heldout_percent:.3g} %; with each held-out recording's own offset "
+            f"{self.own_percent:.3g} %)"
         )
 
     def as_dict(self, joint_names: Sequence[str]) -> dict[str, Any]:
@@ -361,15 +370,20 @@ def _fitted_indices(model: IdentifiedModel, count: int) -> list[int]:
 def _recorded(
     model: IdentifiedModel, found: RecordingOffsets, which: Sequence[int]
 ) -> IdentifiedModel:
-    """``model`` with ``found`` in its record: ``metadata.recording_offsets`` and each
-    fitted recording's ``torque_offset`` per joint [N m]."""
+    """``model`` with ``found`` in its record: ``metadata.recording_offsets``, each
+    fitted recording's ``torque_offset`` per joint [N m], and in ``metadata.selection``
+    (``heldout_own_offsets``: those joints) that its held-out errors were read with each
+    recording's own offset (the structure chosen on the recordings shifted by theirs)."""
     joints = model.robot.joint_names
     recs = [dict(r) for r in model.info.recordings or ()]
     for r, i in enumerate(which):
         if i < len(recs):
             recs[i]["torque_offset"] = {joints[j]: float(found.offsets[r, j]) for j in found.joints}
     extra = {**model.info.extra, "recording_offsets": found.as_dict(joints)}
-    info = dataclasses.replace(model.info, extra=extra, recordings=tuple(recs))
+    selection = model.info.selection
+    if selection is not None:
+        selection = {**selection, "heldout_own_offsets": [joints[j] for j in found.joints]}
+    info = dataclasses.replace(model.info, extra=extra, recordings=tuple(recs), selection=selection)
     return dataclasses.replace(model, info=info)
 
 

@@ -88,6 +88,7 @@ from .candidates import (
     without_recordings,
 )
 from .core import model_advice, model_columns, shared_bases
+from .differing_recording import with_differing
 from .dissipation import (
     ReversedSignError,
     Violation,
@@ -1227,7 +1228,7 @@ def identify_recordings(
         )  # fmt: skip
     _warned(model, terms)
     if selection is not None and structure == selection.chosen:
-        selection = _per_recording_of(model, selection, gone)
+        selection = with_differing(_per_recording_of(model, selection, gone), data)
     heldout = _heldout_record(model, fitted if validation is None else validation)
     combined = _combined(robot, fitted, structure, drive, model.base)
     model = _recorded(model, exact, combined, heldout, structure, selection, given)

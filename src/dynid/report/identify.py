@@ -908,12 +908,27 @@ def _structure_section(doc: dict) -> str:
     rule = f"Rule: {esc(sel.get('rule', ''))}; validation: {esc(sel.get('validation', ''))}."
     kept = determined_sentence(sel.get("kept_determined"))
     rule += "" if kept is None else f" {esc(capitalised(kept))}."
+    if own := sel.get("heldout_own_offsets"):  # the recordings' offsets fitted one each
+        rule += (
+            " The held-out errors hold each held-out recording's own torque offset on "
+            f"{len(own)} joint(s) (fitted one per recording); a new recording's offset is "
+            "unknown to the model, its error higher."
+        )
     parts = [f"<p>{rule}</p>", table(headers, rows, marked=marked)]
     per = _per_recording_table(doc, sel, "chosen structure", judged=True)
     if per:
         parts.append(per)
-        disagree = [n for n in sel.get("notes") or () if str(n).startswith(DISAGREE_NOTE)]
-        parts += [f"<p>{esc(capitalised(str(n)))}.</p>" for n in disagree]
+        differ = tuple(
+            f"{d.get('file')}: held-out error"
+            for d in sel.get("differing_recordings") or ()
+            if isinstance(d, dict)
+        )
+        said = [
+            n
+            for n in sel.get("notes") or ()
+            if str(n).startswith(DISAGREE_NOTE) or (differ and str(n).startswith(differ))
+        ]
+        parts += [f"<p>{esc(capitalised(str(n)))}.</p>" for n in said]
     return section("structure", "Model structure", *parts)
 
 
@@ -937,11 +952,16 @@ def _per_recording_table(doc: dict, record: dict, what: str, judged: bool = Fals
     if not per:
         return ""
     odd = set(record.get("outlying_recordings") or ())
+    differ = {
+        d.get("file") for d in record.get("differing_recordings") or () if isinstance(d, dict)
+    }
     recs = _get(doc, "metadata", "recordings") or ()
     out = {r.get("file") for r in recs if isinstance(r, dict) and r.get("left_out")}
     cut = {r.get("file") for r in recs if isinstance(r, dict) and r.get("cut_out")}
 
     def said(name: Any) -> str:
+        if name in differ:
+            return "clearly above the others' (not outlying): fitted, named in a note"
         if name not in odd:
             return ""
         if name in cut:
@@ -954,10 +974,10 @@ def _per_recording_table(doc: dict, record: dict, what: str, judged: bool = Fals
 
     rows = [
         [esc(r.get("file", "")), cell(r.get("heldout_error_percent"))]
-        + ([said(r.get("file"))] if odd else [])
+        + ([said(r.get("file"))] if odd or differ else [])
         for r in per
     ]
-    head = ["recording", "held-out error [%]"] + (["judgement"] if odd else [])
+    head = ["recording", "held-out error [%]"] + (["judgement"] if odd or differ else [])
     return f"<p>Held-out error of the {what} per recording (fitted on the others).</p>" + table(
         head, rows
     )
