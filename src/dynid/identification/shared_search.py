@@ -72,7 +72,7 @@ def once(what: str, objects: tuple[Any, ...], values: tuple[Any, ...], make: Cal
     got = held.get(key)
     if got is not None and all(a is b for a, b in zip(got[0], objects, strict=True)):
         _said(got[2])
-        return got[1]  # type: ignore[no-any-return]
+        return got[1]
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         try:
