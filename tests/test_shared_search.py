@@ -55,7 +55,7 @@ def _counted(monkeypatch):
 
 def test_the_spring_search_reads_back_the_first_and_chooses_as_made_again(monkeypatch):
     """Regression: the spring's trial made the whole identification again, the search
-    without the spring inside it (a Baxter's run 39 s against 15 s without the trial).
+    without the spring inside it (a Baxter's run 20 s against 9 s without the trial).
     Within one shared block, after the search without a spring, the search with a spring
     on joint 2 prepares no recording again and fits only the spring's candidates (one
     search more, not two); its choice, table and coefficients equal those of the same
