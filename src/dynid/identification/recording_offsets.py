@@ -40,8 +40,9 @@ from .core import model_columns
 from .log import TorqueLog
 from .log_rows import log_blocks
 from .model import IdentifiedModel
-from .recordings import Recordings, prepare_recordings
+from .recordings import Recordings
 from .selection import fitted_logs, identify_recordings
+from .shared_search import prepared_once
 from .streaming import streams
 
 #: A recording's offset differs where it lies this many standard errors from the mean.
@@ -354,7 +355,7 @@ def _prepared(
     cutoff = None if model.info.log is None else model.info.log.cutoff_hz
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return prepare_recordings(
+        return prepared_once(
             robot, fitted_logs(model, logs), [names[i] for i in which], cutoff_hz=cutoff, **prep
         )
 
