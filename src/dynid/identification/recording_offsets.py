@@ -40,9 +40,8 @@ from .core import model_columns
 from .log import TorqueLog
 from .log_rows import log_blocks
 from .model import IdentifiedModel
-from .recordings import Recordings
+from .recordings import Recordings, prepare_recordings
 from .selection import fitted_logs, identify_recordings
-from .shared_search import prepared_once
 from .streaming import streams
 
 #: A recording's offset differs where it lies this many standard errors from the mean.
@@ -355,7 +354,7 @@ def _prepared(
     cutoff = None if model.info.log is None else model.info.log.cutoff_hz
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return prepared_once(
+        return prepare_recordings(
             robot, fitted_logs(model, logs), [names[i] for i in which], cutoff_hz=cutoff, **prep
         )
 

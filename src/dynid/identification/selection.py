@@ -128,7 +128,6 @@ from .outlying_spans import Span
 from .recordings import Recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
-from .shared_search import once
 from .spring_candidate import tried_joints, with_spring
 from .stribeck_joints import per_joint_vst
 from .structural import absorbed_by
@@ -240,6 +239,9 @@ def _lacks(c: Candidate, best: Candidate) -> dict[str, float]:
     return {lab: r for lab, r in best.determined().items() if lab not in held}
 
 
+@shared_steps()
+@shared_bases()
+@shared_eigen()
 def select_structure(
     robot: Robot,
     data: Recordings,
@@ -280,35 +282,8 @@ def select_structure(
     Returns
     -------
     Selection or None
-        None when the data are too short for held-out judgement. Within
-        :func:`~.shared_search.shared_searches`, the search of the same recordings and
-        options made once (:func:`~.shared_search.once`): a spring's search after it.
+        None when the data are too short for held-out judgement.
     """
-    search = partial(
-        _searched, robot, data, drive=drive, candidates=candidates, estimator=estimator,
-        folds=folds, validation=validation, rtol=rtol, per_joint=per_joint, keep=keep,
-    )  # fmt: skip
-    objects = (robot, data, validation, drive)
-    return once("structure", objects, (candidates, estimator, folds, rtol, per_joint, keep), search)
-
-
-@shared_steps()
-@shared_bases()
-@shared_eigen()
-def _searched(
-    robot: Robot,
-    data: Recordings,
-    *,
-    drive: Drive | None,
-    candidates: Sequence[Structure] | None,
-    estimator: EstimatorName | Estimator,
-    folds: int,
-    validation: Recordings | None,
-    rtol: float | None,
-    per_joint: bool,
-    keep: bool | None,
-) -> Selection | None:
-    """:func:`select_structure`, made (its arguments)."""
     est = estimator_named(estimator)
     armature_ok = drive is None or drive.identifies_rotor_inertia
     cands = (

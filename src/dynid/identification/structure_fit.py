@@ -24,8 +24,7 @@ from .judge import heldout_judge
 from .largest import limits_middle, recording_bands
 from .log import TorqueLog
 from .model import IdentifiedModel
-from .recordings import Recordings
-from .shared_search import prepared_once
+from .recordings import Recordings, prepare_recordings
 from .structure import Structure, structure_terms
 
 
@@ -98,8 +97,8 @@ def _recordings(
 ) -> tuple[Recordings, Recordings | None]:
     """The recordings prepared (:func:`~.recordings.prepare_recordings` with ``kw``) and the
     separate recording ``validate_on`` prepared as they are (their cut-off and decimation)."""
-    data = prepared_once(robot, logs, names, drive, **kw)
+    data = prepare_recordings(robot, logs, names, drive=drive, **kw)
     if validate_on is None:
         return data, None
     same = {**kw, "cutoff_hz": data.cutoff_hz, "decimate": data.pieces[0].decimate}
-    return data, prepared_once(robot, [validate_on], ["validation log"], drive, **same)
+    return data, prepare_recordings(robot, [validate_on], ["validation log"], drive=drive, **same)

@@ -71,7 +71,6 @@ from ..identification.motor_constants import shared_gear_ratio
 from ..identification.recording_offsets import identify_with_offsets
 from ..identification.residual_dependence import outside_model_note, round_off_note
 from ..identification.selection import fitted_logs, identify_recordings
-from ..identification.shared_search import shared_searches
 from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
@@ -855,17 +854,13 @@ def _searched(
     efforts corrected by the factors the richest structure names
     (:func:`~dynid.workflows.gains_first.gains_first`: its factors are the held-out
     verdict's), fitted to those efforts (its drive's torque constants times the factors),
-    with a note saying so; the first model's warnings said only when it is kept. A spring
-    the held-out residual names is judged by a search made again (:func:`_spring_judged`)
-    that reads back what the first computed (:func:`~dynid.identification.shared_search.
-    shared_searches`)."""
+    with a note saying so; the first model's warnings said only when it is kept."""
     current = drive is not None and drive.effort == "current"
     if structure != "auto" or not current:
-        with shared_searches():
-            model = fitted(structure, drive)
-            held = _predicted_heldout(model, logs, separate)
-            if structure == "auto":
-                model, held = _spring_judged(fitted, model, held, drive, logs, separate)
+        model = fitted(structure, drive)
+        held = _predicted_heldout(model, logs, separate)
+        if structure == "auto":
+            model, held = _spring_judged(fitted, model, held, drive, logs, separate)
         return model, held, None
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
