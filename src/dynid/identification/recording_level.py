@@ -143,8 +143,8 @@ def recording_levels(
     if not t2 > 0:
         return None
     pct = 100 * float(np.sqrt(e2 / t2))
-    own = 100 * float(np.sqrt(own2 / t2))
-    return RecordingLevels(found, levels, pct, own, tuple(sorted(set(rec))))
+    own_pct = 100 * float(np.sqrt(own2 / t2))
+    return RecordingLevels(found, levels, pct, own_pct, tuple(sorted(set(rec))))
 
 
 def rest_ratios(

@@ -203,10 +203,10 @@ def _dependence_said(
     own = None if verdict.level == "good" else _own_offsets(val, error, tau, noise.sensor, offsets)
     verdict = with_hint(verdict, None if own is None else own.sentence(names))
     levels = None if own is None else {j: own.of(j) or () for j in own.joints}
-    rest = error if own is None else _rest(own, error, getattr(val.pieces, "recording", ()))
+    left = error if own is None else _rest(own, error, getattr(val.pieces, "recording", ()))
     verdict = with_dependence_hint(
-        verdict, q, dq, rest, noise.total, names, terms, tilt,
-        rest_ratios(noise.ratios, error, rest), springs, tau, offsets, left_out, ddq, inertia,
+        verdict, q, dq, left, noise.total, names, terms, tilt,
+        rest_ratios(noise.ratios, error, left), springs, tau, offsets, left_out, ddq, inertia,
         lacks, kinds, levels,
     )  # fmt: skip
     return ResidualHints(verdict, springs, None, tilt, load)
