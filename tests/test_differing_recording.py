@@ -27,7 +27,6 @@ from dynid.friction.model import ClassicalFriction
 from dynid.identification.differing_recording import NOTE_Z, differing_recording
 from dynid.identification.recording_offsets import RecordingOffsets, identify_with_offsets
 from dynid.identification.selection import identify_recordings
-from dynid.identification.structure import Structure
 from dynid.report.identify import _structure_section
 from dynid.simulation.measurement import SensorNoise
 
@@ -186,36 +185,3 @@ def test_identify_verdict_tells_a_recordings_constant_residual_as_its_own_offset
     assert verdict.level != "good"
     assert "with the recording's own torque offsets" in verdict.reason
     assert "a level that changes along the motion" not in verdict.reason
-
-
-def test_identify_verdict_diagnoses_what_the_recordings_own_offsets_leave(shifted):
-    """Regression: after the recording's own offsets, identify's held-out verdict read
-    each joint's residual with them still in it and suggested a spring on both joints of a
-    planar arm (-26 and 0.72 N m/rad); now what they leave is diagnosed (the noise)."""
-    model, logs = shifted
-    reason = heldout_torques(model, logs[-1], others=logs[:-1]).verdict.reason
-    assert "with the recording's own torque offsets" in reason
-    assert "follows its position" not in reason and "spring" not in reason
-
-
-def test_a_true_spring_is_still_suggested_where_the_offsets_differ(arm):
-    """A spring of -3 N m/rad on joint 2 (no spring term) beside offsets that differ: the
-    held-out verdict still names it on joint 2 (the links take a share of it)."""
-    friction = ClassicalFriction(FV, np.zeros(2), np.zeros(2))
-    logs = []
-    for k in range(4):
-        (log,) = recordings(
-            arm, [k + 1], friction=friction, duration=3.0, fs=200.0, noise=SensorNoise(),
-            added=lambda log, o=OFFSETS[k]: o + np.outer(log.q[:, 1], [0.0, -3.0]),
-        )  # fmt: skip
-        logs.append(log)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        model = identify_with_offsets(
-            arm, logs, NAMES, structure=Structure(friction=("viscous", "offset"))
-        )
-    assert "recording_offsets" in model.info.extra
-    reason = heldout_torques(model, logs[-1], others=logs[:-1]).verdict.reason
-    assert "joint2: " in reason
-    said = reason.split("joint2: ")[1]
-    assert "follows its position: a spring of about -2" in said

@@ -170,9 +170,8 @@ def test_the_summary_says_the_offsets_in_one_line(differing):
 
 def test_validate_gives_the_error_with_the_recording_s_own_offset(arm, differing, tmp_path):
     """A new recording whose offsets differ from the model's by 0.3-0.4 N m: the verdict
-    gives its error with them removed beside the error, then diagnoses what they leave:
-    not a level that changes along the motion, nor a spring (before: the constant was
-    diagnosed again in each joint's clause)."""
+    gives its error with them removed beside the error, and tells each joint's constant
+    as the recording's offset, not a level that changes along the motion."""
     from dynid.io.torque_log import save_torque_log
     from dynid.workflows.validate import validate_files
 
@@ -186,76 +185,5 @@ def test_validate_gives_the_error_with_the_recording_s_own_offset(arm, differing
     assert abs(float(f"0.{got[1]}") - (0.6 - OFFSETS[:, 0].mean())) < 0.05
     own, whole = re.search(r"the error is ([0-9.]+) % \(of ([0-9.]+) %\)", reason).groups()
     assert float(own) < 0.5 * float(whole)
+    assert "is one constant over the recording: its torque offset differs" in reason
     assert "a level that changes along the motion" not in reason
-    assert "is one constant over the recording" not in reason
-    assert "follows its position" not in reason
-
-
-#: Offsets that differ about a mean of zero [N m]: a shared offset predicts held-out
-#: recordings no better, so the structure leaves it out.
-ZERO_MEAN = np.array([[0.3, 0.3], [-0.3, -0.3], [0.1, 0.1], [-0.1, -0.1]])
-NO_OFFSET = Structure(friction=("viscous", "coulomb"))
-
-
-def _fitted_in(arm, offsets, structure, fit=identify_with_offsets):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        return fit(arm, _logs(arm, offsets), NAMES, structure=structure)
-
-
-@pytest.fixture(scope="module")
-def zero_mean(arm):
-    return _fitted_in(arm, ZERO_MEAN, NO_OFFSET)
-
-
-def test_offsets_about_zero_are_fitted_though_the_structure_holds_none(arm, zero_mean):
-    """A structure without the offset: each recording's offset comes back within 0.04 N m,
-    the refit holds the offset (their mean, near zero) and the viscous coefficients within
-    6 % of the true ones (-5 % and -1 %; -5 % and +1 % for the same motions without
-    offsets); before, no offset was fitted and fv came back -134 % and +70 % off."""
-    rec = zero_mean.info.extra["recording_offsets"]
-    assert rec["joints"] == list(zero_mean.robot.joint_names)
-    np.testing.assert_allclose(np.array(rec["offsets"]), ZERO_MEAN, atol=0.04)
-    assert "offset" in zero_mean.info.extra["terms"]
-    np.testing.assert_allclose(zero_mean.friction.params[:, -1], rec["mean"], atol=0.005)
-    np.testing.assert_allclose(zero_mean.friction.params[:, -1], 0.0, atol=0.04)
-    np.testing.assert_allclose(_fv(zero_mean), FV, rtol=0.06)
-    before = _fitted_in(arm, ZERO_MEAN, NO_OFFSET, identify_recordings)
-    assert np.max(np.abs(_fv(before) / FV - 1)) > 0.5
-
-
-def test_offsets_about_zero_are_fitted_after_the_structure_search(arm):
-    """The structure chosen on held-out data: the viscous coefficients within 6 % of the
-    true ones with one offset per recording fitted; before, the search chose an armature
-    and an offset of -1.7 N m in their place (fv 100 % off), which the check skipped."""
-    got = _fitted_in(arm, ZERO_MEAN, "auto")
-    assert "recording_offsets" in got.info.extra
-    np.testing.assert_allclose(_fv(got), FV, rtol=0.06)
-    before = _fitted_in(arm, ZERO_MEAN, "auto", identify_recordings)
-    assert np.max(np.abs(_fv(before) / FV - 1)) > 0.5
-
-
-def test_nothing_fires_on_one_shared_offset_the_structure_lacks(arm):
-    """Recordings sharing one offset, a structure without it: no record, the structure
-    as given."""
-    got = _fitted_in(arm, np.tile([0.3, -0.2], (len(NAMES), 1)), NO_OFFSET)
-    assert "recording_offsets" not in got.info.extra
-    assert "offset" not in got.info.extra["terms"]
-
-
-def test_validate_judges_what_the_recordings_own_offsets_leave(arm, differing, tmp_path):
-    """Three new recordings whose offsets differ from the model's by up to 0.5 N m: the
-    verdict gives the error with them removed and then diagnoses what they leave (the
-    noise), no spring; before, it read the constants pooled over the recordings' motions
-    as a spring on each joint."""
-    from dynid.io.torque_log import save_torque_log
-    from dynid.workflows.validate import validate_files
-
-    new = np.array([[0.8, -0.5], [-0.2, 0.4], [0.4, 0.0]])
-    logs = _logs(arm, new)
-    paths = [save_torque_log(tmp_path / f"new{k}.csv", log) for k, log in enumerate(logs)]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DynidWarning)
-        reason = validate_files(differing, paths).verdict.reason
-    assert "with the recording's own torque offsets" in reason
-    assert "spring" not in reason and "follows its position" not in reason

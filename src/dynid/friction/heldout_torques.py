@@ -61,7 +61,7 @@ from ..identification.low_speed import low_speed_hint
 from ..identification.model import IdentifiedModel
 from ..identification.model_sign import gravity_loaded
 from ..identification.pieces import split_at_gaps, unwrapped, wrappable
-from ..identification.recording_level import RecordingLevels, recording_levels, rest_ratios
+from ..identification.recording_level import RecordingLevels, recording_levels
 from ..identification.residual_dependence import (
     BINS,
     MIN_PER_BIN,
@@ -254,7 +254,6 @@ class HeldOutTorques:
         said = None if self.gains is None else self.gains.sentence()
         own = None if said is not None else self._own_offsets(verdict)
         verdict = with_hint(verdict, None if own is None else own.sentence(self.joint_names))
-        rest = self._rest(own)  # what each recording's own offset leaves
         verdict = (
             with_hint(verdict, said)
             if said is not None
@@ -262,12 +261,12 @@ class HeldOutTorques:
                 verdict,
                 [v.log.q],
                 [v.log.dq],
-                [rest],
+                [v.log.tau - v.tau_hat],
                 fl.total_rms,
                 self.joint_names,
                 self.terms,
                 self.tilt,
-                rest_ratios(fl.joint_ratios, [v.log.tau - v.tau_hat], [rest]),
+                fl.joint_ratios,
                 self.springs,
                 [v.log.tau],
                 self.offsets,
@@ -282,19 +281,6 @@ class HeldOutTorques:
         verdict = with_hint(verdict, self.low_speed, ", ")
         verdict = with_caveat(verdict, self.caveat)
         return with_replaced_spikes(verdict, self.spikes, ", as the fit replaced them")
-
-    def _rest(self, own: RecordingLevels | None) -> NDArray[np.float64]:
-        """The held-out residual [N m], less each recording's own offset where ``own``
-        found them (:meth:`~dynid.identification.recording_level.RecordingLevels.removed`)."""
-        v = self.validation
-        error = v.log.tau - v.tau_hat
-        rec = self.recording
-        if own is None or rec is None or rec.size != error.shape[0]:
-            return error
-        rest = error.copy()
-        for k in np.unique(rec):
-            rest[rec == k] = own.removed(error[rec == k], int(k))
-        return rest
 
     def _own_offsets(self, verdict: Verdict) -> RecordingLevels | None:
         """Above the floor, the joints whose model holds an offset and whose held-out

@@ -8,10 +8,7 @@ recording's quarters differs. :func:`recording_levels` finds, per joint, the rec
 whose residual is steady (the means of :data:`SEGMENTS` consecutive parts within
 :data:`STEADY` of the whole mean) and above a practical size (:data:`NOISE_FRACTION` of the
 joint's noise), and the error with those constants removed; :func:`level_clause` says one
-joint's in words. What each joint's residual follows is then judged on what the constants
-leave (:meth:`RecordingLevels.removed`, :func:`rest_ratios`): a recording's constant read
-with the motion of several recordings pooled looks like a dependence on position (a
-spring suggested on each joint of a planar arm whose offsets differ).
+joint's in words.
 """
 
 from __future__ import annotations
@@ -44,27 +41,12 @@ class RecordingLevels:
         The relative RMS error [%] over every sample (every joint) as judged.
     own_percent : float
         The same with each recording's constant removed on ``joints``.
-    recordings : tuple of int
-        The recording of each row of ``levels`` (as given to :func:`recording_levels`).
     """
 
     joints: tuple[int, ...]
     levels: NDArray[np.float64]
     percent: float
     own_percent: float
-    recordings: tuple[int, ...] = ()
-
-    def removed(self, error: NDArray[np.float64], recording: int) -> NDArray[np.float64]:
-        """``error`` (N, n) [N m] of the recording ``recording`` less its constant on
-        :attr:`joints` (unchanged for a recording not judged)."""
-        e = np.asarray(error, dtype=np.float64)
-        if recording not in self.recordings:
-            return e
-        row = self.recordings.index(recording)
-        at = list(self.joints)
-        level = np.zeros(e.shape[-1])
-        level[at] = self.levels[row, at]
-        return e - level
 
     def of(self, joint: int) -> tuple[float, ...] | None:
         """Joint ``joint``'s constant per recording [N m], None where it is no offset."""
@@ -143,27 +125,7 @@ def recording_levels(
     if not t2 > 0:
         return None
     pct = 100 * float(np.sqrt(e2 / t2))
-    own_pct = 100 * float(np.sqrt(own2 / t2))
-    return RecordingLevels(found, levels, pct, own_pct, tuple(sorted(set(rec))))
-
-
-def rest_ratios(
-    ratios: NDArray[np.float64] | None,
-    error: Sequence[NDArray[np.float64]],
-    rest: Sequence[NDArray[np.float64]],
-) -> NDArray[np.float64] | None:
-    """Each joint's error over its noise (``ratios``, the verdict's: None for none) for
-    what the recordings' constants leave: scaled by the RMS of ``rest`` over that of
-    ``error`` (pieces, N m), so that the joints diagnosed are those whose rest is still
-    above their noise."""
-    if ratios is None:
-        return None
-    e = np.concatenate([np.asarray(x, dtype=np.float64) for x in error])
-    r = np.concatenate([np.asarray(x, dtype=np.float64) for x in rest])
-    whole = np.sqrt(np.mean(e**2, axis=0))
-    left = np.sqrt(np.mean(r**2, axis=0))
-    scale = np.divide(left, whole, out=np.ones_like(whole), where=whole > 0)
-    return np.asarray(ratios, dtype=np.float64) * scale
+    return RecordingLevels(found, levels, pct, 100 * float(np.sqrt(own2 / t2)))
 
 
 def level_clause(

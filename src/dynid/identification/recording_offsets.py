@@ -43,7 +43,6 @@ from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
 from .selection import fitted_logs, identify_recordings
 from .streaming import streams
-from .structure import Structure
 
 #: A recording's offset differs where it lies this many standard errors from the mean.
 Z_SCORE = 4.0
@@ -158,7 +157,7 @@ def _rows(
     model's columns cannot be rebuilt (a drive, columns that do not match its fit) or
     their rows would not stack in memory (:func:`~.streaming.streams`, with one column per
     recording and joint more)."""
-    if model.drive is not None and not model.drive.is_bare:  # a bare one: the armature's
+    if model.drive is not None:
         return None
     columns = model_columns(
         robot, data, terms=tuple(t.term for t in model.terms.values()), base=model.base
@@ -388,54 +387,6 @@ def _recorded(
     return dataclasses.replace(model, info=info)
 
 
-def _given(model: IdentifiedModel, found: RecordingOffsets) -> Structure | None:
-    """``model``'s structure (its record of its terms) holding the offset on the joints
-    whose offsets differ (``found``): a new recording's is their mean; None where the
-    model does not record its terms."""
-    s = _given_as_is(model)
-    if s is None:
-        return None
-    keep = {f"fo{j + 1}" for j in found.joints}
-    if "offset" in s.friction:
-        return dataclasses.replace(s, drop=tuple(d for d in s.drop if d not in keep))
-    drop = tuple(f"fo{j + 1}" for j in range(model.robot.n) if f"fo{j + 1}" not in keep)
-    return dataclasses.replace(s, friction=(*s.friction, "offset"), drop=s.drop + drop)
-
-
-def _given_as_is(model: IdentifiedModel) -> Structure | None:
-    """``model``'s structure as it records it (None where it does not)."""
-    terms = model.info.extra.get("terms")
-    return None if terms is None else Structure.parse(",".join(str(t) for t in terms))
-
-
-def _holding_offsets(
-    robot: Robot,
-    model: IdentifiedModel,
-    logs: Sequence[TorqueLog],
-    names: Sequence[str],
-    found: RecordingOffsets,
-    fit: Callable[..., IdentifiedModel],
-    kw: dict[str, Any],
-) -> IdentifiedModel:
-    """``model`` (fitted on the shifted ``logs``) where its structure holds the offset on
-    each joint whose offsets differ (``found``), else fitted again on ``logs`` with the
-    offset added there (:func:`_given`): the offsets are one per recording and joint, the
-    model's a new recording's (their mean, however near zero)."""
-    given = _given(model, found)
-    if given is None or given == _given_as_is(model):
-        return model
-    return _searched(fit(robot, logs, names, **{**kw, "structure": given}), model)
-
-
-def _searched(model: IdentifiedModel, searched: IdentifiedModel) -> IdentifiedModel:
-    """``model`` (its structure given) with the record of the structure search of
-    ``searched`` (``metadata.selection``) where it has none of its own."""
-    if model.info.selection is not None or searched.info.selection is None:
-        return model
-    info = dataclasses.replace(model.info, selection=searched.info.selection)
-    return dataclasses.replace(model, info=info)
-
-
 def identify_with_offsets(
     robot: Robot,
     logs: Sequence[TorqueLog],
@@ -456,25 +407,17 @@ def identify_with_offsets(
     names = list(names) if names is not None else [f"log{k + 1}" for k in range(len(logs))]
     found, which = None, _fitted_indices(model, len(logs))
     applies = kw.get("drive") is None and kw.get("validate_on") is None
-    if applies and len(which) >= 3:  # with or without the offset in its structure
+    if applies and len(which) >= 3 and "offset" in model.info.extra.get("terms", ()):
         found = recording_offsets(robot, model, _prepared(robot, model, logs, names, which, kw))
     if found is None or not found.differ:
         for w in said:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return model
-    shifted = shifted_logs(logs, which, found)
-    refit = _holding_offsets(
-        robot, fit(robot, shifted, names, **kw), shifted, names, found, fit, kw
-    )
+    refit = fit(robot, shifted_logs(logs, which, found), names, **kw)
     again_which = _fitted_indices(refit, len(logs))
     if len(again_which) >= 3:
         data = _prepared(robot, refit, logs, names, again_which, kw)
         again = recording_offsets(robot, refit, data)
         if again is not None and again.differ:
-            moved = np.max(np.abs(again.offsets - found.offsets)) > np.min(again.tolerance)
             found, which = again, again_which
-            if moved:  # the first structure's offsets were off: once more on its own
-                shifted = shifted_logs(logs, which, found)
-                given = _given(refit, found) or "auto"
-                refit = _searched(fit(robot, shifted, names, **{**kw, "structure": given}), refit)
     return _recorded(refit, found, which)

@@ -29,7 +29,7 @@ from ..identification.gravity_tilt import GravityTilt
 from ..identification.log import TorqueLog
 from ..identification.low_speed import with_low_speed_hint
 from ..identification.model import IdentifiedModel
-from ..identification.recording_level import RecordingLevels, recording_levels, rest_ratios
+from ..identification.recording_level import RecordingLevels, recording_levels
 from ..identification.residual_dependence import (
     dependence_hint,
     friction_left_out,
@@ -203,24 +203,11 @@ def _dependence_said(
     own = None if verdict.level == "good" else _own_offsets(val, error, tau, noise.sensor, offsets)
     verdict = with_hint(verdict, None if own is None else own.sentence(names))
     levels = None if own is None else {j: own.of(j) or () for j in own.joints}
-    left = error if own is None else _rest(own, error, getattr(val.pieces, "recording", ()))
     verdict = with_dependence_hint(
-        verdict, q, dq, left, noise.total, names, terms, tilt,
-        rest_ratios(noise.ratios, error, left), springs, tau, offsets, left_out, ddq, inertia,
-        lacks, kinds, levels,
+        verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
+        tau, offsets, left_out, ddq, inertia, lacks, kinds, levels,
     )  # fmt: skip
     return ResidualHints(verdict, springs, None, tilt, load)
-
-
-def _rest(
-    own: RecordingLevels, error: Sequence[NDArray[np.float64]], recording: Sequence[int]
-) -> list[NDArray[np.float64]]:
-    """Each piece's residual ``error`` [N m] less its recording's own offset (``own``,
-    ``recording`` each piece's), so that what each joint's residual follows is judged on
-    what the offsets leave."""
-    if len(recording) != len(error):
-        return list(error)
-    return [own.removed(e, int(r)) for e, r in zip(error, recording, strict=True)]
 
 
 def _own_offsets(
