@@ -118,6 +118,25 @@ def _label_order(label: str) -> tuple[int, str]:
     return int(label[len(prefix) :]), prefix
 
 
+def _checked_per_joint(
+    value: float | tuple[float, ...], n: int, law: str, what: str, one: str
+) -> tuple[float, ...]:
+    """A law's shape (one for every joint, or one per joint) for each of ``n`` joints
+    (motors): :func:`_per_joint`, its count checked.
+
+    Raises
+    ------
+    OptionError
+        Values per joint given for another number of joints (naming ``--terms law:...``).
+    """
+    if not isinstance(value, float) and len(value) != n:
+        raise OptionError(
+            f"--terms {law}:{width_text(value)}: {len(value)} {what} for {n} joints "
+            f"(motors); give {one}, or one per joint separated by '/'"
+        )
+    return _per_joint(value, n)
+
+
 @dataclass(frozen=True, slots=True)
 class Structure:
     """The terms of a model beside the links' parameters.
@@ -269,14 +288,7 @@ class Structure:
         OptionError
             Widths per joint given for another number of joints.
         """
-        if isinstance(self.width, float):
-            return (self.width,) * n
-        if len(self.width) != n:
-            raise OptionError(
-                f"--terms smooth:{width_text(self.width)}: {len(self.width)} widths for {n} "
-                "joints (motors); give one width, or one per joint separated by '/'"
-            )
-        return self.width
+        return _checked_per_joint(self.width, n, "smooth", "widths", "one width")
 
     def with_width(self, joint: int, width: float, n: int) -> Structure:
         """The same structure with the smooth Coulomb of ``joint`` (0-based, of ``n``) at
@@ -293,14 +305,7 @@ class Structure:
         OptionError
             Velocities per joint given for another number of joints.
         """
-        if isinstance(self.vst, float):
-            return (self.vst,) * n
-        if len(self.vst) != n:
-            raise OptionError(
-                f"--terms stribeck:{width_text(self.vst)}: {len(self.vst)} Stribeck velocities "
-                f"for {n} joints (motors); give one, or one per joint separated by '/'"
-            )
-        return self.vst
+        return _checked_per_joint(self.vst, n, "stribeck", "Stribeck velocities", "one")
 
     def with_vst(self, joint: int, vst: float, n: int) -> Structure:
         """The same structure with the Stribeck velocity of ``joint`` (0-based, of ``n``)
