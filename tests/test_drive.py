@@ -67,6 +67,15 @@ def _trajectory(n: int, seed: int, duration: float = 6.0, fs: float = 250.0):
     return t, q, dq, ddq
 
 
+def _exact_fit(robot: dynid.Robot, log: TorqueLog, drive: Drive):
+    """The paper's terms fitted by least squares to an exact log with its accelerations:
+    no low-pass, every sample."""
+    return identify_from_log(
+        robot, log, cutoff_hz=None, decimate=1, drive=drive, structure="classical",
+        estimator="ols",
+    )  # fmt: skip
+
+
 def _joint_torques(model, data, q, dq, ddq) -> np.ndarray:
     """Reference joint torques: Pinocchio's RNEA plus the drive terms, written out."""
     K = Drive.from_gears(GEAR, COUPLING, offset=OFFSET).transmission
@@ -112,19 +121,11 @@ def test_identify_motor_side_coupled_wrist_predicts_held_out_torques_to_round_of
     train, _ = _motor_log(model, data, seed=1)
     held, tau_held = _motor_log(model, data, seed=2)
     drive = _drive()
-    m = identify_from_log(
-        robot,
-        train,
-        cutoff_hz=None,
-        decimate=1,
-        drive=drive,
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, train, drive)
     assert "Ia1" in m.base.std_labels
     assert any("Ia6" in e for e in m.base.expressions)
     h = dynid.identification.log.joint_side_log(held, drive)
-    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    tau_hat = dynid.model_torques(m, h.q, h.dq, h.ddq)
     err = np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held)
     assert err < 1e-6
 
@@ -135,17 +136,9 @@ def test_identify_motor_currents_with_torque_constants():
     train, _ = _motor_log(model, data, seed=1, currents=True)
     held, tau_held = _motor_log(model, data, seed=3)
     drive = _drive(effort="current", torque_constant=KT)
-    m = identify_from_log(
-        robot,
-        train,
-        cutoff_hz=None,
-        decimate=1,
-        drive=drive,
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, train, drive)
     h = dynid.identification.log.joint_side_log(held, _drive())
-    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    tau_hat = dynid.model_torques(m, h.q, h.dq, h.ddq)
     assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
 
 
@@ -158,17 +151,9 @@ def test_without_the_coupling_the_fit_is_worse():
     # the log is the coupled one: read it as joint torques through the true transmission
     h = dynid.identification.log.joint_side_log(held, _drive())
     tr = dynid.identification.log.joint_side_log(train, _drive())
-    m = identify_from_log(
-        robot,
-        tr,
-        cutoff_hz=None,
-        decimate=1,
-        drive=Drive.from_gears(GEAR, offset=0 * OFFSET),
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, tr, Drive.from_gears(GEAR, offset=0 * OFFSET))
     assert wrong.n == 6
-    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    tau_hat = dynid.model_torques(m, h.q, h.dq, h.ddq)
     assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) > 1e-4
 
 
@@ -326,15 +311,7 @@ def test_noisy_motor_torques_give_errors_of_the_order_of_their_std():
     log = TorqueLog(
         t, (q - OFFSET) @ K.T, dq @ K.T, np.linalg.solve(K.T, tau.T).T + noise, ddq @ K.T
     )
-    m = identify_from_log(
-        robot,
-        log,
-        cutoff_hz=None,
-        decimate=1,
-        drive=_drive(),
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, log, _drive())
     beta = m.base.beta_from_phi(np.concatenate([robot.phi.reshape(-1), IA]))
     f_true = np.stack([FV, FC, FO], axis=1).reshape(-1)
     r = m.base.rank
@@ -449,15 +426,7 @@ def test_friction_fitted_per_motor_through_the_coupled_drive(tmp_path):
     robot, model, data = _ur5()
     train, _ = _motor_log(model, data, seed=1)
     held, _ = _motor_log(model, data, seed=2)
-    m = identify_from_log(
-        robot,
-        train,
-        cutoff_hz=None,
-        decimate=1,
-        drive=_drive(),
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, train, _drive())
     unfiltered = Preprocessing(cutoff_hz=None, filter_tau=False)
     res = friction_residual(m, held, unfiltered)  # read through the model's drive
     fit = fit_friction_through(res, m.drive, "classical")
@@ -549,21 +518,13 @@ def test_geared_coupled_arm_base_is_complete_for_every_gear_ratio(ratio, ia):
         return TorqueLog(t, q @ K.T, dqm, np.linalg.solve(K.T, tau.T).T, ddqm), tau
 
     (train, _), (held, tau_held) = log(1), log(2)
-    m = identify_from_log(
-        robot,
-        train,
-        cutoff_hz=None,
-        decimate=1,
-        drive=drive,
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, train, drive)
     one = Drive.from_gears(np.ones(6), [(6, 5, 0.6)], side="motor")
     ref = dynid.base_parameters(robot, kind="torque", terms=(RotorInertia(one),))
     assert m.base.rank == ref.rank == 40
     np.testing.assert_array_equal(m.base.independent, ref.independent)
     h = dynid.identification.log.joint_side_log(held, drive)
-    tau_hat = m.torques(h.q, h.dq, h.ddq) + dynid.friction.validation.own_friction(m).torques(h.dq)
+    tau_hat = dynid.model_torques(m, h.q, h.dq, h.ddq)
     assert np.linalg.norm(tau_hat - tau_held) / np.linalg.norm(tau_held) < 1e-6
 
 
@@ -629,15 +590,7 @@ def test_gear_ratio_1_in_a_drive_file_identifies_a_joint_side_armature(tmp_path)
         return TorqueLog(np.arange(q.shape[0]) / 250.0, q, dq, tau, ddq), tau
 
     (train, _), (held, tau_held) = log(1), log(2)
-    m = identify_from_log(
-        robot,
-        train,
-        cutoff_hz=None,
-        decimate=1,
-        drive=drive,
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, train, drive)
     assert "Ia6" in m.base.std_labels
     tau_hat = m.torques(held.q, held.dq, held.ddq)
     tau_hat = tau_hat + dynid.friction.validation.own_friction(m).torques(held.dq)
@@ -655,15 +608,7 @@ def test_validate_checks_the_joint_limits_of_a_motor_side_log_at_the_joints(tmp_
     train, _ = _motor_log(model, data, seed=1)
     held, _ = _motor_log(model, data, seed=2)
     assert np.max(np.abs(held.q)) > 10 * np.max(np.abs(robot.q_max))  # motor angles
-    m = identify_from_log(
-        robot,
-        train,
-        cutoff_hz=None,
-        decimate=1,
-        drive=_drive(),
-        structure="classical",
-        estimator="ols",
-    )
+    m = _exact_fit(robot, train, _drive())
     path = tmp_path / "held.csv"
     save_torque_log(path, held)
     with warnings.catch_warnings():
