@@ -5,20 +5,23 @@
 outer block's memo is shared by the nested ones) and drops it at the block's end, so that
 nothing is held between runs and no global cache can serve stale data. ``value_key(x)``
 is a hashable key of a value by what it holds (arrays by their bytes, dataclasses by
-their fields).
+their fields); ``value_digest(x)`` a short digest of that key, for a memo whose entries
+would otherwise hold a copy of large inputs.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Hashable, Iterator
+import hashlib
+import pickle
+from collections.abc import Callable, Hashable, Iterator, Mapping
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Any, TypeVar
 
 import numpy as np
 
-__all__ = ["scoped", "value_key"]
+__all__ = ["scoped", "value_digest", "value_key"]
 
 T = TypeVar("T")
 
@@ -51,3 +54,39 @@ def value_key(x: Any) -> Hashable:
         return tuple(value_key(v) for v in x)
     hash(x)
     return (type(x).__qualname__, x)
+
+
+def value_digest(x: Any) -> bytes:
+    """A 32-byte BLAKE2b digest of ``x`` as :func:`value_key` reads it, mappings too (equal
+    values, equal digests; TypeError where :func:`value_key` raises one)."""
+    h = hashlib.blake2b(digest_size=32)
+    _feed(h, x)
+    return h.digest()
+
+
+def _feed(h: Any, x: Any) -> None:
+    """Feed ``x`` to the hash ``h`` as :func:`value_key` reads it (a mapping item by item, in
+    the order of its keys' reprs), an array's bytes without a copy where it is
+    contiguous."""
+    if isinstance(x, np.ndarray):
+        a = np.ascontiguousarray(x)
+        h.update(pickle.dumps(("array", a.shape, a.dtype.str)))
+        h.update(a.data.cast("B") if a.size else b"")
+        return
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        h.update(pickle.dumps(("dataclass", type(x).__qualname__, len(dataclasses.fields(x)))))
+        for f in dataclasses.fields(x):
+            _feed(h, getattr(x, f.name))
+        return
+    if isinstance(x, Mapping):
+        h.update(pickle.dumps(("mapping", len(x))))
+        for k in sorted(x, key=repr):
+            _feed(h, k)
+            _feed(h, x[k])
+        return
+    if isinstance(x, tuple | list):
+        h.update(pickle.dumps(("sequence", len(x))))
+        for v in x:
+            _feed(h, v)
+        return
+    h.update(pickle.dumps(value_key(x)))

@@ -128,6 +128,7 @@ from .outlying_spans import Span
 from .recordings import Recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
+from .shared_search import searched_once
 from .spring_candidate import tried_joints, with_spring
 from .stribeck_joints import per_joint_vst
 from .structural import absorbed_by
@@ -239,6 +240,7 @@ def _lacks(c: Candidate, best: Candidate) -> dict[str, float]:
     return {lab: r for lab, r in best.determined().items() if lab not in held}
 
 
+@searched_once
 @shared_steps()
 @shared_bases()
 @shared_eigen()
