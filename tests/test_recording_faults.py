@@ -19,7 +19,7 @@ import pytest
 import dynid
 from dynid.cli.__main__ import main
 from dynid.dynamics.terms import gravity_torques
-from dynid.exceptions import DataError
+from dynid.exceptions import DataError, DynidWarning
 from dynid.identification.log import TorqueLog
 from dynid.identification.model_sign import opposite_sign
 from dynid.identification.sanity import check_torque_log
@@ -409,6 +409,44 @@ def test_one_recording_of_another_convention_is_flipped_alone(panda, log, tmp_pa
     assert "--units c.csv:tau=-1" in str(exc.value), str(exc.value)
     own = identify_files(panda, every, IdentifyOptions(columns=(None, "c.csv:tau=-1")))
     np.testing.assert_array_equal(own.model.fit.beta, alike.model.fit.beta)
+
+
+def test_one_recording_with_a_joint_recorded_reversed_is_read_back_alone(panda, log, tmp_path):
+    """Regression: two recordings, the second with joint 4 recorded reversed (position,
+    velocity and torque negated): the refusal's hint was ``--units q4=-1,tau4=-1``, which
+    flips the first recording too, and that one was refused next with the same hint. The
+    hint now names the file's own entries, which read it back: the fit is the one of both
+    recordings logged alike (bit for bit); both recordings reversed alike get the entries
+    of every file, the warning on their positions beyond the joint's limits saying that
+    negated they lie within them."""
+    from dynid.workflows.identify import IdentifyOptions, identify_files
+
+    half = len(log.t) // 2
+    a = TorqueLog(log.t[:half], log.q[:half], log.dq[:half], log.tau[:half])
+    b = TorqueLog(log.t[half:], log.q[half:], log.dq[half:], log.tau[half:])
+    sign = np.array([1.0, 1, 1, -1, 1, 1, 1])
+    save_torque_log(tmp_path / "a.csv", a)
+    save_torque_log(tmp_path / "alike" / "b.csv", b)
+    save_torque_log(tmp_path / "b.csv", TorqueLog(b.t, b.q * sign, b.dq * sign, b.tau * sign))
+    both = [tmp_path / "a.csv", tmp_path / "b.csv"]
+    with pytest.raises(DataError, match="b.csv: joint4 looks recorded reversed") as exc:
+        identify_files(panda, both)
+    said = str(exc.value)
+    assert "--units b.csv:q4=-1,b.csv:tau4=-1 reads it so in this recording alone" in said, said
+    assert "negative gear_ratio" not in said, said
+    entries = "b.csv:q4=-1,b.csv:dq4=-1,b.csv:tau4=-1"
+    own = identify_files(panda, both, IdentifyOptions(columns=(None, entries)))
+    alike = identify_files(panda, [tmp_path / "a.csv", tmp_path / "alike" / "b.csv"])
+    np.testing.assert_array_equal(own.model.fit.beta, alike.model.fit.beta)
+    save_torque_log(
+        tmp_path / "both" / "a.csv", TorqueLog(a.t, a.q * sign, a.dq * sign, a.tau * sign)
+    )
+    with (
+        pytest.raises(DataError, match="joint4 looks recorded reversed") as exc,
+        pytest.warns(DynidWarning, match="negated, they lie within them: recorded reversed"),
+    ):
+        identify_files(panda, [tmp_path / "both" / "a.csv", tmp_path / "b.csv"])
+    assert "--units q4=-1,tau4=-1 reads it so (and" in str(exc.value), str(exc.value)
 
 
 def test_a_log_whose_comment_lines_say_currents_is_not_read_as_torques(panda, log, tmp_path):

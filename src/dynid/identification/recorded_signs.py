@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -146,7 +147,9 @@ def _recorded(log: TorqueLog, drive: Drive | None) -> _Recorded | None:
     return _Recorded(log.q[at][ok], log.dq[at][ok], ddq[ok], log.tau[at][ok], drive)
 
 
-def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> str | None:
+def reversed_joint(
+    robot: Robot, log: TorqueLog, drive: Drive | None = None, *, file: str | None = None
+) -> str | None:
     """The finding that columns of a log were recorded reversed, each position (and
     velocity) of the opposite sign, with or without its effort (a motor mounted or wired
     the other way: its encoder and current both negated; or the encoder alone), or None;
@@ -155,7 +158,9 @@ def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> 
     ``log`` is as recorded, read through ``drive`` (motor-side positions and efforts,
     currents): a reversed column is the log's own, a motor's of a motor-side log (a
     coupled wrist's motor turns two joints), named so with the ``--units`` entries in the
-    log's columns (``q6=-1,tau6=-1``).
+    log's columns (``q6=-1,tau6=-1``; ``file``: that recording's own,
+    ``rec2.csv:q6=-1,rec2.csv:tau6=-1``, one recording among several whose others read
+    right).
 
     Judged on the robot's whole rigid-body torques over every joint, at the accelerations
     :func:`motion_accelerations` derives (one derivation for the torques and the rotor
@@ -194,6 +199,15 @@ def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> 
     str or None
         The finding, one line with the ``--units`` entries.
     """
+    found = _reversal(robot, log, drive)
+    return None if found is None else _reversed_line(robot, drive, *found, file=file)
+
+
+def _reversal(
+    robot: Robot, log: TorqueLog, drive: Drive | None
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_], tuple[float, float, float]] | None:
+    """:func:`reversed_joint`'s judgement: the columns reversed and the efforts negated
+    (n,) with what they leave, as read and the links' share (sums of squares), or None."""
     if not np.any(robot.phi):
         return None
     rec = _recorded(log, drive)
@@ -219,7 +233,7 @@ def reversed_joint(robot: Robot, log: TorqueLog, drive: Drive | None = None) -> 
         return None  # torques alone negated explain it best: opposite_sign's
     if rec.left(robot, one, -one) <= left:  # every torque of the opposite sign
         return None
-    return _reversed_line(robot, rec.drive, motion < 0, torque < 0, (left, read, total))
+    return motion < 0, torque < 0, (left, read, total)
 
 
 def _changes(
@@ -251,11 +265,12 @@ def _reversed_line(
     motion: NDArray[np.bool_],
     torque: NDArray[np.bool_],
     sums: tuple[float, float, float],
+    file: str | None = None,
 ) -> str:
     """:func:`reversed_joint`'s finding: the columns reversed (``motion``, n) and the
     efforts negated (``torque``, n) named in the log's own columns (a motor-side log's
     motors), what is left reversed and as read (``sums``: those and the torques' sums of
-    squares), the ``--units`` entries."""
+    squares), the ``--units`` entries (``file``'s own where given)."""
     left, read, total = sums
     motors = drive is not None and drive.side == "motor"
     names = [f"motor {k + 1}" if motors else robot.joint_names[k] for k in range(robot.n)]
@@ -266,15 +281,18 @@ def _reversed_line(
         ("its " if one else f"{names[k]}'s ") + ("position and torque" if torque[k] else "position")
         for k in rev
     ] + [f"{names[k]}'s torque" for k in alone]
+    at = "" if file is None else f"{file}:"
     cols = ",".join(
-        [f"q{k + 1}=-1" + (f",tau{k + 1}=-1" if torque[k] else "") for k in rev]
-        + [f"tau{k + 1}=-1" for k in alone]
+        [f"{at}q{k + 1}=-1" + (f",{at}tau{k + 1}=-1" if torque[k] else "") for k in rev]
+        + [f"{at}tau{k + 1}=-1" for k in alone]
     )
-    rates = ", ".join(f"dq{k + 1}=-1, ddq{k + 1}=-1" for k in rev)
+    rates = ", ".join(f"{at}dq{k + 1}=-1, {at}ddq{k + 1}=-1" for k in rev)
     if not one and alone.size == 0 and len(set(torque[rev].tolist())) == 1:  # all alike
         what = ["their positions and torques" if torque[rev[0]] else "their positions"]
     single = len(what) == 1 and " and " not in what[0] and not what[0].startswith("their")
-    gears = drive is not None and not drive.is_coupled and bool(np.all(torque[rev]))
+    gears = (
+        file is None and drive is not None and not drive.is_coupled and bool(np.all(torque[rev]))
+    )
     return (
         f"{', '.join(names[k] for k in rev)} {'looks' if one else 'look'} recorded reversed: "
         f"{', '.join(what)} {'has' if single else 'have'} the opposite sign to the model's "
@@ -287,7 +305,9 @@ def _reversed_line(
         + f" leave a residual of {np.sqrt(left / total):.2g} of the links' RMS torque, "
         f"against {np.sqrt(read / total):.2g} as read): a motor or encoder mounted the "
         "other way; "
-        f"hint: --units {cols} reads {'it' if one else 'them'} so (and {rates} for the log's "
+        f"hint: --units {cols} reads {'it' if one else 'them'} so"
+        + (" in this recording alone (the others read right)" if file else "")
+        + f" (and {rates} for the log's "
         "velocity and acceleration columns, if it has them"
         + ("; the motors' columns of this motor-side log" if motors else "")
         + ")"
@@ -1016,9 +1036,12 @@ def recording_sign_findings(
     if sides is None:
         sides = [joint_side_log(log, drive) for log in logs]
     out: list[SignFinding] = []
-    for r, (name, log) in enumerate(zip(names, logs, strict=True)):
-        if (mirrored := reversed_joint(robot, log, drive)) is not None:
-            out.append(SignFinding(name, "reversed", mirrored))
+    reversals = [_reversal(robot, log, drive) for log in logs]
+    for r, name in enumerate(names):
+        if (mine := reversals[r]) is not None:
+            own = _reversed_alone(mine, [x for i, x in enumerate(reversals) if i != r])
+            line = _reversed_line(robot, drive, *mine, file=name if own else None)
+            out.append(SignFinding(name, "reversed", line))
         else:
             others = (x for i, x in enumerate(sides) if i != r)
             if (opposite := opposite_sign_among(robot, sides[r], name, others)) is not None:
@@ -1037,6 +1060,19 @@ def recording_sign_findings(
         name = next(n for n in (", ".join(kept), *kept) if found.startswith(f"{n}: "))
         out.append(SignFinding(name, "opposite", found.removeprefix(f"{name}: ")))
     return tuple(out)
+
+
+def _reversed_alone(
+    mine: tuple[NDArray[np.bool_], NDArray[np.bool_], Any],
+    others: Sequence[tuple[NDArray[np.bool_], NDArray[np.bool_], Any] | None],
+) -> bool:
+    """Whether a recording's reversal (``mine``: :func:`_reversal`'s columns and efforts)
+    is its own: some other recording is not reversed so (its hint then names the file,
+    ``rec2.csv:q4=-1``; an entry for every file would flip the others wrong)."""
+    return any(
+        o is None or not (np.array_equal(o[0], mine[0]) and np.array_equal(o[1], mine[1]))
+        for o in others
+    )
 
 
 def _motor_groups(acts: NDArray[np.bool_]) -> list[tuple[list[int], list[int]]]:

@@ -947,12 +947,28 @@ def check_limits(rec: Recorded, robot: Robot) -> None:
                 f"{name}: joint {robot.joint_names[j]} spans [{qmin[j]:.4g}, {qmax[j]:.4g}], "
                 f"far outside the limits of robot {robot.name!r} [{robot.q_min[j]:.4g}, "
                 f"{robot.q_max[j]:.4g}]{also}: a recording of another robot, or in other "
-                f"units?{_counts_hint(read.q[:, bad])}",
+                f"units?{_negated_hint(qmin[bad], qmax[bad], lo[bad], hi[bad])}"
+                f"{_counts_hint(read.q[:, bad])}",
                 DynidWarning,
                 stacklevel=caller_level(),
             )
     if (said := effort_limit_finding(robot, [log.tau for log in sides])) is not None:
         _log.log(NOTE, "%s", said)
+
+
+def _negated_hint(
+    qmin: NDArray[np.float64],
+    qmax: NDArray[np.float64],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+) -> str:
+    """A hint for joints whose positions (spans ``qmin``..``qmax`` [rad]) lie outside the
+    limits ``lo``..``hi`` (with their margin) but within them negated: recorded reversed
+    (a motor or encoder mounted the other way), which the sign checks judge; empty
+    otherwise (a TIAGo arm's motor 4 logged reversed was said to be another robot's)."""
+    if not np.all((-qmax >= lo) & (-qmin <= hi)):
+        return ""
+    return "; negated, they lie within them: recorded reversed? (the sign checks judge it)"
 
 
 def _counts_hint(q: NDArray[np.float64]) -> str:
