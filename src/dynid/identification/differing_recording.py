@@ -125,7 +125,7 @@ def recording_floors(data: Recordings) -> dict[str, float]:
         if not mine or any(p.torque_noise_std is None for p in mine):
             continue
         measured = data.measured
-        taus = [p.tau_raw if measured and p.tau_raw is not None else p.log.tau for p in mine]
+        taus = [p.targets(p.tau_raw if measured and p.tau_raw is not None else None) for p in mine]
         gains = [
             1.0 if measured else lowpass_noise_gain(p.sample_rate_hz, p.cutoff_hz) for p in mine
         ]

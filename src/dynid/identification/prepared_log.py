@@ -167,6 +167,16 @@ class PreparedLog(TorqueRoute):
         """One piece of samples of ``n`` rows, window :attr:`lag`."""
         return Serial(self.n, self.lag)
 
+    def targets(self, tau: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """The torques [N m] (N, n) the fit's rows target (:func:`log_blocks`): ``tau``
+        (default the prepared log's; the raw torques of the same samples) less the rotor
+        torques of the drive's known rotor inertias, which the rows take off."""
+        out = self.log.tau if tau is None else tau
+        drive = self.drive
+        if drive is None or drive.rotor_inertia is None or self.log.ddq is None:
+            return out
+        return out - drive.rotor_torques(self.log.ddq, drive.rotor_inertia)
+
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
         """One block (:func:`log_blocks`); several when the log is too long to stack."""
         if columns.drive is not self.drive:

@@ -165,7 +165,8 @@ __all__ = [
 def _with_floor(heldout: Any, data: Recordings) -> Any:
     """The held-out record with the noise floor of the torques it was judged on, ``data``
     (the recordings of the folds, or the separate recording; as measured, or filtered when
-    the recordings were not)
+    the recordings were not; less the rotor torques of a drive's known rotor inertias, as
+    the fit's errors are: :meth:`~.prepared_log.PreparedLog.targets`)
     (:func:`~dynid.identification.metrics.noise_floor_percent`) and the sensor noise it
     is made of, each joint's raw torque noise [N m] as the RMS over the samples used
     (``noise_rms``: the one value the summary, heldout.json and the report read), when
@@ -173,8 +174,8 @@ def _with_floor(heldout: Any, data: Recordings) -> Any:
     pieces = data.pieces
     if heldout is None or any(p.torque_noise_std is None for p in pieces):
         return heldout
-    measured = data.measured  # judged on the torques as measured
-    taus = [p.log.tau if p.tau_raw is None or not measured else p.tau_raw for p in pieces]
+    measured = data.measured  # judged on the torques as measured (less known rotors')
+    taus = [p.targets(None if p.tau_raw is None or not measured else p.tau_raw) for p in pieces]
     stds = [p.torque_noise_std for p in pieces]
     noise = [np.asarray(s, dtype=np.float64) for s in stds if s is not None]
     floor = noise_floor_percent(
