@@ -4,6 +4,7 @@ standstill rule, the held-out selection, friction.json of every law and the MuJo
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -431,6 +432,27 @@ def test_a_smooth_laws_width_is_written_as_width_not_as_the_standstill_band(tmp_
         np.testing.assert_array_equal(law_friction(rec, None, 2, "f", "k").band, width)
     classical = LAWS["classical"].model([[0.5, 0.8, 0.0]], [0.005])
     assert law_record(classical)["standstill_band"] == [0.005]
+
+
+def test_a_stribeck_fit_on_data_with_few_slow_samples_gives_no_free_static_level():
+    """Regression: one recording of a geared arm's shoulder motor whose slowest samples
+    outside the standstill band move at 1.27 rad/s (two of them; the truth: viscous and
+    Coulomb friction, no bump) left the bump's column near zero at a Stribeck velocity of
+    0.27 rad/s and the static level free: fs = 1.5e7 N m, and `dynid friction` printed the
+    other recording predicted at 7e7 %. The static level is now bounded by the torques it
+    explains: the fitted law stays within 2 x the largest residual at every speed from 0
+    to the data's largest, and within 2 % of the viscous and Coulomb law of the data from 2
+    rad/s on."""
+    path = Path(__file__).parent / "data" / "stribeck_few_slow_samples.csv"
+    dq, r = np.loadtxt(path, delimiter=",", unpack=True)
+    band = 1e-3
+    p = np.asarray(LAWS["stribeck"].fit(dq, r, band).params)
+    top = float(np.max(np.abs(dq)))
+    v = np.linspace(-top, top, 2001)
+    out = LAWS["stribeck"].torques(v[:, None], p[None, :], np.array([band]))[:, 0]
+    assert np.all(np.abs(out) <= 2 * np.max(np.abs(r))), p
+    seen = np.abs(v) >= 2.0  # where the data hold more than a few samples
+    np.testing.assert_allclose(out[seen], 3e-4 * v[seen] + 0.1 * np.sign(v[seen]), rtol=0.02)
 
 
 def test_a_stribeck_fit_with_a_band_wider_than_its_largest_velocity_is_made():

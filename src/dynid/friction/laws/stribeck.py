@@ -6,12 +6,14 @@
 with ``s`` the sign outside the standstill band (:func:`~dynid.friction.model.coulomb_sign`);
 :func:`stribeck_law` makes the law for another sign
 (:mod:`dynid.friction.laws.smooth_stribeck`).
-``fv`` [N m s/rad], ``fc``, ``fs`` [N m] ``>= 0``, the Stribeck velocity ``vst`` [rad/s]
-in ``[1e-3, 10]``, the offset ``fo`` [N m] of either sign. Given ``vst`` the law is linear
-in the others; the fit is a variable projection: bounded linear least squares for each
-``vst`` on a logarithmic grid, then a bounded scalar search of ``ln vst`` between the grid
-neighbours of the best point (deterministic). MuJoCo holds ``fv`` as ``damping`` and ``fc``
-as ``frictionloss``; the peak ``fs - fc`` at low speed and the offset are dropped.
+``fv`` [N m s/rad], ``fc``, ``fs`` [N m] ``>= 0`` (``fs`` at most twice the largest
+torque of the samples the bump acts at, and ``fc`` where it acts at none), the Stribeck
+velocity ``vst`` [rad/s] in ``[1e-3, 10]``, the offset ``fo`` [N m] of either sign.
+Given ``vst`` the law is linear in the others; the fit is a variable projection: bounded
+linear least squares for each ``vst`` on a logarithmic grid, then a bounded scalar search
+of ``ln vst`` between the grid neighbours of the best point (deterministic). MuJoCo holds
+``fv`` as ``damping`` and ``fc`` as ``frictionloss``; the peak ``fs - fc`` at low speed and
+the offset are dropped.
 """
 
 from __future__ import annotations
@@ -81,7 +83,7 @@ def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float, sign: Sig
         sign, ones, residual) and their squared error."""
         v, s, ones, rr = data
         A = _at_vst(v, s, ones, np.asarray(np.exp(ln_vst)))
-        x = bounded_lstsq(A, rr, lo, hi)
+        x = _bounded_bump(A, rr, lo, hi)
         return x, float(np.sum((A @ x - rr) ** 2))
 
     top = min(_UPPER[3], max(float(np.max(np.abs(dq))), 2 * _LOWER[3]))
@@ -103,6 +105,30 @@ def _fit(dq: NDArray[np.float64], r: NDArray[np.float64], band: float, sign: Sig
     x, _ = solve(g, full)
     p = np.array([x[0], x[1], x[2], np.exp(g), x[3]])
     return JointFit(p, bool(res.success), int(res.nfev) + grid.size)
+
+
+#: A sample holds the Stribeck bump where its column ``s(dq) exp(-(dq/vst)^2)`` is at least
+#: this (the bump at 1 % of its height).
+BUMP_ACTS = 0.01
+
+
+def _bounded_bump(
+    A: NDArray[np.float64], r: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The bounded least squares of ``fv, fc, fs, fo`` on the columns ``A`` (N, 4) at one
+    ``vst``, with the static level ``fs`` at most twice the largest torque ``r`` of the
+    samples where the bump acts (:data:`BUMP_ACTS`) and ``fs = fc`` (no bump) where none
+    does: data without slow motion outside the standstill band leave the bump's column
+    near zero and ``fs`` free (one recording of a geared arm's shoulder: fs 1.2e7 N m, the
+    other predicted at 7e7 %)."""
+    acts = np.abs(A[:, 2]) >= BUMP_ACTS
+    if not acts.any():
+        merged = np.column_stack([A[:, 0], A[:, 1] + A[:, 2], A[:, 3]])
+        fv, fc, fo = bounded_lstsq(merged, r, lo[[0, 1, 3]], hi[[0, 1, 3]])
+        return np.array([fv, fc, fc, fo])
+    top = hi.copy()
+    top[2] = min(top[2], 2.0 * float(np.max(np.abs(r[acts]))))
+    return bounded_lstsq(A, r, lo, top)
 
 
 def _mjcf(P: NDArray[np.float64], dq_max: NDArray[np.float64]) -> MjcfTerms:
