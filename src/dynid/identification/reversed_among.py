@@ -211,8 +211,10 @@ class _Among:
 
 def _among(robot: Robot, logs: Sequence[TorqueLog], drive: Drive | None) -> _Among | None:
     """:class:`_Among` of ``logs``, or None for fewer than two or one too short to judge."""
+    if len(logs) < 2:
+        return None
     sampled = [_sampled(log) for log in logs]
-    if len(logs) < 2 or any(s is None for s in sampled):
+    if any(s is None for s in sampled):
         return None
     kept = [s for s in sampled if s is not None]
     one = np.ones(robot.n)
