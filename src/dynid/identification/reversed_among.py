@@ -141,16 +141,26 @@ def _rows(
     return tau - tau.mean(axis=0), X - X.mean(axis=0)
 
 
-def _fit(
-    rows: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]], w: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """The coefficients (p,) of least squares over ``rows`` (each joint's torques and
-    columns), each joint's rows weighted by ``w`` (n,) [1/(N m)]."""
-    A = np.concatenate([(X * w[None, :, None]).reshape(-1, X.shape[2]) for _, X in rows])
-    b = np.concatenate([(y * w).ravel() for y, _ in rows])
-    scale = np.linalg.norm(A, axis=0)
+Gram = tuple[NDArray[np.float64], NDArray[np.float64]]
+
+
+def _gram(row: tuple[NDArray[np.float64], NDArray[np.float64]], w: NDArray[np.float64]) -> Gram:
+    """The normal equations ``A^T A`` (p, p) and ``A^T b`` (p,) of one recording's rows
+    (joint torques and columns), each joint's rows weighted by ``w`` (n,) [1/(N m)]."""
+    y, X = row
+    A = (X * w[None, :, None]).reshape(-1, X.shape[2])
+    return A.T @ A, A.T @ (y * w).ravel()
+
+
+def _fit(grams: Sequence[Gram]) -> NDArray[np.float64]:
+    """The least-squares coefficients (p,) of the recordings whose normal equations are
+    ``grams`` summed, each column scaled to unit norm (the minimum-norm solution where the
+    rows do not determine them: the base parameters' combinations)."""
+    G = sum((g for g, _ in grams), np.zeros_like(grams[0][0]))
+    h = sum((x for _, x in grams), np.zeros_like(grams[0][1]))
+    scale = np.sqrt(np.diag(G))
     scale[scale == 0] = 1.0
-    coef = np.linalg.lstsq(A / scale, b, rcond=1e-10)[0]
+    coef = np.linalg.lstsq(G / np.outer(scale, scale), h / scale, rcond=1e-12)[0]
     out: NDArray[np.float64] = coef / scale
     return out
 
@@ -185,6 +195,8 @@ class _Among:
     rows: list[tuple[NDArray[np.float64], NDArray[np.float64]]]
     w: NDArray[np.float64]
     reach: list[NDArray[np.intp]]
+    #: Per recording, the normal equations of its rows as read (:func:`_gram`).
+    grams: list[Gram]
     #: :meth:`flipped`'s rows by recording and motor, computed once.
     seen: dict[tuple[int, int], tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
         default_factory=dict, compare=False, repr=False
@@ -219,11 +231,12 @@ def _among(robot: Robot, logs: Sequence[TorqueLog], drive: Drive | None) -> _Amo
     kept = [s for s in sampled if s is not None]
     one = np.ones(robot.n)
     rows = [_rows(robot, s, drive, one) for s in kept]
-    coef = _fit(rows, one)
+    coef = _fit([_gram(r, one) for r in rows])
     pooled = sum((_left(r, coef) for r in rows), np.zeros(robot.n))
     count = sum(r[0].shape[0] for r in rows)
     w = 1.0 / np.sqrt(np.maximum(pooled / count, 1e-30))
-    return _Among(robot, drive, kept, rows, w, _reaches(drive, robot.n))
+    grams = [_gram(r, w) for r in rows]
+    return _Among(robot, drive, kept, rows, w, _reaches(drive, robot.n), grams)
 
 
 def held_out_ratios(
@@ -246,7 +259,7 @@ def _ratios(among: _Among) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     out, gain = np.ones((R, n)), np.zeros((R, n))
     every = np.arange(n)
     for r in range(R):
-        coef = _fit([x for i, x in enumerate(among.rows) if i != r], among.w)
+        coef = _fit([g for i, g in enumerate(among.grams) if i != r])
         read = _left(among.rows[r], coef) * among.w**2
         for k in range(n):
             flipped = _left(among.flipped(r, k), coef) * among.w**2
@@ -262,7 +275,10 @@ def _pooled(among: _Among, signs: Sequence[bool], k: int) -> NDArray[np.float64]
         among.flipped(i, k) if f else x
         for i, (x, f) in enumerate(zip(among.rows, signs, strict=True))
     ]
-    coef = _fit(rows, among.w)
+    grams = [
+        _gram(x, among.w) if f else g for x, g, f in zip(rows, among.grams, signs, strict=True)
+    ]
+    coef = _fit(grams)
     out: NDArray[np.float64] = sum(
         (_left(x, coef) * among.w**2 for x in rows), np.zeros(len(among.w))
     )
