@@ -11,14 +11,16 @@ import numpy as np
 import pytest
 
 import dynid
-from dynid.exceptions import DataError
+from dynid.exceptions import DataError, DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.log import TorqueLog
 from dynid.identification.recorded_signs import reversed_joint
 from dynid.identification.recordings import prepare_recordings
 from dynid.identification.reversed_among import reversed_among
+from dynid.io.torque_log import save_torque_log
 from dynid.model.drive import Drive
 from dynid.simulation.measurement import SensorNoise
+from dynid.workflows.validate import ValidateOptions, validate_files
 
 from conftest import geared_recordings, recordings, robot_data_urdf
 
@@ -113,3 +115,23 @@ def test_last_joint_reversal_named_unless_its_link_is_symmetric(panda):
             assert found.text.startswith("joint7 looks recorded reversed")
         else:
             assert found is None
+
+
+def test_validate_warns_of_a_wrist_motor_reversed_in_one_recording(tiago, tmp_path):
+    """``validate`` of the TIAGo arm's two recordings, motor 6 reversed in rec2.csv: the
+    verdict opens with that finding and rec2.csv's own --units entries, validation.json
+    records it under reversed_columns (the rule ``identify`` refuses by)."""
+    robot, logs, drive = tiago
+    save_torque_log(tmp_path / "rec1.csv", logs[0])
+    save_torque_log(tmp_path / "rec2.csv", reversed_motor(logs[1], 5))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        result = validate_files(
+            robot,
+            [tmp_path / "rec1.csv", tmp_path / "rec2.csv"],
+            ValidateOptions(friction="none", drive=drive),
+        )
+    reason = result.verdict.reason
+    assert reason.startswith("rec2.csv: motor 6 looks recorded reversed"), reason
+    assert "rec2.csv:q6=-1,rec2.csv:tau6=-1" in reason
+    assert list(result.metadata()["reversed_columns"]) == ["rec2.csv"]
