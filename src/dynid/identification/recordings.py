@@ -83,6 +83,7 @@ from .prepare import (
 from .prepared_log import PreparedLog, prepare_torque_log
 from .rate import CUTOFF_MULTIPLE
 from .recorded_signs import recording_sign_findings
+from .reversed_among import reversed_among
 from .sanity import check_torque_log
 from .serial import Serial, serial_of_pieces
 from .spikes import despiked, spike_finding
@@ -557,6 +558,8 @@ def prepare_recordings(
     # friction to nothing
     for bad in recording_sign_findings(robot, wholes, [names[r] for r in have], drive, first=True):
         raise DataError(bad.text, file=bad.name)
+    if (other := reversed_among(robot, wholes, [names[r] for r in have], drive)) is not None:
+        raise DataError(other.text, file=other.name)  # a wrist's the description cannot tell
     for r, whole in zip(have, wholes, strict=True):  # units, frozen joints: said once
         for finding in check_torque_log(robot, joint_side_log(whole, drive), drive):
             found.setdefault(finding, []).append(names[r])

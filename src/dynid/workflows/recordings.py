@@ -83,6 +83,7 @@ from ..identification.log import (
 from ..identification.model_sign import every_joint_entry, sign_confirmed
 from ..identification.pieces import unwrapped_log, with_start_turns, wrappable
 from ..identification.recorded_signs import SignFinding, recording_sign_findings
+from ..identification.reversed_among import reversed_among
 from ..identification.sanity import too_few_samples, torque_unit_finding
 from ..identification.spikes import despiked, spike_finding
 from ..identification.unit_mix import (
@@ -655,7 +656,10 @@ def _sign_findings(
     reference: Any = None,
     among: bool = True,
 ) -> tuple[SignFinding, ...]:
-    """:func:`sign_findings` as found (``among``: the recordings' own friction compared)."""
+    """:func:`sign_findings` as found (``among``: the recordings' own friction compared),
+    then, among the recordings not found so, a motor recorded reversed in one of them
+    that the others tell (:func:`~dynid.identification.reversed_among.reversed_among`: a
+    wrist's, which the description's torques over the whole arm cannot)."""
     keep = [
         k
         for k, (name, log) in enumerate(zip(rec.names, rec.joint_side, strict=True))
@@ -664,7 +668,7 @@ def _sign_findings(
     if not keep:
         return ()
     drive = rec.drive if rec.drive is not None and rec.drive.n == robot.n else None
-    return recording_sign_findings(
+    found = recording_sign_findings(
         robot,
         [rec.logs[k] for k in keep],
         [rec.names[k] for k in keep],
@@ -673,6 +677,12 @@ def _sign_findings(
         reference=reference,
         among=among,
     )
+    if not among:
+        return found
+    said = {f.name for f in found}
+    rest = [k for k in keep if rec.names[k] not in said]
+    wrist = reversed_among(robot, [rec.logs[k] for k in rest], [rec.names[k] for k in rest], drive)
+    return found if wrist is None else (*found, wrist)
 
 
 def warn_signs(
