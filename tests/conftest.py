@@ -327,9 +327,10 @@ def geared_recordings(
     return logs, dataclasses.replace(truth, rotor_inertia=None)
 
 
-def point_to_point(robot: dynid.Robot, seed: int, fs: float = 500.0) -> Trajectory:
-    """Eight moves between random configurations (quintic profiles of 1.2 s), each
-    followed by a rest of 1 s: the joints stand still more than a third of the time."""
+def point_to_point(robot: dynid.Robot, seed: int, fs: float = 500.0, moves: int = 8) -> Trajectory:
+    """``moves`` moves between random configurations (quintic profiles of 1.2 s), each
+    followed by a rest of 1 s: the joints stand still more than a third of the time. The
+    first moves of a seed are the same whatever ``moves``."""
     rng = np.random.default_rng(seed)
     lo, hi = np.asarray(robot.q_min), np.asarray(robot.q_max)
     mid, span = (lo + hi) / 2, (hi - lo) / 2
@@ -344,7 +345,7 @@ def point_to_point(robot: dynid.Robot, seed: int, fs: float = 500.0) -> Trajecto
     )
     rest = int(fs)
     parts = []
-    for _ in range(8):
+    for _ in range(moves):
         q1 = mid + 0.5 * span * rng.uniform(-1, 1, robot.n)
         d = q1 - q0
         moving = [q0 + np.outer(h[:, 0], d), np.outer(h[:, 1], d), np.outer(h[:, 2], d)]

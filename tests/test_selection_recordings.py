@@ -48,9 +48,20 @@ def _selection(panda, logs, names, estimator="auto"):
     return model.info.selection, [str(w.message) for w in caught]
 
 
-def test_a_recording_with_a_contact_is_named_and_does_not_decide_the_structure(panda, logs):
+@pytest.fixture(scope="module")
+def clean_selection(panda, logs):
+    """The selection and warnings of the clean recordings alone, by ordinary least squares
+    (the search's estimator whatever the final fit's: the same candidates, errors and
+    choice as with the default estimator), shared by the tests that read them."""
+    clean, _ = logs
+    return _selection(panda, clean, ["a.csv", "b.csv", "c.csv"], "ols")
+
+
+def test_a_recording_with_a_contact_is_named_and_does_not_decide_the_structure(
+    panda, logs, clean_selection
+):
     clean, hit = logs
-    ref, _ = _selection(panda, clean, ["a.csv", "b.csv", "c.csv"])
+    ref, _ = clean_selection
     sel, said = _selection(panda, [*clean, hit], ["a.csv", "b.csv", "c.csv", "hit.csv"])
     assert sel["outlying_recordings"] == ["hit.csv"]
     assert any(m.startswith("hit.csv: held-out error") for m in said)
@@ -68,11 +79,10 @@ def test_a_recording_with_a_contact_is_named_and_does_not_decide_the_structure(p
     assert per["hit.csv"] < 1.5 * max(per[f] for f in ("a.csv", "b.csv", "c.csv"))
 
 
-def test_alike_recordings_each_get_their_held_out_error_and_no_warning(panda, logs):
-    clean, _ = logs
+def test_alike_recordings_each_get_their_held_out_error_and_no_warning(clean_selection):
     # ordinary least squares, the search's estimator: the final fit's folds are the
     # search's (the estimator chosen here is wls, whose folds are its own)
-    sel, said = _selection(panda, clean, ["a.csv", "b.csv", "c.csv"], "ols")
+    sel, said = clean_selection
     assert sel["outlying_recordings"] == []
     assert not [m for m in said if m.startswith(("a.csv", "b.csv", "c.csv"))], said
     chosen = next(c for c in sel["candidates"] if c["name"] == sel["chosen"])

@@ -53,16 +53,24 @@ GEARED = Drive.from_gears(
 )
 
 
-def _chosen(truth, drive=None):
-    """The model identified by default from three noisy 10 s recordings of the Panda with
-    ``truth`` friction (through ``drive``), the one of the best single smooth width, that
-    candidate, and two exact new recordings."""
+def _identified(truth, drive=None):
+    """The model identified by default from three noisy 7 s recordings of the Panda with
+    ``truth`` friction (through ``drive``), and those recordings."""
     robot = dynid.panda()
-    logs = recordings(robot, (1, 2, 3), friction=truth, duration=10.0, noise=NOISE, drive=drive)
-    new = recordings(robot, (4, 5), friction=truth, duration=10.0, drive=drive)
+    logs = recordings(robot, (1, 2, 3), friction=truth, duration=7.0, noise=NOISE, drive=drive)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        model = identify_recordings(robot, logs, drive=drive)
+        return identify_recordings(robot, logs, drive=drive), logs
+
+
+def _chosen(truth, drive=None):
+    """The model of :func:`_identified`, the one of the best single smooth width fitted on
+    the same recordings, that candidate, and two exact new recordings (7 s each)."""
+    robot = dynid.panda()
+    model, logs = _identified(truth, drive)
+    new = recordings(robot, (4, 5), friction=truth, duration=7.0, drive=drive)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
         cands = model.info.selection["candidates"]
         single = min(
             (c for c in cands if "/" not in c["name"] and "smooth:" in c["name"]),
@@ -175,7 +183,7 @@ def test_a_geared_arm_s_motors_get_their_own_widths():
 def test_equal_widths_keep_one_width():
     """Every joint at 0.005 rad/s: the per-joint search keeps one width for all (the
     chosen structure holds no per-joint width)."""
-    model, _, _, _ = _chosen(_truth(np.full(7, SHARP)))
+    model, _ = _identified(_truth(np.full(7, SHARP)))
     chosen = Structure.parse(",".join(model.info.extra["terms"]))
     assert not isinstance(chosen.width, tuple), chosen.name
 

@@ -56,9 +56,9 @@ def armature_logs(panda):
     fr = ClassicalFriction(VISCOUS, np.zeros(7), np.zeros(7))
     noisy = SensorNoise(tau_std=NOISE)
     logs = recordings(
-        panda, (1, 2, 3, 4), friction=fr, armature=ARMATURE, duration=8.0, noise=noisy
+        panda, (1, 2, 3, 4), friction=fr, armature=ARMATURE, duration=6.0, noise=noisy
     )
-    held = random_fourier(panda, np.random.default_rng(4))(sample_times(8.0, 500.0))
+    held = random_fourier(panda, np.random.default_rng(4))(sample_times(6.0, 500.0))
     return logs[:3], held, logs[3]  # the held-out recording: trajectory 4's
 
 
@@ -91,12 +91,12 @@ def _fitted_with_held_out(panda, seeds, fr):
     """The default identification of the first recordings of an arm with ``fr`` and the
     armature (noise as the sensors'), the last recording held out and its true states."""
     *logs, test = recordings(
-        panda, seeds, friction=fr, armature=ARMATURE, duration=8.0, noise=SensorNoise()
+        panda, seeds, friction=fr, armature=ARMATURE, duration=6.0, noise=SensorNoise()
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
         model = identify_recordings(panda, logs)
-    held = random_fourier(panda, np.random.default_rng(seeds[-1]))(sample_times(8.0, 500.0))
+    held = random_fourier(panda, np.random.default_rng(seeds[-1]))(sample_times(6.0, 500.0))
     return model, test, held
 
 
