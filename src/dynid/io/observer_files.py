@@ -31,8 +31,11 @@
                      "model_check": {     # the model judged on the logs as validate does
                          "relative_error_percent": e, "noise_floor_percent": f,
                          "verdict": {"level", "label", "reason", "ratio"},
-                         "fitted": [k, m]}},  # k of the m logs the model's training
+                         "fitted": [k, m]},   # k of the m logs the model's training
                                           # recordings (in-sample)
+                     "beyond_identification": [  # absent: none; a log's joint moved
+                         {"log", "joint", "speed", "identified"}]},  # > 3 x as fast as
+                                          # the identification's data [rad/s]
      "units": {...}}
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
@@ -50,7 +53,9 @@ dropped, which are not events: ``min_duration_s`` and ``merge_s`` [s], ``count``
 :data:`~dynid.observer.events.MAX_DROPPED` per log), each ``{"start", "end",
 "duration_s"}`` [s], ``joints`` and ``joint_names`` (over the threshold), ``joint`` (the
 one furthest over it, 1-based), ``peak`` [N m] and ``ratio`` (``|r| / contact``) per
-joint, ``rule`` (``isolated`` or ``short``) and ``log``.
+joint, ``rule`` (``isolated`` or ``short``) and ``log``. ``beyond_identification`` (when
+any log moves a joint more than 3 times as fast as the model's identification data) holds
+``{"log", "joint", "speed", "identified"}`` [rad/s] per such log and joint.
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
 [s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and

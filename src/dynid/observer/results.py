@@ -310,8 +310,13 @@ class ObserveResult:
         weight of a load at the flange (:func:`~dynid.observer.unmodelled_load.load_note`),
         first a load carried over an event, held through a log or picked and released
         (:func:`~dynid.observer.carried_load.load_words`);
+        a calibration on logs moved beyond the identification's speeds, or a detection's
+        such log with events (:meth:`beyond`); with ``--no-loads``, the loads that fit an
+        event (:func:`~dynid.observer.carried_load.unread_load_words`);
         false alarms that each start shortly before a missed labelled contact: labels that
-        look late (:func:`~dynid.observer.scoring.shifted_labels_note`)."""
+        look late (:func:`~dynid.observer.scoring.shifted_labels_note`), left out for a log
+        beyond the identification's speeds or whose other false alarms come at a similar
+        rate (:meth:`_shifted_note`)."""
         identified = self.model.source == "identified"
         carried = [ld for x in self.logs for ld in x.loads]
         out: tuple[str, ...] = tuple(x.recording for x in self.logs if x.recording)
