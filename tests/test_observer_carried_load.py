@@ -55,9 +55,13 @@ def logs(tmp_path_factory):
     return d
 
 
-def _detect(d, name):
+def _detect(d, name, loads=True):
     opts = ObserveOptions(
-        data=(d / name,), params="panda", thresholds=d / "cal" / "thresholds.json", frame="flange"
+        data=(d / name,),
+        params="panda",
+        thresholds=d / "cal" / "thresholds.json",
+        frame="flange",
+        loads=loads,
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -92,6 +96,25 @@ def test_a_load_held_through_the_log_is_named_with_payload_advice(logs):
     assert load.whole and load.mass == pytest.approx(MASS, rel=0.02)  # the weight alone: 6 % low
     notes = " ".join(result.notes)
     assert "dynid payload" in notes and "dynid validate" not in notes
+
+
+def test_no_loads_names_the_load_that_fits_instead_of_blaming_the_model(logs):
+    """Regression (a UR5 with an unknown 1 kg payload and --no-loads: one event over the
+    whole log, the note blaming "friction ... or thresholds calibrated with another
+    model"): with --no-loads the load is not applied, but a note names the load that fits
+    the residual, with its mass (within 2 % of the 0.8 kg simulated) and the share it
+    explains, and points to dropping --no-loads; the note on the flagged log names the load,
+    not the model's friction."""
+    result = _detect(logs, "loaded.csv", loads=False)
+    (log,) = result.logs
+    assert log.loads == () and any(e.end - e.start > 4.0 for e in log.events)  # not applied
+    (load,) = log.unread_loads
+    assert load.whole and load.mass == pytest.approx(MASS, rel=0.02)
+    (said,) = [x for x in result.notes if "a constant load at the flange fits" in x]
+    assert f"{load.mass:.2f} kg" in said and "without --no-loads" in said
+    assert "dynid payload" in said
+    notes = " ".join(result.notes)
+    assert "friction or other terms it misses" not in notes
 
 
 def _spliced(plain, loaded, out, t0, t1):
@@ -166,9 +189,12 @@ def test_a_model_without_friction_keeps_the_carried_loads_notes(monkeypatch):
         model=SimpleNamespace(
             source="identified", friction=None, robot=SimpleNamespace(joint_names=["a", "b"])
         ),
-        logs=[SimpleNamespace(path=Path("free.csv"), loads=[load], recording=None)],
+        logs=[
+            SimpleNamespace(path=Path("free.csv"), loads=[load], recording=None, unread_loads=[])
+        ],
         unmodelled=None, load=None, frame=None, wrench=None, friction_source=None,
-        score=lambda: None, mostly_flagged_note=lambda: None,
+        score=lambda: None, mostly_flagged_note=lambda: None, _motion_notes=lambda: (),
+        _shifted_note=lambda: None,
     )  # fmt: skip
     notes = results.ObserveResult.notes.fget(fake)
     assert notes[0] == "free.csv: carried 0.8 kg", notes

@@ -34,7 +34,13 @@ from ..observer.detection import undetected_at_rest
 from ..observer.friction import standstill_margin
 from ..observer.gain_noise import GainNoise
 from ..observer.rest_margin import rest_margin_lines
-from ..observer.results import LogObservation, ObserveResult, dropped_words, flagged_words
+from ..observer.results import (
+    LogObservation,
+    ObserveResult,
+    beyond_lines,
+    dropped_words,
+    flagged_words,
+)
 from ..observer.scoring import score_words
 from ..observer.wrench import estimate_words
 from ..pipeline.collision import CollisionStageResult
@@ -1102,6 +1108,7 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         rows += _gain_noise_line(result.gain_noise, robot)
         rows.append(f"calibrated on {th.samples} samples of {len(result.logs)} log(s)")
         rows += _check_lines(result.check, robot)
+        rows += beyond_lines(result, _labels_by_log(result))
         return "\n".join(rows)
     if "max |r|/contact" in cols:
         least = "" if result.min_duration_s is None else f" for {result.min_duration_s:g} s"
@@ -1138,10 +1145,17 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         )
     rows += _dropped_lines(result, labels, names)
     rows += _score_lines(result, labels)
+    rows += beyond_lines(result, _labels_by_log(result))
     if result.frame is not None:  # what the residual tables' fx..mz hold
         words = estimate_words(result.model.robot, result.frame, result.wrench)
         rows.append(f"estimated (fx..mz of the residual tables): {words}")
     return "\n".join(rows)
+
+
+def _labels_by_log(result: ObserveResult) -> dict[int, str]:
+    """Each log's name as the summary says it (:func:`log_labels`), by the log's ``id``."""
+    labels = log_labels([x.path for x in result.logs])
+    return {id(x): label for x, label in zip(result.logs, labels, strict=True)}
 
 
 def format_collision_stage(res: CollisionStageResult) -> str:

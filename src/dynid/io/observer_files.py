@@ -31,8 +31,11 @@
                      "model_check": {     # the model judged on the logs as validate does
                          "relative_error_percent": e, "noise_floor_percent": f,
                          "verdict": {"level", "label", "reason", "ratio"},
-                         "fitted": [k, m]}},  # k of the m logs the model's training
+                         "fitted": [k, m]},   # k of the m logs the model's training
                                           # recordings (in-sample)
+                     "beyond_identification": [  # absent: none; a log's joint moved
+                         {"log", "joint", "speed", "identified"}]},  # > 3 x as fast as
+                                          # the identification's data [rad/s]
      "units": {...}}
 
 ``events.json`` (schema ``dynid-events/1``): ``events``, a list of ``{"start", "end"}``
@@ -50,7 +53,9 @@ dropped, which are not events: ``min_duration_s`` and ``merge_s`` [s], ``count``
 :data:`~dynid.observer.events.MAX_DROPPED` per log), each ``{"start", "end",
 "duration_s"}`` [s], ``joints`` and ``joint_names`` (over the threshold), ``joint`` (the
 one furthest over it, 1-based), ``peak`` [N m] and ``ratio`` (``|r| / contact``) per
-joint, ``rule`` (``isolated`` or ``short``) and ``log``.
+joint, ``rule`` (``isolated`` or ``short``) and ``log``. ``beyond_identification`` (when
+any log moves a joint more than 3 times as fast as the model's identification data) holds
+``{"log", "joint", "speed", "identified"}`` [rad/s] per such log and joint.
 
 ``residuals.csv``: a dynid CSV table (comment lines, ``# rows: N``, a header) with ``t``
 [s], ``r1 .. rn`` [N m] and, with a frame, ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] and
@@ -127,6 +132,20 @@ _REST_MARGIN = Record(
         "min_rest_s": Field("number", required=True, low=0.0, unit="s"),
     }
 )
+#: The logs moved beyond the identification's speeds (``beyond_identification`` of
+#: ``events.json`` and of ``thresholds.json``'s ``calibration``): one entry per log and joint.
+BEYOND_IDENTIFICATION = Field(
+    "objects",
+    record=Record(
+        {
+            "log": Field("string", required=True),
+            "joint": Field("string", required=True),
+            "speed": Field("number", required=True, low=0.0, unit="rad/s"),
+            "identified": Field("number", required=True, low=0.0, unit="rad/s"),
+        }
+    ),
+)
+
 #: ``thresholds.json``: every per-joint list of the same length n
 THRESHOLDS = Format(
     THRESHOLDS_SCHEMA,
@@ -180,6 +199,7 @@ THRESHOLDS = Format(
                         "sample_rate_hz": Field("number", low=0.0, unit="Hz"),
                         "velocities": Field("string", choices=("measured", "derived", "mixed")),
                         "model_check": Field("object"),
+                        "beyond_identification": BEYOND_IDENTIFICATION,
                     },
                     open=True,
                 ),
@@ -307,6 +327,7 @@ EVENTS = Format(
             "flagged_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
             "score": Field("object", record=SCORE),
             "dropped": Field("object", record=DROPPED),
+            "beyond_identification": BEYOND_IDENTIFICATION,
             "units": Field("any"),
         },
         open=True,
@@ -722,6 +743,7 @@ def save_observation(
                 cal["sigma_max"] = check.sigma_max.tolist()
             if check.model is not None:  # the model behind the thresholds
                 cal["model_check"] = _model_check_info(check.model)
+        cal |= _beyond_info(result, cal["data"])
         return [
             save_thresholds(
                 out / "thresholds.json",
@@ -774,6 +796,7 @@ def save_observation(
         **({} if (total := result.score()) is None else {"score": _score_info(result, total)}),
         **({} if result.min_duration_s is None else {"dropped": _dropped_info(result, joints)}),
         **_loads_info(result, labels),
+        **_beyond_info(result, labels),
         **meta,
     }
     paths.insert(
@@ -815,6 +838,21 @@ def _loads_info(result: ObserveResult, labels: Sequence[str]) -> dict[str, Any]:
         for ld in x.loads
     ]
     return {"loads": out} if out else {}
+
+
+def _beyond_info(result: ObserveResult, labels: Sequence[str]) -> dict[str, Any]:
+    """``beyond_identification``: each log and joint moved more than
+    :data:`~dynid.identification.motion_range.BEYOND` times as fast as in the model's
+    identification data, with both speeds [rad/s] (:meth:`ObserveResult.beyond`);
+    nothing when none."""
+    by_log = {id(x): label for x, label in zip(result.logs, labels, strict=True)}
+    names = result.model.robot.joint_names
+    out = [
+        {"log": by_log[id(x)], "joint": names[j], "speed": here, "identified": ident}
+        for x, joints in result.beyond()
+        for j, here, ident in joints
+    ]
+    return {"beyond_identification": out} if out else {}
 
 
 def _dropped_info(result: ObserveResult, joints: Sequence[str]) -> dict[str, Any]:

@@ -81,6 +81,7 @@ __all__ = [
     "rigid_load_regressor",
     "samples_within",
     "load_words",
+    "unread_load_words",
 ]
 
 #: Shortest event read as a load [s].
@@ -537,4 +538,31 @@ def load_words(load: CarriedLoad, *, identified: bool = True) -> str:
         f"contact, not the model's error), {com}: the model lacks it; identify it with dynid "
         f"payload on collision-free logs recorded with it ({todo}), then calibrate again; "
         f"{off}"
+    )
+
+
+def unread_load_words(load: CarriedLoad, *, identified: bool = True) -> str:
+    """One line of a load that fits an event's residual in a detection with
+    :data:`NO_LOADS` (not applied): its span, mass, centre of mass and the share of the
+    residual it explains, and that the detection without the flag reads it as a load
+    (and, held through the whole log, that ``dynid payload`` identifies it)."""
+    c = ", ".join(f"{x:+.3f}" for x in load.com)
+    held = (
+        "held through the whole log"
+        if load.whole
+        else f"picked at {load.picked:.2f} s and released at {load.released:.2f} s"
+    )
+    todo = "model_with_payload.json for --model" if identified else "robot_with_payload.toml"
+    payload = (
+        f"; to add it to the model, dynid payload on collision-free logs recorded with it ({todo})"
+        if load.whole
+        else ""
+    )
+    return (
+        f"{NO_LOADS}: a constant load at the {LOAD_FRAME} fits the residual of the event "
+        f"{load.start:.2f} s to {load.end:.2f} s ({held}): {load.mass:.2f} kg, CoM ({c}) m "
+        f"in the flange's axes, explaining {100.0 * load.explained:.3g} % of it, not the "
+        "model's friction or thresholds; without "
+        f"{NO_LOADS} the event is read as that load and the contacts on top of it are "
+        f"detected{payload}"
     )

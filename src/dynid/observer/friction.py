@@ -315,6 +315,7 @@ def banding_note(
     be read as (validation: ``"judged"``, ``"model error"``)."""
     changed = [s for s in seen if s is not None and s is not friction]
     said = []
+    owned = []  # the largest band of its own each widened part carries [rad/s] (0: none)
     for k, part in enumerate(friction_parts(friction) if changed else ()):
         used = [u for s in changed if (u := friction_parts(s)[k]).kind == part.kind]
         widened = [np.asarray(u.band) > np.asarray(part.band) for u in used]
@@ -323,6 +324,8 @@ def banding_note(
         moved = np.any(widened, axis=0)
         bands = [np.asarray(u.band)[w] for u, w in zip(used, widened, strict=True)]
         top = max(float(np.max(b, initial=0.0)) for b in bands)
+        own = np.broadcast_to(np.asarray(part.band, dtype=np.float64), moved.shape)[moved]
+        owned.append(float(np.max(own, initial=0.0)))
         where = "motor" if part.at_motors else "joint"
         said.append(
             f"{part.kind} friction: the standstill band of {where}(s) "
@@ -331,10 +334,16 @@ def banding_note(
         )
     if not said:
         return None
+    if max(owned) > 0.0:  # a band of its own, narrower than these logs' noise
+        why = (
+            f"its own band, up to {max(owned):.3g} rad/s from the velocities it was "
+            "identified on, is narrower than these logs' noise"
+        )
+    else:
+        why = "it carries no band of its own; a friction.json of `dynid friction` does"
     return (
         "; ".join(said) + ": sign(dq) of the noise at rest would flip the whole Coulomb "
-        f"torque, read as {read_as} (a friction.json of `dynid friction` carries its "
-        "own band)"
+        f"torque, read as {read_as} ({why})"
     )
 
 

@@ -6,6 +6,7 @@ what :func:`dynid.io.observer_files.save_observation` writes.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -14,14 +15,16 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError
 from ..friction.model import FrictionModel, FrictionSum
+from ..identification.motion_range import BEYOND
 from .calibration_check import CalibrationCheck
-from .carried_load import CarriedLoad, load_words
+from .carried_load import NO_LOADS, CarriedLoad, load_words, unread_load_words
 from .detection import ContactEvent, Thresholds
 from .events import DroppedCrossing
 from .friction import banding_note
 from .gain_noise import GainNoise
 from .model import ObserverModel
-from .scoring import ContactScore, combined, shifted_labels_note
+from .motion_range import FASTER, beyond_joints, motion_hint
+from .scoring import ContactScore, combined, early_by_chance, shifted_labels_note
 from .thresholds import ModelFingerprint
 from .unmodelled import MOST_FLAGGED, UnmodelledFriction, no_friction_note
 from .unmodelled_load import UnmodelledLoad, load_note
@@ -33,6 +36,7 @@ __all__ = [
     "FigureSeries",
     "LogObservation",
     "ObserveResult",
+    "beyond_lines",
     "dropped_words",
     "flagged_words",
     "robot_friction_note",
@@ -139,6 +143,14 @@ class LogObservation:
         The log's stamps as ``identify`` and ``validate`` say them when jittered or
         missing samples of their grid (``rec4.csv: 1 piece, 10000 samples; stamps
         jittered, std 0.2 ms at a 2 ms period``); None: uniform.
+    speed_max : ndarray, shape (n,), or None
+        Each joint's largest speed over the observed samples [rad/s]
+        (:func:`~dynid.observer.motion_range.log_speed_max`), compared with the
+        identification's (:meth:`ObserveResult.beyond`); None: not measured.
+    unread_loads : tuple of CarriedLoad
+        Of a detection with the reading of loads off (``--no-loads``): the loads that fit
+        the residual of a long event as the default reading fits them
+        (:mod:`~dynid.observer.carried_load`), not applied: a note names them.
     """
 
     path: Path
@@ -163,6 +175,8 @@ class LogObservation:
     unexplained: tuple[float, ...] | None = None
     loads: tuple[CarriedLoad, ...] = ()
     recording: str | None = None
+    speed_max: NDArray[np.float64] | None = None
+    unread_loads: tuple[CarriedLoad, ...] = ()
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -296,8 +310,13 @@ class ObserveResult:
         weight of a load at the flange (:func:`~dynid.observer.unmodelled_load.load_note`),
         first a load carried over an event, held through a log or picked and released
         (:func:`~dynid.observer.carried_load.load_words`);
+        a calibration on logs moved beyond the identification's speeds, or a detection's
+        such log with events (:meth:`beyond`); with ``--no-loads``, the loads that fit an
+        event (:func:`~dynid.observer.carried_load.unread_load_words`);
         false alarms that each start shortly before a missed labelled contact: labels that
-        look late (:func:`~dynid.observer.scoring.shifted_labels_note`)."""
+        look late (:func:`~dynid.observer.scoring.shifted_labels_note`), left out for a log
+        beyond the identification's speeds or whose other false alarms come at a similar
+        rate (:meth:`_shifted_note`)."""
         identified = self.model.source == "identified"
         carried = [ld for x in self.logs for ld in x.loads]
         out: tuple[str, ...] = tuple(x.recording for x in self.logs if x.recording)
@@ -314,11 +333,17 @@ class ObserveResult:
                 own = robot_friction_note(self.friction_source, self.model.friction)
             banded = banding_note(self.model.friction, [x.friction for x in self.logs])
             out += tuple(x for x in (own, banded) if x is not None)
+        out += self._motion_notes()
         u = self.unmodelled  # its note says the same of a model without friction
         said = u is not None and u.overall is not None and u.flagged_share() > MOST_FLAGGED
         held = any(ld.whole for ld in carried)  # its note names the cause, not the model
         if not said and not held and (flagged := self.mostly_flagged_note()) is not None:
             out += (flagged,)
+        out += tuple(
+            f"{x.path.name}: {unread_load_words(ld, identified=identified)}"
+            for x in self.logs
+            for ld in x.unread_loads
+        )
         load = load_note(self.load, self.model.robot.joint_names, identified=identified)
         if load:
             out += (load,)
@@ -328,24 +353,111 @@ class ObserveResult:
             is not None
         ):
             out += (note,)
-        if (total := self.score()) is not None and (shifted := shifted_labels_note(total)):
+        if (shifted := self._shifted_note()) is not None:
             out += (shifted,)
         return out
+
+    def beyond(self) -> list[tuple[LogObservation, list[tuple[int, float, float]]]]:
+        """The logs that move a joint more than
+        :data:`~dynid.identification.motion_range.BEYOND` times as fast as the model's
+        identification data (its record's ``speed_max``), each with those joints (0-based),
+        their largest speed in the log and in the identification's data [rad/s]
+        (:func:`~dynid.observer.motion_range.beyond_joints`)."""
+        ident = self._identified_speeds()
+        return [(x, found) for x in self.logs if (found := beyond_joints(ident, x.speed_max))]
+
+    def _identified_speeds(self) -> tuple[float, ...] | None:
+        info = self.model.logs_read
+        return None if info is None else info.speed_max
+
+    def _beyond_hint(self, x: LogObservation) -> str | None:
+        """``validate``'s words on the log ``x`` moved beyond the identification's speeds."""
+        return motion_hint(self._identified_speeds(), x.speed_max, self.model.robot.joint_names)
+
+    def _motion_notes(self) -> tuple[str, ...]:
+        """A calibration on logs moved beyond the identification's speeds: its thresholds
+        hold the model's error there; a detection's log so moved, with events, when the
+        note on most of the logs flagged does not say it: its events may be the model's
+        error."""
+        calibrating = self.min_duration_s is None
+        flagged = self.mostly_flagged_note() is not None
+        out = []
+        for x, _ in self.beyond():
+            hint = self._beyond_hint(x)
+            if hint is None:
+                continue
+            if calibrating:
+                out.append(
+                    f"{x.path.name}: thresholds calibrated on motion beyond the model's "
+                    f"identification data hold its error at those speeds: {hint}"
+                )
+            elif x.events and not flagged:
+                out.append(
+                    f"{x.path.name}: its events may be the model's error rather than "
+                    f"contacts: {hint}"
+                )
+        return tuple(out)
+
+    def _shifted_note(self) -> str | None:
+        """The note on labels that look late (:func:`~dynid.observer.scoring.shifted_labels_note`)
+        over the logs whose false alarms before missed contacts no other cause explains: a
+        log moved beyond the identification's speeds (the model's error at speed) or one
+        with false alarms elsewhere at a similar rate
+        (:func:`~dynid.observer.scoring.early_by_chance`) does not count."""
+        beyond = {id(x) for x, _ in self.beyond()}
+        scores = []
+        for x in self.logs:
+            if (sc := x.score) is None:
+                continue
+            if id(x) in beyond or early_by_chance(sc):
+                sc = dataclasses.replace(sc, early=())
+            scores.append(sc)
+        return shifted_labels_note(combined(scores)) if scores else None
 
     def mostly_flagged_note(self) -> str | None:
         """Of a detection whose events cover more than half of the logs
         (:data:`MOST_FLAGGED_TIME`): a residual over the contact threshold through most of
-        the motion is the model's error, not contacts; None otherwise (a calibration)."""
+        the motion is the model's error, not contacts; None otherwise (a calibration).
+        Where a log moves beyond the identification's speeds, the note names that as the
+        cause (``validate``'s words); where a load fits the residual with ``--no-loads``,
+        the load."""
         if self.min_duration_s is None:
             return None
         flagged, logged = self.flagged(loads=False)  # a load's event is no model error
         if not (logged > 0 and flagged > MOST_FLAGGED_TIME * logged):
             return None
-        return (
+        head = (
             f"events cover {100.0 * flagged / logged:.3g} % of the logs: a residual over "
-            "the contact threshold through most of the motion is the model's error (friction "
+            "the contact threshold through most of the motion"
+        )
+        if any(x.unread_loads for x in self.logs):
+            return (
+                f"{head} is not contacts: a load at the flange that the model lacks fits "
+                f"it (named below; {NO_LOADS} reads it as the model's error)"
+            )
+        beyond = [f"{x.path.name}: {h}" for x, _ in self.beyond() if (h := self._beyond_hint(x))]
+        if beyond:
+            return f"{head} is the model's error, not contacts: " + "; ".join(beyond)
+        names = self.model.robot.joint_names
+        faster = [
+            f"{x.path.name} moves "
+            + ", ".join(f"{names[j]} up to {h:.3g} rad/s" for j, h, _ in found)
+            + " ("
+            + ", ".join(f"{i:.3g}" for *_, i in found)
+            + " in the identification's data)"
+            for x in self.logs
+            if (found := beyond_joints(self._identified_speeds(), x.speed_max, FASTER))
+        ]
+        where = (
+            ""
+            if not faster
+            else f"; {'; '.join(faster)}: the model extrapolates there (friction growing "
+            "faster with speed than its law)"
+        )
+        return (
+            f"{head} is the model's error (friction "
             "or other terms it misses, or thresholds calibrated with another model), not "
-            "contacts; check the model on a collision-free log with dynid validate"
+            f"contacts{where}; check the model on a collision-free log with dynid validate"
         )
 
 
@@ -372,6 +484,30 @@ def robot_friction_note(source: str, friction: FrictionModel | FrictionSum) -> s
         + (f": {', '.join(sizes)}" if sizes else "")
         + "); --friction friction.json (of `dynid friction`) replaces it"
     )
+
+
+def beyond_lines(result: ObserveResult, labels: dict[int, str] | None = None) -> list[str]:
+    """The summary's lines on the logs moved beyond the identification's speeds
+    (:meth:`ObserveResult.beyond`): a head, then per log its joints with both speeds;
+    ``labels``: each log's name by its ``id`` (default its file name); none without such a
+    log."""
+    found = result.beyond()
+    if not found:
+        return []
+    names = result.model.robot.joint_names
+    rows = [
+        f"motion beyond the identification's data (over {BEYOND:g} x a joint's largest "
+        "speed there): the model extrapolates"
+        + (", and the thresholds hold its error there" if result.min_duration_s is None else "")
+    ]
+    for x, joints in found:
+        name = x.path.name if labels is None else labels.get(id(x), x.path.name)
+        said = ", ".join(
+            f"{names[j]} {here:.3g} rad/s ({ident:.3g} in the identification's data)"
+            for j, here, ident in joints
+        )
+        rows.append(f"  {name}: {said}")
+    return rows
 
 
 def flagged_words(flagged: float, logged: float) -> str:

@@ -137,6 +137,7 @@ from .observe_logs import (
     observed_blocks,
     prepared_log,
     recording_note,
+    speeds_of,
 )
 from .recordings import (
     Recorded,
@@ -619,6 +620,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
                 loads=opts.loads,
             )  # fmt: skip
         )
+        logs[-1] = dataclasses.replace(logs[-1], speed_max=speeds_of(prep, model))
     return ObserveResult(
         model, given, tuple(logs), fingerprint, own, opts.frame, kind,
         min_duration_s=opts.min_duration_s, merge_s=opts.merge_s,
@@ -1136,6 +1138,7 @@ def _observation(
             peak,
             friction=None if seen is model.friction else seen,
             recording=recording_note(prep),
+            speed_max=speeds_of(prep, model),
         )
 
     return in_file(path, run)

@@ -323,7 +323,9 @@ def detected_log(
     pick: an external force, a weight or a steady push along gravity alike) is kept with
     the level ``load`` and scored as any event. ``retable`` opens the residual table
     again for that second run (``retable(loads=...)``: its header names the loads);
-    ``loads`` False (``--no-loads``): no event is read as a load."""
+    ``loads`` False (``--no-loads``): no event is read as a load; those that fit one are
+    kept as :attr:`~dynid.observer.results.LogObservation.unread_loads` (a note names
+    them)."""
     log = prep.log
     steps = np.diff(log.t)
     period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
@@ -333,7 +335,7 @@ def detected_log(
         first = _detected_once(
             prep, model, mapped, thresholds, options, table=table, samples=samples, **kw
         )
-    if not log.t.shape[0] or not loads:
+    if not log.t.shape[0]:
         _said_again(said)
         return first
     span = (float(log.t[0]), float(log.t[-1]))
@@ -341,9 +343,9 @@ def detected_log(
     long = any(b - a >= MIN_LOAD_S for a, b in events)
     motion = _load_motion(prep) if long else None
     found = carried_loads(model.robot, samples, events, options.gains(model.n), span, motion)
-    if not found:
+    if not found or not loads:  # --no-loads: the loads that fit are named, not applied
         _said_again(said)
-        return first
+        return replace(first, unread_loads=tuple(found)) if found else first
     kw = {**kw, "unmodelled": None, "load": None, "motion": motion}  # fed once, by the first
     kw["picks"] = load_events(found, first.events)
     again = None if retable is None else retable(loads=found)  # its header names them

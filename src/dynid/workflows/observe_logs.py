@@ -51,6 +51,7 @@ from ..observer.friction import (
     velocity_bands,
 )
 from ..observer.model import ObserverModel
+from ..observer.motion_range import log_speed_max, speed_window
 from ..observer.pieces import PositionJump, pieces, position_jumps
 from ..observer.residual import MomentumObserver, ObserverOptions
 from ..observer.thresholds import RestMargin
@@ -68,6 +69,7 @@ __all__ = [
     "observed_blocks",
     "observed_rows",
     "prepared_log",
+    "speeds_of",
 ]
 
 
@@ -185,6 +187,16 @@ def _finite(spans: list[tuple[int, int]], dq: NDArray[np.float64]) -> list[tuple
     """The spans whose velocities are finite throughout (a piece too short to filter has
     NaN derived velocities: it is not observed, never an error about a velocity column)."""
     return [(a, b) for a, b in spans if np.isfinite(dq[a:b]).all()]
+
+
+def speeds_of(prep: PreparedLog, model: ObserverModel) -> NDArray[np.float64]:
+    """Each joint's largest speed (n,) [rad/s] over the samples the observer runs on,
+    measured as the model's identification measured its own (velocities averaged over a
+    quarter period of its cut-off, else of the observer's:
+    :func:`~dynid.observer.motion_range.log_speed_max`)."""
+    info = model.logs_read
+    cutoff = prep.cutoff_hz if info is None or info.cutoff_hz is None else info.cutoff_hz
+    return log_speed_max(prep.dq, prep.spans, speed_window(prep.log.t, cutoff))
 
 
 def recording_note(prep: PreparedLog) -> str | None:
