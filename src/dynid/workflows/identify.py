@@ -53,6 +53,7 @@ from ..feasibility.convex import (
 from ..feasibility.payload_arm import model_structure
 from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
+from ..identification.confounded_offset import with_confounded_offsets
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.core import model_loose, shared_bases
 from ..identification.data import StaticDataset
@@ -660,6 +661,7 @@ def _fit_logs(
     logs = fitted_logs(model, logs)  # without the recordings found outlying
     model = _say_gravity_scale(robot, model, logs, opt.drive, held)
     model = _with_unknown_scale(model, held, robot.joint_names)
+    model = _with_confounded(model, held)
     if opt.consistent:
         result = _consistent_of(robot, model, held, first, opt, prior)
         return IdentifyResult(model, result, (), held, None, gravity)
@@ -908,6 +910,18 @@ def _spring_judged(
         return model, held
     model = fitted("auto", drive, named)
     return model, _predicted_heldout(model, logs, separate)
+
+
+def _with_confounded(model: IdentifiedModel, held: HeldOutTorques | None) -> IdentifiedModel:
+    """``model`` with a note per torque offset left out that its training data cannot tell
+    from a link parameter (:func:`~dynid.identification.confounded_offset.
+    with_confounded_offsets`, on the held-out prediction's prepared pieces), each said."""
+    if held is None or not held.prepared:
+        return model
+    model, said = with_confounded_offsets(model, held.prepared)
+    for note in said:
+        _log.log(NOTE, "%s", note)
+    return model
 
 
 def _loose_at_floor(
