@@ -172,3 +172,22 @@ def test_identify_notes_an_offset_left_out_that_a_link_parameter_takes_up(arm, n
         warnings.simplefilter("ignore", DynidWarning)
         got = identify_logs(arm, wide, IdentifyOptions(terms=TERMS), names=["c.csv", "d.csv"])
     assert not [n for n in got.model.info.notes if "cannot tell it from" in n]
+
+
+def test_a_separate_recording_at_other_poses_is_judged_as_validate_judges_it(arm):
+    """identify's held-out verdict on a separate recording (``validate_on``) with joint 1
+    at 0.75..1.25 rad (trained within +-0.25): joint 1 named outside on every sample, the
+    extrapolation said first, no offset of the recording's own asserted; heldout.json's
+    record names it."""
+    logs = [_recording(arm, _sines(0.0, 0.25, s), s) for s in (1, 2)]
+    far = _recording(arm, _sines(1.0, 0.25, 7), 7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        got = identify_logs(arm, logs, IdentifyOptions(terms=TERMS), validate_on=far)
+    assert got.heldout is not None
+    reason = got.heldout.verdict.reason
+    assert f"outside the identification's motion: {arm.joint_names[0]} at " in reason, reason
+    assert "100 % of samples outside" in reason and "extrapolates there first" in reason, reason
+    assert "zeroed anew" not in reason, reason
+    (joint,) = [j for j in got.heldout.as_dict()["outside_training"]["joints"] if j["clear"]]
+    assert joint["joint"] == 1 and joint["share_percent"] == 100

@@ -39,7 +39,7 @@ __all__ = [
 #: the range's span (and :data:`TOLERANCE_LEAST`): noise and filtering at the range's ends;
 #: a velocity by :data:`SPEED_TOLERANCE` (a recording's peaks seldom match).
 TOLERANCE = 0.02
-SPEED_TOLERANCE = 0.1
+SPEED_TOLERANCE = 0.25
 #: The least margin [rad, rad/s; m, m/s] beyond a range that counts (a joint held still).
 TOLERANCE_LEAST = 0.01
 #: A joint clearly outside: at least this share of the recording's samples outside ...
@@ -135,6 +135,24 @@ class OutsideTraining:
                 f"outside, up to {o.beyond:.2g} {unit} beyond)"
             )
         return "outside the identification's motion: " + "; ".join(parts)
+
+    def concerned(self, joints: set[int]) -> tuple[int, ...]:
+        """Of ``joints`` (0-based: those the residual concerns), those clearly outside the
+        training's poses."""
+        return tuple(sorted(set(self.clear("position")) & joints))
+
+    @staticmethod
+    def hedge(joints: Sequence[int], causes: Sequence[str], joint_names: Sequence[str]) -> str:
+        """The clause that puts the extrapolation before the ``causes`` (in words; none:
+        what the residual follows) the residual of ``joints`` would be given."""
+        which = ", ".join(joint_names[j] for j in joints)
+        cause = " or ".join(causes) if causes else "what it follows along the motion"
+        return (
+            f"the model extrapolates there first: the recording lies clearly outside the "
+            f"identification's poses on {which}, so {cause} is not confirmed as the "
+            "residual's cause; hint: validate on a recording within those poses, or identify "
+            "from recordings that cover these poses too"
+        )
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready: per joint outside, ``joint`` (from 1), ``kind``, ``here``,

@@ -77,6 +77,7 @@ from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
 from ..identification.torque_delay import TorqueDelay
+from ..identification.training_range import outside_training
 from ..model.drive import Drive
 from ..model.robot import Robot, checked_robot
 from ..progress import NOTE
@@ -718,12 +719,14 @@ def _predicted_heldout(
     model: IdentifiedModel, logs: Sequence[TorqueLog], separate: TorqueLog | None
 ) -> HeldOutTorques | None:
     """The held-out prediction of ``model`` fitted to ``logs`` (``separate``: the
-    ``validate_on`` log), from the logs as the fit took them (without those it left out,
+    ``validate_on`` log, with the joints it takes outside the training's positions and
+    velocities: :func:`~dynid.identification.training_range.outside_training`), from the
+    logs as the fit took them (without those it left out,
     :func:`~dynid.identification.selection.fitted_logs`); one it cannot make (every
     held-out piece too short to filter) is a warning, never a failed identification."""
     logs = fitted_logs(model, logs)
     try:
-        return heldout_torques(model, logs[-1], separate=separate, others=logs[:-1])
+        held = heldout_torques(model, logs[-1], separate=separate, others=logs[:-1])
     except DynidError as exc:
         warnings.warn(
             f"skipped the held-out prediction (heldout.json and its figures): {exc}",
@@ -731,6 +734,11 @@ def _predicted_heldout(
             stacklevel=caller_level(),
         )
         return None
+    record = model.info.log
+    if held is None or separate is None or record is None:
+        return held
+    ranges, log = (record.position_range, record.velocity_range), held.validation.log
+    return dataclasses.replace(held, outside=outside_training(*ranges, [log.q], [log.dq]))
 
 
 def _say_gravity_scale(

@@ -67,18 +67,6 @@ def _concerned(hints: ResidualHints, noise: JudgedNoise, cause_joints: set[int])
     return above | cause_joints
 
 
-def _hedge(said: list[str], joints: Sequence[int], names: Sequence[str]) -> str:
-    """The clause that puts the extrapolation first."""
-    which = ", ".join(names[j] for j in joints)
-    cause = " or ".join(said) if said else "what it follows along the motion"
-    return (
-        f"the model extrapolates there first: the recording lies clearly outside the "
-        f"identification's poses on {which}, so {cause} is not confirmed as the residual's "
-        "cause; hint: validate on a recording within those poses, or identify from "
-        "recordings that cover these poses too"
-    )
-
-
 def _appended(verdict: Verdict, clause: str) -> Verdict:
     """``verdict`` with ``clause`` appended to its reason at any level."""
     return dataclasses.replace(verdict, reason=f"{verdict.reason}; {clause}")
@@ -108,10 +96,10 @@ def outside_said(
         return hints, None
     line = outside.sentence(names, units)
     said, cause_joints = _causes(hints, names)
-    clear = sorted(set(outside.clear("position")) & _concerned(hints, noise, cause_joints))
+    clear = outside.concerned(_concerned(hints, noise, cause_joints))
     if clear and hints.verdict.level != "good":
         plain = without_causes()
         if plain.verdict.reason != hints.verdict.reason or said:  # a cause was said
-            verdict = _appended(_appended(plain.verdict, line), _hedge(said, clear, names))
+            verdict = _appended(_appended(plain.verdict, line), outside.hedge(clear, said, names))
             return dataclasses.replace(plain, verdict=verdict), outside
     return dataclasses.replace(hints, verdict=_appended(hints.verdict, line)), outside
