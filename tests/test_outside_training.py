@@ -191,3 +191,14 @@ def test_a_separate_recording_at_other_poses_is_judged_as_validate_judges_it(arm
     assert "zeroed anew" not in reason, reason
     (joint,) = [j for j in got.heldout.as_dict()["outside_training"]["joints"] if j["clear"]]
     assert joint["joint"] == 1 and joint["share_percent"] == 100
+
+
+def test_one_recording_held_out_in_time_blocks_gets_the_note_too(arm):
+    """One recording (held out in time blocks, no pieces kept apart) with joint 1 within
+    +-0.25 rad: the offset left out is named as with several recordings."""
+    log = _recording(arm, _sines(0.0, 0.25, 5), 5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        got = identify_logs(arm, [log], IdentifyOptions(terms=TERMS))
+    (note,) = [n for n in got.model.info.notes if "cannot tell it from" in n]
+    assert note.startswith("joint 1 (") and "fo1 was left out" in note and "mc1x" in note

@@ -923,10 +923,15 @@ def _spring_judged(
 def _with_confounded(model: IdentifiedModel, held: HeldOutTorques | None) -> IdentifiedModel:
     """``model`` with a note per torque offset left out that its training data cannot tell
     from a link parameter (:func:`~dynid.identification.confounded_offset.
-    with_confounded_offsets`, on the held-out prediction's prepared pieces), each said."""
-    if held is None or not held.prepared:
+    with_confounded_offsets`, on the held-out prediction's prepared pieces: of one
+    recording held out in time blocks, the whole of it as predicted), each said."""
+    if held is None:
         return model
-    model, said = with_confounded_offsets(model, held.prepared)
+    blocks = model.holdout is not None and model.holdout.scheme == "blocks"
+    pieces = held.prepared or ((held.validation.log,) if blocks else ())
+    if not pieces:
+        return model
+    model, said = with_confounded_offsets(model, pieces)
     for note in said:
         _log.log(NOTE, "%s", note)
     return model
