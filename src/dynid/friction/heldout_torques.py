@@ -78,8 +78,10 @@ from ..identification.residual_dependence import (
 from ..identification.residual_spring import ResidualSpring, residual_spring
 from ..identification.rotor_sign import per_joint
 from ..identification.spikes import despiked
+from ..identification.training_range import OutsideTraining
 from ..identification.verdict import (
     NOISE_FLOOR_SHARE,
+    SYSTEMATIC_RATIO,
     Verdict,
     with_caveat,
     with_hint,
@@ -186,6 +188,12 @@ class HeldOutTorques:
         of the others: a residual that is one steady constant over each is said as the
         recordings' own torque offsets (:mod:`~dynid.identification.recording_level`),
         as ``validate`` says it; None: one held-out block or log.
+    outside : OutsideTraining or None
+        Of a separate recording (``validate_on``), the joints it takes outside the
+        positions and velocities the model was fitted on
+        (:mod:`~dynid.identification.training_range`): said in the verdict, which names no
+        cause of a residual where it lies clearly outside the training's poses; None:
+        none, or held-out data of the training's own recordings.
     """
 
     validation: Validation
@@ -207,6 +215,7 @@ class HeldOutTorques:
     robot: Robot | None = None
     fitted: tuple[tuple[int, NDArray[np.float64]], ...] | None = None
     recording: NDArray[np.intp] | None = None
+    outside: OutsideTraining | None = None
 
     def _judged(self) -> tuple[Verdict, NoiseFloor]:
         """:func:`~dynid.identification.floor_verdict.judged_prediction` of the held-out
@@ -253,10 +262,12 @@ class HeldOutTorques:
         v = self.validation
         said = None if self.gains is None else self.gains.sentence()
         own = None if said is not None else self._own_offsets(verdict)
-        verdict = with_hint(verdict, None if own is None else own.sentence(self.joint_names))
+        line, hedge = self._extrapolated(verdict, fl.joint_ratios, own)
+        own_said = None if own is None or hedge else own.sentence(self.joint_names)
+        verdict = with_hint(verdict, own_said)
         verdict = (
             with_hint(verdict, said)
-            if said is not None
+            if said is not None or hedge is not None
             else with_dependence_hint(
                 verdict,
                 [v.log.q],
@@ -277,10 +288,39 @@ class HeldOutTorques:
         )
         if said is not None and verdict.level == "good":  # at the floor, the factors said
             verdict = dataclasses.replace(verdict, reason=f"{verdict.reason}; {said}")
+        for clause in (line, hedge):
+            if clause is not None:
+                verdict = dataclasses.replace(verdict, reason=f"{verdict.reason}; {clause}")
         verdict = with_derived_cutoff_hint(verdict, self.logs, self.cutoff_hz)
         verdict = with_hint(verdict, self.low_speed, ", ")
         verdict = with_caveat(verdict, self.caveat)
         return with_replaced_spikes(verdict, self.spikes, ", as the fit replaced them")
+
+    def _extrapolated(
+        self,
+        verdict: Verdict,
+        ratios: NDArray[np.float64] | None,
+        own: RecordingLevels | None,
+    ) -> tuple[str | None, str | None]:
+        """The clause naming the joints the held-out recording takes outside the training
+        (:attr:`outside`; None: none), and, above the floor where it lies clearly outside
+        the training's poses on a joint the residual concerns (above its noise, or named by
+        a cause), the clause that puts the model's extrapolation before any cause (None:
+        the causes are said as before)."""
+        if self.outside is None:
+            return None, None
+        line = self.outside.sentence(self.joint_names)
+        springs = () if self.springs is None else tuple(self.springs.named)
+        joints = set(springs) | (set() if own is None else set(own.joints))
+        if ratios is not None:
+            joints |= {int(j) for j in np.flatnonzero(np.asarray(ratios) >= SYSTEMATIC_RATIO)}
+        clear = self.outside.concerned(joints)
+        if verdict.level == "good" or not clear:
+            return line, None
+        causes = [] if own is None else ["the recording's own torque offset"]
+        causes += ["a tilted gravity vector"] if self.tilt is not None and self.tilt.named else []
+        causes += ["a joint spring"] if springs else []
+        return line, self.outside.hedge(clear, causes, self.joint_names)
 
     def _own_offsets(self, verdict: Verdict) -> RecordingLevels | None:
         """Above the floor, the joints whose model holds an offset and whose held-out
@@ -342,7 +382,9 @@ class HeldOutTorques:
         of the gravity vector the residual points to (``gravity_tilt``, null when not
         judged), and the stiffness per joint it points to (``springs``, null when not
         judged; schema ``heldout.json``), and the gain per motor of the logged efforts
-        (``drive_gains``, null when not judged)."""
+        (``drive_gains``, null when not judged), and of a separate recording the joints it
+        takes outside the training's motion (``outside_training``, when any:
+        :meth:`~dynid.identification.training_range.OutsideTraining.as_dict`)."""
         e, v, fl = self.validation.errors, self.verdict, self.floor
         return {
             "block": self.block,
@@ -363,6 +405,7 @@ class HeldOutTorques:
             "gravity_tilt": None if self.tilt is None else self.tilt.as_dict(),
             "springs": None if self.springs is None else self.springs.as_dict(),
             "drive_gains": None if self.gains is None else self.gains.as_dict(),
+            **({"outside_training": o.as_dict()} if (o := self.outside) is not None else {}),
             "units": units_said(
                 self.robot,
                 {

@@ -96,6 +96,11 @@ class LogInfo:
         the joints): the motion the model was identified on, which ``validate`` compares
         a recording's with (:mod:`~dynid.identification.motion_range`); None in older
         records.
+    position_range, velocity_range : tuple of (float, float) or None
+        Each joint's lowest and highest position [rad or m] and velocity [rad/s or m/s]
+        over the samples used (as prepared, at the joints): the poses and motion the model
+        was identified on, which ``validate`` compares a recording's with
+        (:mod:`~dynid.identification.training_range`); None in older records.
     drop_invalid : bool
         Rows with NaN/inf or a repeated timestamp were dropped from the logs
         (``--drop-invalid``) instead of refused: ``validate``, ``friction``, ``observe``
@@ -122,6 +127,8 @@ class LogInfo:
     stamp_jitter_s: float = 0.0
     torque_delay_s: float = 0.0
     drop_invalid: bool = False
+    position_range: tuple[tuple[float, float], ...] | None = None
+    velocity_range: tuple[tuple[float, float], ...] | None = None
 
     @property
     def preprocessing(self) -> Preprocessing:

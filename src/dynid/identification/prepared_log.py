@@ -41,6 +41,7 @@ from .prepare import (
 from .rate import cutoff_from_motion, decimation, motion_frequency
 from .sanity import check_torque_log, too_few_samples
 from .serial import Serial, hac_lag
+from .training_range import motion_ranges
 from .velocity_noise import moving_joints, signal_noise_std
 
 __all__ = ["MAX_FINE_BYTES", "PreparedLog", "prepare_torque_log"]
@@ -216,6 +217,8 @@ class PreparedLog(TorqueRoute):
                 motion_frequency_hz=self.motion_frequency_hz,
                 resampled=self.resampled,
                 speed_max=tuple(float(x) for x in np.max(np.abs(self.log.dq), axis=0)),
+                position_range=motion_ranges([self.log.q]),
+                velocity_range=motion_ranges([self.log.dq]),
             ),
         )
 

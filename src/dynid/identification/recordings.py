@@ -88,6 +88,7 @@ from .sanity import check_torque_log
 from .serial import Serial, serial_of_pieces
 from .spikes import despiked, spike_finding
 from .streaming import streams
+from .training_range import motion_ranges
 from .trim import common_cutoff, edge_seconds, within_edges
 from .velocity_noise import noise_band, pieces_noise_std
 
@@ -442,6 +443,8 @@ class Recordings(TorqueRoute):
             speed_max=tuple(
                 float(x) for x in np.max([np.max(np.abs(p.log.dq), axis=0) for p in ps], axis=0)
             ),
+            position_range=motion_ranges([p.log.q for p in ps]),
+            velocity_range=motion_ranges([p.log.dq for p in ps]),
             max_gap_s=self.max_gap_s,
             torque_delay_s=self.torque_delay_s,
             n_dropped=sum(c.n_dropped for c in found.values()),

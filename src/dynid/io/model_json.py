@@ -316,6 +316,9 @@ def _route_parts(m: dict[str, Any]) -> tuple[StaticInfo | None, LogInfo | None]:
         vals = {k: m.pop(k) for k in _LOG_KEYS if k in m}
         if vals.get("speed_max") is not None:
             vals["speed_max"] = tuple(float(x) for x in vals["speed_max"])
+        for key in ("position_range", "velocity_range"):
+            if vals.get(key) is not None:
+                vals[key] = tuple((float(a), float(b)) for a, b in vals[key])
         log = LogInfo(**vals)
     return static, log
 
@@ -368,6 +371,9 @@ _META = Record(
         "friction_band": Field("numbers", null_items=True),
         "friction_kept": Field("bools"),
         "rank_gap": Field("numbers", nullable=True, shape=(2,)),
+        "speed_max": Field("numbers", nullable=True, shape=(None,), low=0),
+        "position_range": Field("numbers", nullable=True, shape=(None, 2)),
+        "velocity_range": Field("numbers", nullable=True, shape=(None, 2)),
     },
     open=True,
 )

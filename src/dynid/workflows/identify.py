@@ -53,6 +53,7 @@ from ..feasibility.convex import (
 from ..feasibility.payload_arm import model_structure
 from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
+from ..identification.confounded_offset import with_confounded_offsets
 from ..identification.consistency import fit_mismatch, limit_violations
 from ..identification.core import model_loose, shared_bases
 from ..identification.data import StaticDataset
@@ -76,6 +77,7 @@ from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
 from ..identification.torque_delay import TorqueDelay
+from ..identification.training_range import outside_training
 from ..model.drive import Drive
 from ..model.robot import Robot, checked_robot
 from ..progress import NOTE
@@ -660,6 +662,7 @@ def _fit_logs(
     logs = fitted_logs(model, logs)  # without the recordings found outlying
     model = _say_gravity_scale(robot, model, logs, opt.drive, held)
     model = _with_unknown_scale(model, held, robot.joint_names)
+    model = _with_confounded(model, held)
     if opt.consistent:
         result = _consistent_of(robot, model, held, first, opt, prior)
         return IdentifyResult(model, result, (), held, None, gravity)
@@ -716,12 +719,14 @@ def _predicted_heldout(
     model: IdentifiedModel, logs: Sequence[TorqueLog], separate: TorqueLog | None
 ) -> HeldOutTorques | None:
     """The held-out prediction of ``model`` fitted to ``logs`` (``separate``: the
-    ``validate_on`` log), from the logs as the fit took them (without those it left out,
+    ``validate_on`` log, with the joints it takes outside the training's positions and
+    velocities: :func:`~dynid.identification.training_range.outside_training`), from the
+    logs as the fit took them (without those it left out,
     :func:`~dynid.identification.selection.fitted_logs`); one it cannot make (every
     held-out piece too short to filter) is a warning, never a failed identification."""
     logs = fitted_logs(model, logs)
     try:
-        return heldout_torques(model, logs[-1], separate=separate, others=logs[:-1])
+        held = heldout_torques(model, logs[-1], separate=separate, others=logs[:-1])
     except DynidError as exc:
         warnings.warn(
             f"skipped the held-out prediction (heldout.json and its figures): {exc}",
@@ -729,6 +734,11 @@ def _predicted_heldout(
             stacklevel=caller_level(),
         )
         return None
+    record = model.info.log
+    if held is None or separate is None or record is None:
+        return held
+    ranges, log = (record.position_range, record.velocity_range), held.validation.log
+    return dataclasses.replace(held, outside=outside_training(*ranges, [log.q], [log.dq]))
 
 
 def _say_gravity_scale(
@@ -908,6 +918,23 @@ def _spring_judged(
         return model, held
     model = fitted("auto", drive, named)
     return model, _predicted_heldout(model, logs, separate)
+
+
+def _with_confounded(model: IdentifiedModel, held: HeldOutTorques | None) -> IdentifiedModel:
+    """``model`` with a note per torque offset left out that its training data cannot tell
+    from a link parameter (:func:`~dynid.identification.confounded_offset.
+    with_confounded_offsets`, on the held-out prediction's prepared pieces: of one
+    recording held out in time blocks, the whole of it as predicted), each said."""
+    if held is None:
+        return model
+    blocks = model.holdout is not None and model.holdout.scheme == "blocks"
+    pieces = held.prepared or ((held.validation.log,) if blocks else ())
+    if not pieces:
+        return model
+    model, said = with_confounded_offsets(model, pieces)
+    for note in said:
+        _log.log(NOTE, "%s", note)
+    return model
 
 
 def _loose_at_floor(

@@ -42,6 +42,7 @@ with every policy the command applies, so that the Python API behaves as the com
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import warnings
 from collections.abc import Callable, Sequence
@@ -79,6 +80,7 @@ from ..identification.recorded_signs import SignFinding
 from ..identification.residual_spring import ResidualSpring
 from ..identification.spikes import SPIKES_BEFORE_JUDGING
 from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_delay
+from ..identification.training_range import OutsideTraining
 from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -105,7 +107,8 @@ from .recordings import (
     unwrapped_recorded,
     warn_signs,
 )
-from .validate_hints import JudgedNoise, residual_hints, terms_held
+from .validate_hints import JudgedNoise, ResidualHints, residual_hints, terms_held
+from .validate_outside import outside_said, training_record
 
 __all__ = ["ValidateOptions", "ValidateResult", "identification_beside", "validate_files"]
 
@@ -273,6 +276,10 @@ class ValidateResult:
         (:func:`~dynid.observer.residual_load.residual_load`; named first in ``verdict``'s
         reason, the joints diagnosed on what it leaves, when
         :attr:`~dynid.observer.residual_load.ResidualLoad.named`); None: not judged.
+    outside : OutsideTraining, optional
+        The joints the recordings take outside the positions and velocities the model was
+        identified on (:mod:`~dynid.workflows.validate_outside`, said in ``verdict``'s
+        reason); None: none, or no record of them.
     """
 
     validation: RecordingsValidation
@@ -298,6 +305,7 @@ class ValidateResult:
     gains: DriveGains | None = None
     flange_load: ResidualLoad | None = None
     error_spans: ErrorSpans | None = None
+    outside: OutsideTraining | None = None
 
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
@@ -324,7 +332,10 @@ class ValidateResult:
         :meth:`~dynid.identification.torque_delay.TorqueDelay.as_dict`) and
         ``torque_delay_used`` (the delay the recordings were prepared with and its source,
         when one was applied or given:
-        :meth:`~dynid.identification.torque_delay.AppliedDelay.as_dict`)."""
+        :meth:`~dynid.identification.torque_delay.AppliedDelay.as_dict`) and
+        ``outside_training`` (the joints the recordings take outside the positions and
+        velocities the model was identified on, when any:
+        :meth:`~dynid.identification.training_range.OutsideTraining.as_dict`)."""
         v = self.verdict
         spikes = dict(zip(self.files, self.spikes, strict=True)) if self.spikes else None
         parts = {
@@ -357,6 +368,7 @@ class ValidateResult:
             **({"drive_gains": self.gains.as_dict()} if self.gains is not None else {}),
             **({"torque_delay": d.as_dict()} if (d := self.torque_delay) and d.named else {}),
             **({"torque_delay_used": a.as_dict()} if (a := self.applied_delay) else {}),
+            **({"outside_training": o.as_dict()} if (o := self.outside) is not None else {}),
         } | ({"joint_names": list(self.joint_names)} if self.joint_names else {})
 
 
@@ -473,11 +485,11 @@ def validate_files(
     # a torque of the opposite sign leaves twice the torque, which no term of the model
     # explains: what the residual follows is not diagnosed (a current log's gains are)
     current = not beyond and placed is not None and placed.effort == "current"
-    hints = residual_hints(
-        model, verdict, val, rec.logs, noise, names,
-        dependence=not beyond and not opposite and sign_map is None and burst is None,
-        held=terms_held(model, placed, label), gains_too=current,
-        payload=_payload_command(model, data, label, feasible, source),
+    hints, outside = _hinted(model if own is None else own, functools.partial(
+            residual_hints, model, verdict, val, rec.logs, noise, names,
+            held=terms_held(model, placed, label), gains_too=current,
+            payload=_payload_command(model, data, label, feasible, source),
+        ), not beyond and not opposite and sign_map is None and burst is None, val, noise,
     )  # fmt: skip
     verdict, gains = with_motion_range_hint(hints.verdict, speeds, dq, names), hints.gains
     named = gains is not None and bool(gains.named)  # a scale off leaves no lag to name
@@ -504,7 +516,7 @@ def validate_files(
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
         reversed_columns=tuple((f.name, f.text) for f in opposite if f.kind == "reversed"),
         springs=hints.springs, gains=gains, torque_delay=delay, applied_delay=applied,
-        gravity_tilt=hints.tilt, flange_load=hints.load, error_spans=burst,
+        gravity_tilt=hints.tilt, flange_load=hints.load, error_spans=burst, outside=outside,
     )  # fmt: skip
 
 
@@ -620,6 +632,25 @@ def _identified_speeds(model: IdentifiedModel | Robot) -> Any:
     if isinstance(model, IdentifiedModel) and model.info.log is not None:
         return model.info.log.speed_max
     return None
+
+
+def _hinted(
+    trained: IdentifiedModel | Robot,
+    hints: Callable[..., ResidualHints],
+    dependence: bool,
+    val: RecordingsValidation,
+    noise: JudgedNoise,
+) -> tuple[ResidualHints, OutsideTraining | None]:
+    """The verdict's hints (``hints``, :func:`~.validate_hints.residual_hints` given all but
+    ``dependence``), with the joints the recordings take outside the motion ``trained``
+    was identified on said, and no cause asserted where they lie clearly outside its poses
+    (:func:`~.validate_outside.outside_said`)."""
+    robot = kinematics_of(trained)
+    units = ["m" if p else "rad" for p in robot.prismatic]
+    return outside_said(
+        training_record(trained), hints(dependence=dependence),
+        lambda: hints(dependence=False), val, noise, robot.joint_names, units,
+    )  # fmt: skip
 
 
 def _payload_command(

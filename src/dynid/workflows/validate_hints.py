@@ -69,13 +69,15 @@ class JudgedNoise:
 @dataclass(frozen=True, slots=True)
 class ResidualHints:
     """The verdict with its hints, and what was fitted to the residual to say them (None:
-    not judged): the springs, the gains per motor, the gravity's tilt, the flange load."""
+    not judged): the springs, the gains per motor, the gravity's tilt, the flange load, the
+    recordings' own torque offsets."""
 
     verdict: Verdict
     springs: ResidualSpring | None = None
     gains: DriveGains | None = None
     tilt: GravityTilt | None = None
     load: ResidualLoad | None = None
+    levels: RecordingLevels | None = None
 
 
 #: The model's terms, the remedy of a residual that follows a joint's acceleration, and
@@ -207,7 +209,7 @@ def _dependence_said(
         verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
         tau, offsets, left_out, ddq, inertia, lacks, kinds, levels,
     )  # fmt: skip
-    return ResidualHints(verdict, springs, None, tilt, load)
+    return ResidualHints(verdict, springs, None, tilt, load, own)
 
 
 def _own_offsets(
