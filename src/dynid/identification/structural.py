@@ -28,6 +28,7 @@ __all__ = [
     "StructuralRank",
     "absorbed_by",
     "combined_notes",
+    "mixed_sign",
     "structural_rank",
 ]
 
@@ -189,3 +190,13 @@ def combined_notes(combined: Mapping[str, str]) -> tuple[str, ...]:
         "friction coefficients that hold one left out as structurally dependent on them (no "
         f"data tell them apart), not their own values alone: {held}",
     )
+
+
+def mixed_sign(combined: Mapping[str, str]) -> frozenset[str]:
+    """The coefficients of ``combined`` (label to what it holds,
+    :func:`absorbed_by`) whose combination is a difference (``"fv6 - fv5"``, with
+    viscous friction at both motors of a differential wrist and at its joints, fv5 left
+    out): its sign says nothing of the friction's, which a sign check or a bound at zero
+    would misread. A sum of friction coefficients (``"jfv5 + 1.445e+04*fv5"``) is below
+    zero only when one of them is, and is not among them."""
+    return frozenset(lab for lab, expr in combined.items() if " - " in expr)
