@@ -704,12 +704,15 @@ def consistent_structure_lines(result: ConsistentResult) -> list[str]:
     terms = [str(t) for t in model.info.extra.get("terms", ())]
     kept = [t for t in terms if not t.startswith("-")]
     used = " + ".join(["links", *kept]) + "".join(f" - {t[1:]}" for t in terms if t[:1] == "-")
+    free = sorted(mixed_sign(model.info.combined))  # a difference: no sign to keep
     out = [
         f"structure of the consistent fit: {used} (its friction law, leave-outs and armature "
         "as fitted by least squares; kept physical: fv, fc, rotor inertias"
         + (", spring stiffnesses" if result.spring is not None else "")
         + " >= 0 and the friction opposing the motion within the velocity limits, the "
-        "offset free)"
+        "offset free"
+        + (f"; {', '.join(free)} free too, holding a difference (combined)" if free else "")
+        + ")"
     ]
     sel = model.info.selection
     if sel:
