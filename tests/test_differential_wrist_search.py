@@ -90,3 +90,36 @@ def test_a_coefficient_holding_a_difference_is_neither_warned_nor_bound_by_its_s
     assert not any("no consistent parameter set" in n for n in res.notes), res.notes
     motor_part = next(p for p in res.friction.parts if p.drive is not None)
     assert motor_part.params[1, 0] == pytest.approx(FV[1] - FV[0], rel=1e-3)
+
+
+def test_a_loose_difference_below_zero_is_not_left_out_as_friction_that_pushes():
+    """The search's own sign judgement: with friction at both sides whose motors' viscous
+    coefficients differ by -5e-6 N m s/rad (fv2 holds fv2 - fv1, fitted below zero and
+    not determined, as the truth makes it likely), fv2 is not left out of the chosen
+    ``at:both`` candidate as 'friction below zero (it pushes the arm)' (which would force
+    fv2 = fv1 on the strength of the difference's sign); jfc2, a coefficient of its own
+    with a true value of 0, still may be."""
+    from dynid.identification.recordings import prepare_recordings
+    from dynid.identification.selection import select_structure
+    from dynid.simulation.measurement import SensorNoise
+
+    robot, drive = planar_2r(), _drive()
+    fv = np.array([0.03, 0.029995])
+    joint = ClassicalFriction(JFV, np.zeros(2), np.zeros(2))
+    logs = recordings(
+        robot,
+        (3, 4),
+        friction=ClassicalFriction(fv, FC, np.zeros(2)).at(drive),
+        drive=drive,
+        duration=2.0,
+        added=lambda g: joint.torques(g.dq),
+        noise=SensorNoise(tau_std=0.05, q_std=1e-6, dq_std=1e-4),
+    )
+    data = prepare_recordings(robot, logs, cutoff_hz=20.0, drive=drive)
+    cands = [Structure.parse(s) for s in ("viscous,coulomb,at:both", "viscous,coulomb,at:motor")]
+    sel = select_structure(robot, data, drive=drive, candidates=cands, per_joint=False)
+    assert sel.chosen.at == "both" and "fv1" in sel.chosen.drop
+    assert "fv2" not in sel.chosen.drop, sel.chosen.name
+    for c in sel.candidates:
+        assert all(lab != "fv2" for lab, _, _ in c.loose_pushing), c
+    assert not any(n.startswith("fv2") for n in sel.notes), sel.notes

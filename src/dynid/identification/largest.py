@@ -16,7 +16,7 @@ from __future__ import annotations
 import re
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -30,6 +30,7 @@ from .core import Judge, identify
 from .estimators import Estimator
 from .model import IdentifiedModel
 from .recordings import Recordings
+from .structural import held_by
 from .structure import (
     STRIBECK_COARSE,
     Structure,
@@ -118,8 +119,15 @@ def fit_largest(
     family = regressor_group(mine[0])[2]
     laws = _family(family)
 
+    held: dict[str, str] = {}  # what coefficients hold of those left out as dependent
+
     def fit(group: list[Structure], drop: frozenset[str]) -> _Fitted:
-        return _fit_group(robot, data, group, arm, drive, est, rtol, judge, fold_labels, drop)
+        model, terms = _fit_group(
+            robot, data, group, arm, drive, est, rtol, judge, fold_labels, drop
+        )
+        if held:  # the candidates' sign checks read it (a difference has no sign)
+            model = replace(model, info=replace(model.info, combined=dict(held)))
+        return model, terms
 
     found = unexcited if unexcited is not None else set()
     drop = frozenset(found)
@@ -129,6 +137,7 @@ def fit_largest(
         if more:
             drop |= more
             found |= more - own  # the data's, not this column set's own dependence
+            held.update(held_by(structural, own))
             fitted, failed = _first_fitted(tries, drop, fit)
             note = f"{_unexcited_text(why, structural)}: {_left_out_text(more, own, what)}"
             notes += [] if note in notes else [note]
