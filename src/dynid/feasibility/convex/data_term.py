@@ -206,7 +206,8 @@ def coefficient_term(
     terms = tuple(t.term for t in model.appended) if k else ()
     index = np.flatnonzero(kept[r_all:])
     differences = mixed_sign(model.info.combined)  # fv6 holding fv6 - fv5: no sign to keep
-    free = np.array([lab in differences for lab in _friction_labels(model)], bool)[index]
+    names = _friction_labels(model)
+    free = np.array([int(i) < len(names) and names[i] in differences for i in index], bool)
     held = model.holdout
     if held is not None and held.whole.p != kept.size:
         held = None  # folds over other columns (friction left out of the term)
