@@ -82,12 +82,15 @@ def test_the_differentials_viscous_friction_at_both_sides_is_structurally_depend
 
 def test_the_default_choice_says_the_combination_left_out_is_structural():
     """The candidates' note names the combination as structural, not as unexcited data,
-    and the coefficient left out is one of it."""
+    and the coefficient left out is one of it, of the candidates with friction at both
+    sides only (the placement whose columns are dependent)."""
     robot, drive, logs = _logs()
     model = identify_recordings(robot, logs, cutoff_hz=None, drive=drive)
-    notes = [n for n in model.info.selection["notes"] if "left out of every candidate" in n]
-    assert len(notes) == 1 and notes[0].startswith("structurally not identifiable"), notes
-    assert "do not excite" not in notes[0]
+    notes = [n for n in model.info.selection["notes"] if "structurally not identifiable" in n]
+    assert len(notes) == 1 and "do not excite" not in notes[0], notes
+    assert notes[0].endswith(
+        "left out of the candidates without armature, friction at the motors and the joints"
+    ), notes
 
 
 def _evaluated(expression: str, truth: dict[str, float]) -> float:

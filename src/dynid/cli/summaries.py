@@ -25,6 +25,7 @@ from ..identification.log import jitter_text
 from ..identification.model import IdentifiedModel
 from ..identification.outlying_spans import cut_text
 from ..identification.pieces import gaps_text
+from ..identification.structural import mixed_sign
 from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints, own_rotors
 from ..io.observer_files import log_labels
 from ..model.robot import Robot
@@ -213,7 +214,7 @@ def term_lines(model: IdentifiedModel) -> list[str]:
         out += _scales_lines(scales, model)
         out += _shape_line(t.term, model)
         out += _rest_line(t, model)
-        out += _negative_viscous_line(t)
+        out += _negative_viscous_line(t, mixed_sign(model.info.combined))
         mine = [lab for lab in t.labels if lab in model.info.combined]
         if mine:
             out.append(
@@ -256,15 +257,17 @@ def _rest_line(t: Any, model: IdentifiedModel) -> list[str]:
     ]
 
 
-def _negative_viscous_line(t: Any) -> list[str]:
+def _negative_viscous_line(t: Any, differences: frozenset[str] = frozenset()) -> list[str]:
     """One line naming the viscous coefficients a friction term fitted below zero (not
     dissipative): within one std of zero, indistinguishable from 0; beyond it, the law
-    misfits (a negative slope stands in for a shape the law lacks)."""
+    misfits (a negative slope stands in for a shape the law lacks). Those that hold a
+    difference of coefficients (``differences``: ``fv6`` holding ``fv6 - fv5``,
+    :func:`~dynid.identification.structural.mixed_sign`) are not judged: the "combined"
+    line names what they hold."""
     if not isinstance(t.term, LinearFriction):
         return []
-    found = negative_viscous(
-        t.labels, np.asarray(t.values), np.asarray(t.std), np.asarray(t.kept), t.term.prefix
-    )
+    kept = np.asarray(t.kept) & np.array([lab not in differences for lab in t.labels], bool)
+    found = negative_viscous(t.labels, np.asarray(t.values), np.asarray(t.std), kept, t.term.prefix)
     if not found:
         return []
     near = [f for f in found if f.indistinguishable]
@@ -707,12 +710,15 @@ def consistent_structure_lines(result: ConsistentResult) -> list[str]:
     terms = [str(t) for t in model.info.extra.get("terms", ())]
     kept = [t for t in terms if not t.startswith("-")]
     used = " + ".join(["links", *kept]) + "".join(f" - {t[1:]}" for t in terms if t[:1] == "-")
+    free = sorted(mixed_sign(model.info.combined))  # a difference: no sign to keep
     out = [
         f"structure of the consistent fit: {used} (its friction law, leave-outs and armature "
         "as fitted by least squares; kept physical: fv, fc, rotor inertias"
         + (", spring stiffnesses" if result.spring is not None else "")
         + " >= 0 and the friction opposing the motion within the velocity limits, the "
-        "offset free)"
+        "offset free"
+        + (f"; {', '.join(free)} free too, holding a difference (combined)" if free else "")
+        + ")"
     ]
     sel = model.info.selection
     if sel:

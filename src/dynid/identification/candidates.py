@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from .dissipation import Violation
 from .holdout import HeldOut
 from .model import IdentifiedModel
+from .structural import mixed_sign
 from .structure import ERROR_FLOOR_PERCENT, Structure
 
 __all__ = [
@@ -362,7 +363,10 @@ def candidate_judged(
     deviations, 0 where not used) says where its friction is not dissipative. With
     ``check``, each column's label (``""`` for a column never left out alone,
     :func:`~.structure.column_labels`) gives the coefficients' relative standard
-    deviations (:attr:`Candidate.relative_std`)."""
+    deviations (:attr:`Candidate.relative_std`). A coefficient that holds a difference
+    of coefficients (``fv6`` holding ``fv6 - fv5``, ``model.info.combined``:
+    :func:`~.structural.mixed_sign`) has no sign of its own: 0 in the dissipation
+    ``check`` and not among :attr:`Candidate.loose_pushing`."""
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     use = use & np.asarray(fit.kept, dtype=bool)
     idx = np.flatnonzero(use)
@@ -382,10 +386,13 @@ def candidate_judged(
         assert whole_std is not None  # asked for with the check
         x, sd = np.zeros(use.size), np.zeros(use.size)
         x[idx], sd[idx] = whole, whole_std * std_inflation(model, rtol)[idx]
-        unphysical = check(x, sd)
+        free = mixed_sign(model.info.combined)
+        signed_labels = [lab if lab not in free else "" for lab in labels]
+        alone = np.array([lab not in free for lab in labels], bool) if free and labels else None
+        unphysical = check(x if alone is None else np.where(alone, x, 0.0), sd)
         relative = relative_stds(x, sd, use, labels)
         negative = negative_bumps(x, use, labels)
-        loose = loose_pushing(x, sd, use, labels)
+        loose = loose_pushing(x, sd, use, signed_labels)
         signed = admissible(x, use, labels)
     return Candidate(
         structure=structure,

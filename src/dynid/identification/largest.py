@@ -16,7 +16,7 @@ from __future__ import annotations
 import re
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -30,6 +30,7 @@ from .core import Judge, identify
 from .estimators import Estimator
 from .model import IdentifiedModel
 from .recordings import Recordings
+from .structural import held_by
 from .structure import (
     STRIBECK_COARSE,
     Structure,
@@ -94,7 +95,10 @@ def fit_largest(
     reverses: its Coulomb friction is an offset), those coefficients are left out of every
     candidate (:func:`_unexcited_coefficients`; ``unexcited`` gathers them over the
     groups, and a group starts without those already found) and the candidates judged
-    again; empty (and a note) when still none is identifiable."""
+    again; those dependent at every motion are left out of this group's candidates only
+    (a column set's own dependence: viscous friction at the motors and at the joints of a
+    differential wrist, not at the motors alone); empty (and a note) when still none is
+    identifiable."""
     shaped = [c for c in mine if {"smooth", "stribeck"} & set(c.friction)]
     coarse = [c for c in mine if "stribeck" not in c.friction or c.vst in STRIBECK_COARSE]
     tries = [mine, coarse]
@@ -115,22 +119,27 @@ def fit_largest(
     family = regressor_group(mine[0])[2]
     laws = _family(family)
 
+    held: dict[str, str] = {}  # what coefficients hold of those left out as dependent
+
     def fit(group: list[Structure], drop: frozenset[str]) -> _Fitted:
-        return _fit_group(robot, data, group, arm, drive, est, rtol, judge, fold_labels, drop)
+        model, terms = _fit_group(
+            robot, data, group, arm, drive, est, rtol, judge, fold_labels, drop
+        )
+        if held:  # the candidates' sign checks read it (a difference has no sign)
+            model = replace(model, info=replace(model.info, combined=dict(held)))
+        return model, terms
 
     found = unexcited if unexcited is not None else set()
     drop = frozenset(found)
     fitted, failed = _first_fitted(tries, drop, fit)
     if fitted is None and classical:
-        more, why, structural = _unexcited_coefficients(classical, drop, fit)
+        more, why, structural, own = _unexcited_coefficients(classical, drop, fit)
         if more:
             drop |= more
-            found |= more
+            found |= more - own  # the data's, not this column set's own dependence
+            held.update(held_by(structural, own))
             fitted, failed = _first_fitted(tries, drop, fit)
-            note = (
-                f"{_unexcited_text(why, structural)}: "
-                f"{', '.join(sorted(more, key=_order))} left out of every candidate"
-            )
+            note = f"{_unexcited_text(why, structural)}: {_left_out_text(more, own, what)}"
             notes += [] if note in notes else [note]
     if fitted is not None:
         model, terms, group, k = fitted
@@ -248,14 +257,18 @@ def _unexcited_coefficients(
     classical: list[Structure],
     drop: frozenset[str],
     fit: Callable[[list[Structure], frozenset[str]], _Fitted],
-) -> tuple[frozenset[str], list[str], list[str]]:
+) -> tuple[frozenset[str], list[str], list[str], frozenset[str]]:
     """The single joints' friction coefficients (``"fc3"``) beside ``drop`` without which
     the data identify the classical candidates' columns, the combinations the data do
-    not excite that named them (:attr:`~dynid.exceptions.RankDeficientError.redundant`)
-    and those of them no data excite (the model's columns dependent at every motion,
-    :attr:`~dynid.exceptions.RankDeficientError.structural`); none when other columns
-    (the links') are not identifiable either."""
+    not excite that named them (:attr:`~dynid.exceptions.RankDeficientError.redundant`),
+    those of them no data excite (the model's columns dependent at every motion,
+    :attr:`~dynid.exceptions.RankDeficientError.structural`) and the coefficients those
+    name: dependent in these columns only (viscous friction at both motors of a
+    differential wrist is dependent on that at its joints, not alone), so left out of
+    these candidates, not of other column sets; none when other columns (the links') are
+    not identifiable either."""
     more: set[str] = set()
+    own: set[str] = set()
     why: list[str] = []
     structural: list[str] = []
     for _ in range(MAX_DROP_ROUNDS):
@@ -265,13 +278,26 @@ def _unexcited_coefficients(
             named = {_offset_instead(lab, exc.combinations) for lab in exc.redundant}
             new = named - drop - more
             if not new or not all(_FRICTION_LABEL.fullmatch(lab) for lab in new):
-                return frozenset(), [], []
+                return frozenset(), [], [], frozenset()
             more |= new
+            own |= new if exc.structural else set()  # then it names the structural ones
             why += [c for c in exc.combinations if c not in exc.structural]
             structural += list(exc.structural)
             continue
-        return frozenset(more), why, structural
-    return frozenset(), [], []
+        return frozenset(more), why, structural, frozenset(own)
+    return frozenset(), [], [], frozenset()
+
+
+def _left_out_text(more: frozenset[str], own: frozenset[str], what: str) -> str:
+    """Which coefficients left out where: those the data do not excite, of every
+    candidate; those dependent in one column set only (``own``), of its candidates
+    (``what``: ``"without armature, friction at the motors and the joints"``)."""
+    said = []
+    if more - own:
+        said.append(f"{', '.join(sorted(more - own, key=_order))} left out of every candidate")
+    if own:
+        said.append(f"{', '.join(sorted(own, key=_order))} left out of the candidates {what}")
+    return "; ".join(said)
 
 
 def _unexcited_text(why: list[str], structural: list[str]) -> str:

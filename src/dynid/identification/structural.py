@@ -12,7 +12,7 @@ identifies from a trajectory that does not excite it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +28,8 @@ __all__ = [
     "StructuralRank",
     "absorbed_by",
     "combined_notes",
+    "held_by",
+    "mixed_sign",
     "structural_rank",
 ]
 
@@ -189,3 +191,34 @@ def combined_notes(combined: Mapping[str, str]) -> tuple[str, ...]:
         "friction coefficients that hold one left out as structurally dependent on them (no "
         f"data tell them apart), not their own values alone: {held}",
     )
+
+
+def mixed_sign(combined: Mapping[str, str]) -> frozenset[str]:
+    """The coefficients of ``combined`` (label to what it holds,
+    :func:`absorbed_by`) whose combination is a difference (``"fv6 - fv5"``, with
+    viscous friction at both motors of a differential wrist and at its joints, fv5 left
+    out): its sign says nothing of the friction's, which a sign check or a bound at zero
+    would misread. A sum of friction coefficients (``"jfv5 + 1.445e+04*fv5"``) is below
+    zero only when one of them is, and is not among them."""
+    return frozenset(lab for lab, expr in combined.items() if " - " in expr)
+
+
+def held_by(combinations: Sequence[str], left_out: Collection[str]) -> dict[str, str]:
+    """What the coefficients hold when the first label of each of ``combinations`` (the
+    model's columns dependent at every motion, as
+    :attr:`~dynid.exceptions.RankDeficientError.structural` names them:
+    ``"fv5 - 1.445e+04*jfv6 - 1.445e+04*jfv5 + 1*fv6"``, the direction ``v`` with
+    ``v_fv5 = 1`` that changes no torque) is among ``left_out``: each other coefficient
+    ``j`` of it holds ``theta_j - v_j theta_first`` (``{"fv6": "fv6 - fv5", "jfv5": "jfv5 +
+    1.445e+04*fv5", ...}``, as :func:`absorbed_by` says it from the columns)."""
+    out: dict[str, str] = {}
+    for combination in combinations:
+        first, *rest = combination.split(" ")
+        if first not in left_out:
+            continue
+        for sign, term in zip(rest[::2], rest[1::2], strict=True):
+            c, _, lab = term.rpartition("*")
+            times = "" if c in ("", "1") else f"{c}*"
+            expr = f"{lab} {'-' if sign == '+' else '+'} {times}{first}"
+            out[lab] = expr if lab not in out else f"{out[lab]}{expr[len(lab) :]}"
+    return out

@@ -15,6 +15,7 @@ from ...exceptions import DataError, ModelError
 from ...identification.holdout import HeldOut
 from ...identification.least_squares import LeastSquaresFit
 from ...identification.model import IdentifiedModel
+from ...identification.structural import mixed_sign
 from ...model.stiffness import JointStiffness
 from ...regressors.terms import FrictionValues, ModelTerm
 from .options import EXACT_RTOL
@@ -64,6 +65,10 @@ class DataTerm:
     std : ndarray, shape (r + k,), optional
         The standard deviations the fit reports for ``x_hat`` (its estimator's: hac,
         robust or classical), against which the result's moves are told; None: unknown.
+    free_sign : ndarray of bool, shape (k,), optional
+        The unknowns that hold a difference of friction coefficients (``fv6`` holding
+        ``fv6 - fv5``, :func:`~dynid.identification.structural.mixed_sign`), kept free of
+        :meth:`nonnegative` and of the dissipation rows; None: none.
     """
 
     P: NDArray[np.float64]
@@ -79,6 +84,7 @@ class DataTerm:
     holdout: HeldOut | None = None
     dissipation: NDArray[np.float64] | None = None
     std: NDArray[np.float64] | None = None
+    free_sign: NDArray[np.bool_] | None = None
 
     @property
     def r(self) -> int:
@@ -97,7 +103,8 @@ class DataTerm:
         if not self.terms:
             return np.zeros(self.n_friction, dtype=bool)
         every = np.concatenate([np.asarray(t.nonnegative, dtype=bool) for t in self.terms])
-        return every[self.friction_layout()]
+        mine = every[self.friction_layout()]
+        return mine if self.free_sign is None else mine & ~self.free_sign
 
     def frictions(self, f: NDArray[np.float64]) -> tuple[FrictionValues, ...]:
         """The unknowns ``f`` (k,) as the friction of each friction term (its law's
@@ -198,6 +205,9 @@ def coefficient_term(
     )
     terms = tuple(t.term for t in model.appended) if k else ()
     index = np.flatnonzero(kept[r_all:])
+    differences = mixed_sign(model.info.combined)  # fv6 holding fv6 - fv5: no sign to keep
+    names = _friction_labels(model)
+    free = np.array([int(i) < len(names) and names[i] in differences for i in index], bool)
     held = model.holdout
     if held is not None and held.whole.p != kept.size:
         held = None  # folds over other columns (friction left out of the term)
@@ -222,7 +232,8 @@ def coefficient_term(
         n_friction=int(kept[r_all:].sum()) if k else 0,
         friction_index=index if k else None,
         terms=terms,
-        dissipation=_dissipation(terms, index, model.robot.dq_max) if k else None,
+        free_sign=free if k else None,
+        dissipation=_dissipation(terms, index, model.robot.dq_max, free) if k else None,
         labels=labels,
         notes=notes,
         holdout=held,
@@ -231,10 +242,15 @@ def coefficient_term(
 
 
 def _dissipation(
-    terms: tuple[ModelTerm, ...], index: NDArray[np.intp], dq_max: NDArray[np.float64]
+    terms: tuple[ModelTerm, ...],
+    index: NDArray[np.intp],
+    dq_max: NDArray[np.float64],
+    free: NDArray[np.bool_],
 ) -> NDArray[np.float64] | None:
     """The terms' dissipation rows over the unknowns ``index`` (of every coefficient of
-    ``terms``, in order); rows that only touch coefficients not fitted (0) dropped."""
+    ``terms``, in order); rows that only touch coefficients not fitted (0) dropped, and
+    those that touch an unknown ``free`` (k,) of its sign (a difference of coefficients:
+    the row would bound the difference as if it were one motor's coefficient)."""
     blocks = [np.asarray(t.dissipation_rows(dq_max), dtype=np.float64) for t in terms]
     width = sum(len(t.labels) for t in terms)
     rows, c = [], 0
@@ -246,7 +262,7 @@ def _dissipation(
     if not rows:
         return None
     G = np.concatenate(rows)[:, index]
-    G = G[np.any(G != 0.0, axis=1)]
+    G = G[np.any(G != 0.0, axis=1) & ~np.any(G[:, free] != 0.0, axis=1)]
     return G if G.shape[0] else None
 
 
