@@ -123,6 +123,31 @@ def test_outside_names_the_joints_the_share_and_how_far():
     assert outside_training(((0.0, 1.0), (0.0, 1.0)), None, [q[:, ::-1] * 0 + 0.5], []) is None
 
 
+def test_a_joint_that_turns_without_end_is_compared_modulo_a_turn():
+    """Regression: an xArm7's continuous joint 7 trained over 2.45..17.9 rad (2.5 turns)
+    was called outside at 1.68..16.9 rad (5 % of samples): every angle had been seen. A
+    joint that turns without end is compared a whole number of turns away: trained over a
+    turn or more, never outside; trained over 0..1 rad, a recording at 2 pi + 0.2 .. 2 pi +
+    0.8 is inside and one at 2 pi + 1.5 .. 2 pi + 2.5 outside by 1.5 rad, as at 1.5..2.5; a
+    limited joint at 2 pi + 0.5 is outside."""
+    from dynid.identification.training_range import endless_joints
+
+    turns = endless_joints([-np.inf, -np.pi, -1.0], [np.inf, np.pi, 1.0], [False, False, False])
+    assert turns.tolist() == [True, True, False]
+    wide = ((2.45, 17.9), (0.0, 1.0), (0.0, 1.0))
+    speeds = ((-1.0, 1.0),) * 3
+    q = np.column_stack(
+        [np.linspace(1.68, 16.9, 101), 2 * np.pi + np.linspace(0.2, 0.8, 101), np.full(101, 0.5)]
+    )
+    assert outside_training(wide, speeds, [q], [q * 0], turns) is None
+    q[:, 1] = 2 * np.pi + np.linspace(1.5, 2.5, 101)
+    q[:, 2] = 2 * np.pi + 0.5
+    found = outside_training(wide, speeds, [q], [q * 0], turns)
+    assert found is not None and [o.joint for o in found.found] == [1, 2]
+    assert found.found[0].beyond == pytest.approx(1.5)
+    assert found.found[1].beyond == pytest.approx(2 * np.pi - 0.5)
+
+
 def test_validate_at_other_poses_says_the_model_extrapolates_not_an_offset(arm, narrow, tmp_path):
     """Validated with joint 1 at 0.75..1.25 rad (trained within +-0.25): the verdict names
     joint 1 outside the training's poses (every sample) and says the model extrapolates

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "endless_joints",
     "CLEAR_LEAST",
     "CLEAR_SHARE",
     "CLEAR_SPAN",
@@ -173,8 +174,15 @@ class OutsideTraining:
         }
 
 
-def _outside(kind: str, training: Ranges, values: Sequence[NDArray[np.float64]]) -> list[Outside]:
-    """The joints whose ``values`` (pieces of (N_k, n)) leave ``training``'s ranges."""
+def _outside(
+    kind: str,
+    training: Ranges,
+    values: Sequence[NDArray[np.float64]],
+    turns: NDArray[np.bool_] | None = None,
+) -> list[Outside]:
+    """The joints whose ``values`` (pieces of (N_k, n)) leave ``training``'s ranges; of the
+    joints ``turns`` (positions of joints that turn without end), the angles modulo a turn
+    (:func:`_same_turn`)."""
     arrays = [np.asarray(v, dtype=np.float64) for v in values if len(v)]
     if not arrays:
         return []
@@ -182,6 +190,8 @@ def _outside(kind: str, training: Ranges, values: Sequence[NDArray[np.float64]])
     if x.ndim != 2 or x.shape[1] != len(training):
         return []
     lo, hi = np.array(training).T
+    if turns is not None and kind == "position":
+        x = _same_turn(x, lo, hi, np.asarray(turns, dtype=bool))
     share = TOLERANCE if kind == "position" else SPEED_TOLERANCE
     margin = np.maximum(share * (hi - lo), TOLERANCE_LEAST)
     below, above = lo - margin - x, x - hi - margin
@@ -204,20 +214,53 @@ def _outside(kind: str, training: Ranges, values: Sequence[NDArray[np.float64]])
     return out
 
 
+def _same_turn(
+    x: NDArray[np.float64],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    turns: NDArray[np.bool_],
+) -> NDArray[np.float64]:
+    """Positions ``x`` (N, n) [rad] with the joints ``turns`` (n,) read as the angle, a
+    whole number of turns away, nearest the middle of their training range ``lo..hi``
+    (n,); one whose training covered a turn or more is inside it at every angle (a
+    continuous joint trained over 2.5 turns was called outside at 1.68..16.9 rad for
+    2.45..17.9)."""
+    out = x.copy()
+    turn = 2 * np.pi
+    for j in np.flatnonzero(turns):
+        if hi[j] - lo[j] >= turn:
+            out[:, j] = np.clip(x[:, j], lo[j], hi[j])
+        else:
+            mid = 0.5 * (lo[j] + hi[j])
+            out[:, j] = x[:, j] - turn * np.round((x[:, j] - mid) / turn)
+    return out
+
+
 def outside_training(
     position_range: Ranges | None,
     velocity_range: Ranges | None,
     q: Sequence[NDArray[np.float64]],
     dq: Sequence[NDArray[np.float64]],
+    turns: ArrayLike | None = None,
 ) -> OutsideTraining | None:
     """The joints whose positions ``q`` or velocities ``dq`` (pieces of (N_k, n) [rad],
     [rad/s]) leave the training's ranges (``position_range``, ``velocity_range``: (n, 2)
     each, None: not recorded) by more than the tolerance (module docstring); None when
-    none does or nothing is recorded."""
+    none does or nothing is recorded. ``turns`` (n,) bool: the joints that turn without
+    end (:func:`endless_joints`), whose positions are compared modulo a turn."""
     found: list[Outside] = []
+    ends = None if turns is None else np.asarray(turns, dtype=bool)
     if position_range is not None:
-        found += _outside("position", position_range, q)
+        found += _outside("position", position_range, q, ends)
     if velocity_range is not None:
         found += _outside("velocity", velocity_range, dq)
     found.sort(key=lambda o: (o.joint, o.kind != "position"))
     return OutsideTraining(tuple(found)) if found else None
+
+
+def endless_joints(q_min: ArrayLike, q_max: ArrayLike, prismatic: ArrayLike) -> NDArray[np.bool_]:
+    """The revolute joints whose limits ``q_min..q_max`` [rad] (n,) span a turn or more
+    (a continuous joint: infinite limits), of the ``prismatic`` (n,) flags: their angle
+    is the same a turn away."""
+    span = np.asarray(q_max, dtype=np.float64) - np.asarray(q_min, dtype=np.float64)
+    return ~np.asarray(prismatic, dtype=bool) & (span >= 2 * np.pi * (1.0 - 1e-9))

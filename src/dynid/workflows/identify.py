@@ -77,7 +77,7 @@ from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
 from ..identification.torque_delay import TorqueDelay
-from ..identification.training_range import outside_training
+from ..identification.training_range import endless_joints, outside_training
 from ..model.drive import Drive
 from ..model.robot import Robot, checked_robot
 from ..progress import NOTE
@@ -738,7 +738,9 @@ def _predicted_heldout(
     if held is None or separate is None or record is None:
         return held
     ranges, log = (record.position_range, record.velocity_range), held.validation.log
-    return dataclasses.replace(held, outside=outside_training(*ranges, [log.q], [log.dq]))
+    robot = model.robot
+    turns = endless_joints(robot.q_min, robot.q_max, robot.prismatic)
+    return dataclasses.replace(held, outside=outside_training(*ranges, [log.q], [log.dq], turns))
 
 
 def _say_gravity_scale(

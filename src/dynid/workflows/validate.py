@@ -80,7 +80,7 @@ from ..identification.recorded_signs import SignFinding
 from ..identification.residual_spring import ResidualSpring
 from ..identification.spikes import SPIKES_BEFORE_JUDGING
 from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_delay
-from ..identification.training_range import OutsideTraining
+from ..identification.training_range import OutsideTraining, endless_joints
 from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -650,6 +650,7 @@ def _hinted(
     return outside_said(
         training_record(trained), hints(dependence=dependence),
         lambda: hints(dependence=False), val, noise, robot.joint_names, units,
+        endless_joints(robot.q_min, robot.q_max, robot.prismatic),
     )  # fmt: skip
 
 

@@ -20,6 +20,7 @@ import dataclasses
 from collections.abc import Callable, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..friction.recordings import RecordingsValidation
 from ..identification.info import LogInfo
@@ -80,18 +81,20 @@ def outside_said(
     noise: JudgedNoise,
     names: Sequence[str],
     units: Sequence[str] | None = None,
+    turns: NDArray[np.bool_] | None = None,
 ) -> tuple[ResidualHints, OutsideTraining | None]:
     """``hints`` with the joints the recordings ``val`` take outside the training's ranges
     of ``record`` said in their verdict (module docstring), and those joints; where the
     recording lies clearly outside the training's poses on joints the residual concerns
     and the verdict names a cause, the hints ``without_causes`` (the residual not
     diagnosed) with the cause said as not confirmed. ``units``: each joint's position unit
-    (default rad)."""
+    (default rad); ``turns``: the joints that turn without end, compared modulo a turn
+    (:func:`~dynid.identification.training_range.endless_joints`)."""
     if record is None:
         return hints, None
     q = [v.log.q for v in val.parts]
     dq = [v.log.dq for v in val.parts]
-    outside = outside_training(record.position_range, record.velocity_range, q, dq)
+    outside = outside_training(record.position_range, record.velocity_range, q, dq, turns)
     if outside is None:
         return hints, None
     line = outside.sentence(names, units)
