@@ -834,8 +834,10 @@ def _prior_mark_line(r: FeasibleResult, *, prior: bool = True) -> list[str]:
     )
     return [
         f"{PRIOR_MARK} set by the prior, not measured: the data give only combinations "
-        f"holding it (the base parameters){share}; unmarked: the data determine it (each "
-        "standard parameter's prior share: report.json determined.prior_share)"
+        f"holding it (the base parameters){share}: its value is the prior's, moved with "
+        "those combinations (a marked mass can end far from the prior and still not be "
+        "measured); unmarked: the data determine it (each standard parameter's prior "
+        "share: report.json determined.prior_share)"
     ]
 
 
