@@ -84,8 +84,10 @@ from ...friction.mujoco import (
 )
 from ...friction.mujoco_soft import (
     MOTION_PERIOD_S,
+    DryFrictionError,
     SoftFrictionLoss,
     dry_friction_error,
+    mujoco_dry_friction,
     representative_motion,
     soft_frictionloss,
 )
@@ -266,7 +268,17 @@ def _reversal_note(
         return ()
     j, w = int(np.argmax(err.rms)), int(np.argmax(err.worst))
     where = f"dq {err.worst_dq[w]:+.2g} rad/s, ddq {err.worst_ddq[w]:+.3g} rad/s^2"
-    reversal = abs(err.worst_dq[w]) < 0.01 * _velocity_range(robot)[w]
+    slow = abs(err.worst_dq[w]) < 0.01 * _velocity_range(robot)[w]
+    made = _acceleration_made(err, w, approx.coulomb, soft)
+    reversal = slow and made
+    corner = approx.coulomb[w] / soft.slope[w] if soft.slope[w] > 0 else 0.0
+    if not reversal and abs(err.worst_dq[w]) <= 2.0 * corner:  # where the ramp bends
+        why = (
+            "the constraint's torque depends on the acceleration too"
+            if made
+            else "MuJoCo's ramp of the velocity departs from the law"
+        )
+        where = f"near rest, where {why}: {where}"
     if reversal:
         where = (
             f"at a velocity reversal, where for about {1e3 * err.window_s[w]:.2g} ms before "
@@ -285,6 +297,22 @@ def _reversal_note(
             "(fc tanh(dq / width) as qfrc_applied or a velocity-dependent actuator)"
         )
     return (said,)
+
+
+def _acceleration_made(
+    err: DryFrictionError, w: int, coulomb: NDArray[np.float64], soft: SoftFrictionLoss
+) -> bool:
+    """Whether the worst difference of joint ``w`` comes from the constraint's torque taking
+    the acceleration's sign before a reversal: MuJoCo's dry friction (``coulomb`` (n,)
+    [N m], ``soft``) at that velocity with the acceleration reversed differs by at least
+    half of it (an xArm7's worst, 0.22 N m at 0.026 rad/s, was the ramp's departure from
+    the law, the same at either acceleration's sign, and was said to be a reversal's)."""
+    dq = np.zeros((2, coulomb.size))
+    ddq = np.zeros((2, coulomb.size))
+    dq[:, w] = err.worst_dq[w]
+    ddq[:, w] = (err.worst_ddq[w], -err.worst_ddq[w])
+    both = mujoco_dry_friction(dq, ddq, coulomb, soft)[:, w]
+    return bool(abs(both[0] - both[1]) >= 0.5 * err.worst[w])
 
 
 def _without_frictionloss(
