@@ -47,8 +47,13 @@ def _causes(hints: ResidualHints, names: Sequence[str]) -> tuple[list[str], set[
         joints |= set(hints.levels.joints)
         which = ", ".join(names[j] for j in hints.levels.joints)
         said.append(f"the recording's own torque offset ({which})")
-    if hints.tilt is not None and hints.tilt.named:
-        said.append("a tilted gravity vector")
+    if hints.tilt is not None and hints.tilt.named:  # with its angles: a candidate still
+        ax, ay = np.degrees(hints.tilt.angle)
+        said.append(
+            f"a tilted gravity vector (tilted by about {ax:.2g} deg about x and {ay:.2g} deg "
+            f"about y, {100 * min(hints.tilt.explained, 1.0):.0f} % of the residual above the "
+            "noise)"
+        )
     named = () if hints.springs is None else tuple(hints.springs.named)
     if named:
         joints |= set(named)
