@@ -50,16 +50,21 @@ def _confounded(doc: dict) -> list[str]:
         said = f"{who}: its torque offset {c.get('label', '?')} was left out, but fitted beside "
         said += f"the model's columns it reads {c['value']:.3g} N m"
         if is_number(std := c.get("std_percent")):
-            said += f" +- {std:.3g} %"
+            said += f" \u00b1 {std:.3g} %"
         if is_number(rho := c.get("correlation")):
             said += f", correlated {rho:.3f} with {c.get('partner', 'another coefficient')}"
         rng = c.get("position_range")
         if isinstance(rng, list) and len(rng) == 2 and all(map(is_number, rng)):
             said += f"; the joint moved only within {rng[0]:.3g}..{rng[1]:.3g} in training"
+        terms = _meta(doc).get("terms")
+        kept = (
+            f"--terms {','.join(str(t) for t in terms if str(t) != '-' + str(c.get('label')))}"
+            if isinstance(terms, list) and terms
+            else "--terms with the offset"
+        )
         said += (
             ": that coefficient carries whatever offset there is, right at these poses only; "
-            "hint: keep the offset (--terms with offset), or record poses over a wider range "
-            "of that joint"
+            f"hint: {kept} keeps the offset, or record poses over a wider range of that joint"
         )
         out.append(f"<b>Offset not told apart</b>: {esc(said)}")
     return out
