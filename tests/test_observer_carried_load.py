@@ -24,10 +24,10 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.io.observer_files import save_observation
 from dynid.io.robot.toml import save_toml
 from dynid.observer.carried_load import inertia_determined
 from dynid.observer.unmodelled_load import LOAD_FRAME
-from dynid.io.observer_files import save_observation
 from dynid.workflows.observe import ObserveOptions, observe_files
 
 from conftest import report_of, verdict_of
