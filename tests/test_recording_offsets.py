@@ -199,7 +199,7 @@ def test_the_identify_report_shows_each_recording_s_offset(differing, tmp_path):
     path = save_model_json(tmp_path / "identification.json", differing)
     page = report_of("identify", {"identification.json": path})
     text = verdict_of(page)
-    assert "Torque offsets differ between recordings: the torque offsets differ" in text, text
+    assert "Torque offsets per recording: the torque offsets differ between" in text, text
     rows = section_of(page, "offsets")
     names = differing.robot.joint_names
     assert rows[0] == ["recording", *(f"{j} offset [N m]" for j in names)], rows

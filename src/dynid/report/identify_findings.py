@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .html import capitalised, esc, is_number, number, section, table
+from .html import esc, is_number, number, section, table
 
 __all__ = ["finding_facts", "offsets_section"]
 
@@ -96,7 +96,7 @@ def _offsets(doc: dict) -> list[str]:
     if not isinstance(rec, dict) or not isinstance(rec.get("note"), str):
         return []
     return [
-        f"<b>Torque offsets differ between recordings</b>: {esc(rec['note'])} "
+        f"<b>Torque offsets per recording</b>: {esc(rec['note'])} "
         '(every offset: <a href="#offsets">table below</a>)'
     ]
 
@@ -170,8 +170,9 @@ def offsets_section(doc: Any) -> str:
             rows.append([label] + [value(rec[key], k) for k in cols])
     heads = ["recording", *(f"{j} offset [N m]" for j in joints)]
     said = (
-        f"<p>{esc(capitalised(str(rec.get('note', ''))))}.</p>"
-        if isinstance(rec.get("note"), str)
-        else ""
+        "<p>Each recording's torque offset, fitted one per recording and joint, &plusmn; the "
+        "standard error of its difference from the mean; mean: the sample-weighted mean, the "
+        "model's offset (a new recording's, as the model predicts it); tolerance: the size a "
+        "difference must exceed to count.</p>"
     )
     return section("offsets", "Torque offsets per recording", said, table(heads, rows))
