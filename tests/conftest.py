@@ -4,7 +4,9 @@ simulated recordings of an arm with known terms."""
 from __future__ import annotations
 
 import dataclasses
+import html
 import os
+import re
 import subprocess
 import sys
 import warnings
@@ -397,3 +399,31 @@ TWO_LEAVES = """<robot name="two_leaves">
     <limit lower="-3" upper="3" effort="5" velocity="3"/></joint>
 </robot>
 """
+
+
+def report_of(command: str, files: dict[str, Path], notes: Sequence[str] = ()) -> str:
+    """The report page of a ``command`` run that wrote ``files`` (name -> path) and said
+    ``notes``, written beside the first file as ``report.html`` (to open in a browser)."""
+    from dynid.report import RunSummary, render_html_report
+
+    page = render_html_report(RunSummary(command=command, notes=tuple(notes)), files)
+    next(iter(files.values())).with_name("report.html").write_text(page, encoding="utf-8")
+    return page
+
+
+def verdict_of(page: str) -> str:
+    """The text of a report page's verdict box (tags stripped, white space collapsed)."""
+    m = re.search(r'<section class="verdict \w+" id="verdict">(.*?)</section>', page, re.S)
+    assert m is not None, "no verdict box"
+    text = re.sub(r"<[^>]+>", "", re.sub(r"</(li|p|span)>", " ", m.group(1)))
+    return " ".join(html.unescape(text).split())
+
+
+def section_of(page: str, anchor: str) -> list[list[str]]:
+    """The rows (cell texts) of the first table after the heading ``id=anchor``."""
+    after = page.split(f'<h2 id="{anchor}">', 1)
+    assert len(after) == 2, f"no section {anchor}"
+    body = after[1].split("</table>", 1)[0]
+    rows = re.findall(r"<tr[^>]*>(.*?)</tr>", body, re.S)
+    cells = [re.findall(r"<t[hd][^>]*>(.*?)</t[hd]>", r, re.S) for r in rows]
+    return [[html.unescape(re.sub(r"<[^>]+>", "", c)).strip() for c in r] for r in cells]

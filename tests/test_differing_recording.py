@@ -30,7 +30,7 @@ from dynid.identification.selection import identify_recordings
 from dynid.report.identify import _structure_section
 from dynid.simulation.measurement import SensorNoise
 
-from conftest import planar_2r, recordings
+from conftest import planar_2r, recordings, report_of, verdict_of
 
 FV = np.array([0.3, 0.2])  # N m s/rad
 NOISE = SensorNoise(tau_std=0.01)
@@ -185,3 +185,24 @@ def test_identify_verdict_tells_a_recordings_constant_residual_as_its_own_offset
     assert verdict.level != "good"
     assert "with the recording's own torque offsets" in verdict.reason
     assert "a level that changes along the motion" not in verdict.reason
+
+
+def test_the_identify_report_says_the_differing_recording_in_its_verdict(cold, tmp_path):
+    """The page of the identification with rec1.csv's friction 1.5 x the others': its
+    verdict names rec1.csv (the recording simulated cold) with its held-out error against
+    its noise floor and the others' range, and no other recording; the note was only in
+    the model-structure section below the figures."""
+    from dynid.io.model_json import save_model_json
+
+    path = save_model_json(tmp_path / "identification.json", cold)
+    text = verdict_of(report_of("identify", {"identification.json": path}))
+    (found,) = cold.info.selection["differing_recordings"]
+    err, floor = found["heldout_error_percent"], found["noise_floor_percent"]
+    others = [o["heldout_error_percent"] for o in found["others"]]
+    said = (
+        f"A recording differs: rec1.csv: held-out error {err:.3g} % ({err / floor:.3g} x its "
+        f"noise floor of {floor:.3g} %), the other recordings {min(others):.3g} to "
+        f"{max(others):.3g} %"
+    )
+    assert said in text, text
+    assert text.count("A recording differs") == 1

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import warnings
 
 import numpy as np
@@ -39,6 +40,8 @@ from dynid.regressors.base import base_parameters
 from dynid.simulation.measurement import SensorNoise, simulate_measurement
 from dynid.simulation.trajectories import Trajectory, random_fourier, uniform_times
 from dynid.workflows.observe import ObserveOptions, observe_files
+
+from conftest import report_of, verdict_of
 
 FS = 250.0
 FV = np.linspace(0.5, 0.2, 7)
@@ -225,3 +228,29 @@ def test_the_late_label_hint_is_left_out_for_a_log_beyond_the_identified_speeds(
         res = dataclasses.replace(res, logs=(dataclasses.replace(res.logs[0], score=sc),))
         said = [x for x in res.notes if "labels look shifted late" in x]
         assert bool(said) == hint, (name, res.notes)
+
+
+def test_the_observe_report_says_the_motion_beyond_the_identification(case, tmp_path):
+    """The page of a detection on the fast log: its verdict says the joints moved over 3 x
+    as fast as the identification's data, each with its speed (the simulated motion's
+    within 5 %) and the identification's record, from events.json alone (the table sat
+    untitled among the file's entries, without units); a run whose note already says it
+    with both speeds is not told twice."""
+    d, speeds, truth = case
+    fast = _observed(d, ("fast.csv",), thresholds=d / "cal" / "thresholds.json")
+    names = list(fast.model.robot.joint_names)
+    save_observation(tmp_path, fast, joints=names, calibrating=False, residuals=False)
+    files = {"events.json": tmp_path / "events.json"}
+    text = verdict_of(report_of("observe", files))
+    (said,) = [x for x in text.split("Motion beyond the identification's data")[1:]]
+    beyond = np.flatnonzero(truth > 3.3 * np.asarray(speeds))  # with margin over 3 x
+    for j in beyond:
+        got, ident = re.findall(
+            rf"{names[j]} up to ([0-9.]+) rad/s \(([0-9.]+) in the identification's data\)", said
+        )[0]
+        assert float(got) == pytest.approx(truth[j], rel=0.05)
+        assert float(ident) == pytest.approx(speeds[j], rel=5e-3)  # to 3 digits
+    assert "fast.csv: " in said and "events there may be its error" in said
+    noted = verdict_of(report_of("observe", files, notes=fast.notes))
+    assert "Motion beyond the identification's data" not in noted  # the note says it
+    assert f"{names[0]} up to" in noted

@@ -24,10 +24,13 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.io.observer_files import save_observation
 from dynid.io.robot.toml import save_toml
 from dynid.observer.carried_load import inertia_determined
 from dynid.observer.unmodelled_load import LOAD_FRAME
 from dynid.workflows.observe import ObserveOptions, observe_files
+
+from conftest import report_of, verdict_of
 
 MASS, G = 0.8, 9.81
 COM_Z = 0.05
@@ -98,7 +101,7 @@ def test_a_load_held_through_the_log_is_named_with_payload_advice(logs):
     assert "dynid payload" in notes and "dynid validate" not in notes
 
 
-def test_no_loads_names_the_load_that_fits_instead_of_blaming_the_model(logs):
+def test_no_loads_names_the_load_that_fits_instead_of_blaming_the_model(logs, tmp_path):
     """Regression (a UR5 with an unknown 1 kg payload and --no-loads: one event over the
     whole log, the note blaming "friction ... or thresholds calibrated with another
     model"): with --no-loads the load is not applied, but a note names the load that fits
@@ -115,6 +118,12 @@ def test_no_loads_names_the_load_that_fits_instead_of_blaming_the_model(logs):
     assert "dynid payload" in said
     notes = " ".join(result.notes)
     assert "friction or other terms it misses" not in notes
+    names = list(result.model.robot.joint_names)
+    save_observation(tmp_path, result, joints=names, calibrating=False, residuals=False)
+    page = report_of("observe", {"events.json": tmp_path / "events.json"}, notes=result.notes)
+    text = verdict_of(page)  # the report says it where a person looks: its verdict
+    assert "loaded.csv: --no-loads: a constant load at the flange fits" in text, text
+    assert f"{load.mass:.2f} kg" in text and f"explaining {100 * load.explained:.3g} %" in text
 
 
 def _spliced(plain, loaded, out, t0, t1):

@@ -9,6 +9,7 @@ controls; the one-standard-error rule on candidates whose fold errors are given.
 from __future__ import annotations
 
 import dataclasses
+import re
 import warnings
 
 import numpy as np
@@ -23,7 +24,7 @@ from dynid.identification.structure import Structure, structure_terms
 from dynid.simulation.measurement import SensorNoise
 from dynid.workflows.identify import identify_logs
 
-from conftest import planar_2r, recordings
+from conftest import planar_2r, recordings, report_of, verdict_of
 
 K, Q0 = 20.0, 0.3  # the spring on joint 2: N m/rad, rad
 NOISE = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
@@ -54,14 +55,19 @@ def _identified(added):
         return identify_logs(arm, logs)
 
 
-def test_a_spring_the_residual_names_is_chosen_and_recovered():
+@pytest.fixture(scope="module")
+def sprung():
+    """The default search on three recordings with a 20 N m/rad spring on joint 2."""
+    return _identified(_spring)
+
+
+def test_a_spring_the_residual_names_is_chosen_and_recovered(sprung):
     """Regression: a Baxter's shoulder spring (40 N m/rad) was only named as a hint, the
     default choice held out at 3.6 x the noise floor with an armature the truth lacks.
     With a 20 N m/rad spring on joint 2 the default search now chooses a spring on joint 2
     alone, its stiffness within 1 % of the truth, and the held-out error at the noise
     floor; the selection's record says so."""
-    res = _identified(_spring)
-    model, held = res.model, res.heldout
+    model, held = sprung.model, sprung.heldout
     assert model.spring is not None
     assert abs(model.spring.k[1] - K) < 0.01 * K, model.spring.k
     assert model.spring.k[0] == 0.0  # no spring on joint 1
@@ -155,3 +161,18 @@ def test_a_spring_chosen_stays_when_a_burst_is_cut():
     assert record.get("cut_out"), record  # the burst cut
     assert model.spring is not None and abs(model.spring.k[1] - K) < 0.01 * K, model.spring
     assert dict(model.info.selection["spring_candidate"])["chosen"] is True
+
+
+def test_the_identify_report_says_the_spring_trial(sprung, tmp_path):
+    """The page of that identification: its verdict says the spring trial, the joint the
+    residual named (joint 2, the one simulated with a spring), that its choice was kept,
+    and both held-out errors, the one without the spring over 10 x the other's; the trial
+    was only among the notes at the page's end."""
+    from dynid.io.model_json import save_model_json
+
+    path = save_model_json(tmp_path / "identification.json", sprung.model)
+    text = verdict_of(report_of("identify", {"identification.json": path}))
+    (said,) = re.findall(r"Spring trial: ([^;]+); the search run again with it: (.+?) apart", text)
+    assert said[0] == "the held-out residual named a joint spring on joint(s) 2", said
+    with_it, without = re.findall(r"held out ([0-9.e+-]+) % against ([0-9.e+-]+) %", said[1])[0]
+    assert said[1].startswith("its choice kept (") and float(without) > 10 * float(with_it), said

@@ -58,7 +58,9 @@ from .html import (
     table,
     verdict,
 )
+from .identify_findings import finding_facts, offsets_section
 from .model_terms import terms_sections
+from .motion import outside_section
 from .run import Answer, RunFiles
 from .springs import spring_facts, springs_section
 
@@ -745,6 +747,7 @@ def answer(run: RunFiles) -> Answer | None:
             ]
             problems = more + problems
         facts += spring_facts(held)  # where the verdict names a spring: its stiffness
+        facts += finding_facts(doc)  # what the record found of the data (.identify_findings)
         facts[:0] = delay_facts(doc)  # a named lag first: the hints after it may be the lag
         facts[:0] = _gravity_facts(doc)  # the gravity every number above was fitted with
         facts[:0] = cut_facts(doc)  # data the fit left out of a recording: beside the verdict
@@ -765,6 +768,9 @@ def answer(run: RunFiles) -> Answer | None:
     shown = frozenset(f for f, _ in FIGURES if f in run.files)
     sections = [_torques_section(run, held), delay_section(doc), springs_section(held)]
     sections.append(_structure_section(doc))
+    sections.append(offsets_section(doc))
+    if isinstance(held, dict):  # a --validate-on log outside the training's motion
+        sections.append(outside_section(held, [str(x) for x in held.get("joint_names") or ()]))
     sections += [_coefficients_section(doc), *terms_sections(doc)]
     return Answer(
         verdict(level, esc(headline) + ".", facts, label),

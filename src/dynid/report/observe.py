@@ -35,6 +35,7 @@ from .html import (
     verdict,
 )
 from .json_tables import json_section
+from .motion import beyond_fact
 from .run import Answer, RunFiles
 
 __all__ = ["answer"]
@@ -468,7 +469,9 @@ def answer(run: RunFiles) -> Answer | None:
     if events is None and calibrated is not None and found["residuals.png"] is not None:
         facts.append("The residual over the calibration with its thresholds: the figure below")
     notes = _notes(run)
-    facts[0:0] = notes  # before the tables: what the numbers below hold
+    where = found["events.json"] if events is not None else found["thresholds.json"]
+    fast = beyond_fact(run.docs.get(where or ""), run.summary.notes)  # the model extrapolates
+    facts[0:0] = notes + ([fast] if fast is not None else [])  # before the tables
     if level == "good" and any(FRICTION_FOUND in n for n in notes):  # thresholds hold it
         level = "fair"
     if found["thresholds.json"] is not None:

@@ -44,6 +44,7 @@ from .html import (
     table,
     verdict,
 )
+from .motion import outside_facts, outside_section, split_reason
 from .run import Answer, RunFiles
 from .springs import spring_facts, springs_section
 from .static_check import static_answer
@@ -90,8 +91,11 @@ def validate_answer(run: RunFiles) -> Answer | None:
         label = label if level == "good" else "usable, with reservations"
     else:
         label = {"poor": "poor: improve the model", "unusable": "unusable: check the data"}[level]
+    reason, outside, hedge = split_reason(reason)  # each said apart (.motion)
+    names = _names(doc, len(doc["rms"])) if isinstance(doc.get("rms"), list) else []
     facts = [
         f"<b>{esc(capitalised(label))}</b>: {esc(reason)}",
+        *outside_facts(doc, names, outside, hedge),
         f"Relative error without {added} {percent(without.get('relative_error_percent'))}"
         + (
             f", with {added}"
@@ -177,7 +181,10 @@ def validate_answer(run: RunFiles) -> Answer | None:
         ),
     )
     shown_label = label if level == judged_level else None  # a worse joint: the level's own
-    sections = (_joint_errors(doc), delay_section(doc), springs_section(doc), figs)
+    sections = (
+        _joint_errors(doc), delay_section(doc), springs_section(doc), figs,
+        outside_section(doc, names),
+    )  # fmt: skip
     return Answer(verdict(level, head, facts, shown_label), sections, shown)
 
 
