@@ -58,6 +58,23 @@ def test_a_call_is_made_once_within_the_block_its_warnings_said_each_time():
     assert runs[-2:] == [2.0, 2.0]
 
 
+def test_results_beyond_the_budget_are_computed_again(monkeypatch):
+    """A result whose arrays exceed the memory the block may hold (a quarter of
+    DYNID_MAX_STACK_BYTES) is computed again on every call, a small one once."""
+    monkeypatch.setenv("DYNID_MAX_STACK_BYTES", str(4 * 8000))
+    runs = []
+
+    @prepared_once
+    def prepare(size):
+        runs.append(size)
+        return np.zeros(size)
+
+    with shared_preparations():
+        for size in (500, 500, 2000, 2000):  # 4,000 and 16,000 bytes against 8,000
+            assert prepare(size).shape == (size,)
+    assert runs == [500, 2000, 2000]
+
+
 def test_the_offsets_check_reads_the_fits_preparation_back(monkeypatch):
     """Regression: identify_with_offsets prepared the three recordings the fit had just
     prepared a second time, with the cut-off the fit read (the same pieces, filter and
