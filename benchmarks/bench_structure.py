@@ -11,6 +11,10 @@
   (0.08 rad/s on joints 1-2, 0.1 on the others; ``fs = 2 fc``) with sensor noise instead,
   whose search also refines the Stribeck velocity and chooses one per joint
   (:mod:`dynid.identification.stribeck_joints`).
+* the same log prepared again at the cut-off the search read, as the offsets' check of
+  ``identify`` prepares the recordings the fit has just prepared: read back within one
+  run (:mod:`dynid.identification.shared_preparation`) against prepared again (the
+  reference: a run without the shared block).
 
 Before timing, the chosen structure is checked to be the simulated one (armature and
 viscous friction; with ``--stribeck``, a Stribeck law with its velocity per joint).
@@ -23,6 +27,7 @@ usage: python benchmarks/bench_structure.py [--duration 20] [--rate 1000] [--str
 
 from __future__ import annotations
 
+import contextvars
 import re
 import sys
 import warnings
@@ -39,7 +44,9 @@ from dynid.exceptions import DynidWarning  # noqa: E402
 from dynid.friction.laws import LAWS  # noqa: E402
 from dynid.friction.model import ClassicalFriction, LawFriction  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
+from dynid.identification.recordings import prepare_recordings  # noqa: E402
 from dynid.identification.selection import identify_recordings  # noqa: E402
+from dynid.identification.shared_preparation import shared_preparations  # noqa: E402
 from dynid.identification.structure import candidate_structures  # noqa: E402
 from dynid.simulation.measurement import (  # noqa: E402
     SensorNoise,
@@ -83,9 +90,44 @@ def main(argv: list[str] | None = None) -> int:
             note=f"chosen: {name}",
         )
     ]
+    again = _prepared_again(robot, log, chosen.info.log.cutoff_hz, args)
+    if again is None:
+        return 1
+    cases.append(again)
     extra = {"duration_s": args.duration, "rate_hz": args.rate, "stribeck": args.stribeck}
     report("model structure", cases, args, extra)
     return 0
+
+
+def _prepared_again(robot: dynid.Robot, log: dynid.TorqueLog, cutoff_hz: float | None, args):
+    """The log prepared again at ``cutoff_hz`` within the block that prepared it once
+    against prepared again outside it (a fresh context), the two checked equal first."""
+
+    def again():
+        return prepare_recordings(robot, [log], cutoff_hz=cutoff_hz)
+
+    def fresh():
+        return contextvars.Context().run(again)
+
+    with shared_preparations():
+        read, made = again(), fresh()
+        same = all(
+            np.array_equal(getattr(a.log, k), getattr(b.log, k))
+            for a, b in zip(read.pieces, made.pieces, strict=True)
+            for k in ("t", "q", "dq", "ddq", "tau")
+        )
+        if not same:
+            print("the preparation read back differs from the one made again", file=sys.stderr)
+            return None
+        ours, ref = measure_pair(again, fresh, min_time=args.min_time, repeats=args.repeats)
+    return Case(
+        "recordings prepared again in one run (offsets' check)",
+        log.n_samples,
+        ours,
+        ref,
+        ref_name="prepared again",
+        note=f"{len(read.pieces)} piece(s) at {cutoff_hz:.3g} Hz",
+    )
 
 
 def _log(robot: dynid.Robot, t: np.ndarray, stribeck: bool) -> dynid.TorqueLog:

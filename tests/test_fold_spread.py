@@ -23,7 +23,9 @@ from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.identification.fold_spread import (
     coefficient_covariance,
+    covariance_of_sums,
     draw_margin,
+    piece_sums,
     prediction_variance,
 )
 from dynid.identification.verdict import SYSTEMATIC_RATIO
@@ -58,6 +60,32 @@ def test_the_covariance_is_the_spread_of_fits_on_fresh_noise(weighted):
     assert np.all(np.diag(twice) > 0)
     moved = np.einsum("mjp,dp->dmj", Y, np.array(draws)) ** 2  # each draw's prediction
     assert np.allclose(prediction_variance(Y, once).mean(0), moved.mean(axis=(0, 1)), rtol=0.1)
+
+
+@pytest.mark.parametrize("weighted", [False, True])
+def test_the_pieces_sums_formed_once_give_each_folds_covariance(weighted):
+    """Three pieces' sums formed once (piece_sums) and added for each fold's training
+    data, the other two (covariance_of_sums), equal the closed form of the two pieces'
+    rows stacked: (Y^T S^-1 Y)^-1 (wls) or (Y^T Y)^-1 Y^T S Y (Y^T Y)^-1 (ols), each row
+    counted k times, to 1e-12."""
+    rng = np.random.default_rng(8)
+    n, p = 3, 4
+    pieces = [(k, rng.normal(size=(m, n, p))) for k, m in ((1, 30), (2, 25), (3, 40))]
+    var = np.array([0.04, 0.01, 0.0025])
+    sums = piece_sums(pieces, var, weighted=weighted)
+    for fold in range(3):
+        train = [pieces[f] for f in range(3) if f != fold]
+        A = np.concatenate([np.sqrt(k) * Y.reshape(-1, p) for k, Y in train])
+        s = np.tile(var, A.shape[0] // n)
+        if weighted:
+            truth = np.linalg.inv(A.T @ (A / s[:, None]))
+        else:
+            G = np.linalg.inv(A.T @ A)
+            truth = G @ A.T @ (A * s[:, None]) @ G
+        got = covariance_of_sums([sums[f] for f in range(3) if f != fold], weighted=weighted)
+        np.testing.assert_allclose(got, truth, rtol=1e-12, atol=1e-12 * np.abs(truth).max())
+        direct = coefficient_covariance(train, var, weighted=weighted)
+        np.testing.assert_allclose(direct, truth, rtol=1e-12, atol=1e-12 * np.abs(truth).max())
 
 
 def test_the_margin_is_one_standard_deviation_of_the_added_squared_error():

@@ -72,6 +72,24 @@ def test_a_residual_of_tilt_columns_gives_its_angles():
     assert quiet is None or not quiet.named
 
 
+@pytest.mark.parametrize("rows", [60, 4000])
+def test_the_models_columns_are_projected_out_as_lstsq_does(rows):
+    """The tilt's least squares beside the model's columns (a tall system: through the
+    blocked QR's triangular factor) give numpy's lstsq solution and rank at its default
+    tolerance, to 1e-10, columns exactly dependent included (rank 9 of 10)."""
+    from dynid.identification.gravity_tilt import _least_squares
+
+    rng = np.random.default_rng(21)
+    A = rng.normal(size=(rows, 10)) * np.logspace(0, 4, 10)
+    A[:, 9] = A[:, 0] - 2.0 * A[:, 3]
+    B = rng.normal(size=(rows, 3))
+    x, rank = _least_squares(A, B)
+    ref, _, ref_rank, _ = np.linalg.lstsq(A, B, rcond=None)
+    assert rank == ref_rank == 9
+    np.testing.assert_allclose(A @ x, A @ ref, rtol=0, atol=1e-10 * np.abs(B).max())
+    np.testing.assert_allclose(x, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
 def _identified(robot, truth, tmp_path, name, spring=0.0):
     """identify_files with default options on three noisy recordings of ``truth`` with
     friction, offsets and rotor inertias (and a spring of ``spring`` N m/rad on joint 2),

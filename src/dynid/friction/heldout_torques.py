@@ -41,10 +41,12 @@ from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains, drive_gains
 from ..identification.floor_verdict import input_step, judged_prediction, prediction_input_noise
 from ..identification.fold_spread import (
-    coefficient_covariance,
+    PieceSums,
+    covariance_of_sums,
     draw_margin,
     fit_factors,
     loose_folds,
+    piece_sums,
     prediction_variance,
 )
 from ..identification.gravity_tilt import GravityTilt, gravity_tilt, tilt_columns
@@ -613,11 +615,22 @@ def _fold_spread(
     for p in parts:
         k = max(1, p.log.n_samples // _SPREAD_SAMPLES)
         own.append((k * p.step, rows(p.log, np.arange(0, p.log.n_samples, k))))
-    factor = _fit_factors(model, own, var)
+    weighted = model.info.estimator != "ols"
+    formed: dict[tuple[int, bytes], PieceSums] = {}
+
+    def sums(f: int, columns: NDArray[np.bool_]) -> PieceSums:
+        """Recording ``f``'s sums of its rows' ``columns``, formed once for each columns
+        (the folds and the final fit share them: each recording trains two of three)."""
+        key = (f, columns.tobytes())
+        if key not in formed:
+            step, Y = own[f]
+            formed[key] = piece_sums([(step, Y[..., columns])], var, weighted=weighted)[0]
+        return formed[key]
+
+    factor = _fit_factors(model, own, var, sums)
     k = input_step(v.log.n_samples)
     at = np.arange(0, v.log.n_samples, k)
     out = np.zeros((at.size, v.log.n))
-    weighted = model.info.estimator != "ols"
     drawn = []
     for fold in range(len(parts)):
         mine = at[labels[at] == fold]
@@ -628,8 +641,8 @@ def _fold_spread(
         scale = max(float(np.sqrt(np.mean(v.log.tau[mine] ** 2))), 1e-300)
         if not np.allclose(Y @ x, v.tau_hat[mine], rtol=0.0, atol=1e-6 * scale):
             return None  # not the folds' columns: no part said
-        train = [(s, Y_[..., fitted]) for f, (s, Y_) in enumerate(own) if f != fold]
-        cov = coefficient_covariance(train, var, weighted=weighted)
+        train = [sums(f, fitted) for f in range(len(own)) if f != fold]
+        cov = covariance_of_sums(train, weighted=weighted)
         out[labels[at] == fold] = prediction_variance(Y[..., fitted], cov)
         drawn.append((k, Y[..., fitted], cov))
     return ((k, out * factor * draw_margin(drawn)),)
@@ -639,10 +652,12 @@ def _fit_factors(
     model: IdentifiedModel,
     own: list[tuple[int, NDArray[np.float64]]],
     var: NDArray[np.float64],
+    sums: Callable[[int, NDArray[np.bool_]], PieceSums],
 ) -> NDArray[np.float64] | float:
     """Each joint's factor of the final fit's own spread over the noise's on its samples
-    ``own`` (:func:`~dynid.identification.fold_spread.fit_factors`); 1 without the fit's
-    covariance."""
+    ``own`` (:func:`~dynid.identification.fold_spread.fit_factors`; ``sums(f, columns)``
+    the noise's sums of recording ``f``'s rows, :func:`~dynid.identification.fold_spread.
+    piece_sums`); 1 without the fit's covariance."""
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     cov = fit.covariance
     width = own[0][1].shape[-1]
@@ -650,7 +665,8 @@ def _fit_factors(
         return 1.0
     kept = np.asarray(fit.kept, dtype=bool)
     rows = [(k, Y[..., kept]) for k, Y in own]
-    noise = coefficient_covariance(rows, var, weighted=model.info.estimator != "ols")
+    weighted = model.info.estimator != "ols"
+    noise = covariance_of_sums([sums(f, kept) for f in range(len(own))], weighted=weighted)
     return fit_factors(rows, noise, np.asarray(cov)[np.ix_(kept, kept)])
 
 

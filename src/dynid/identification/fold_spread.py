@@ -41,7 +41,9 @@ It is counted at its mean plus that standard deviation (:func:`draw_margin`): at
 alone, a planar 2R arm of the truth's structure predicted from 2 s recordings was judged
 above its noise on one joint in two.
 
-* :func:`coefficient_covariance`: ``Sigma`` of rows given at every k-th sample;
+* :func:`coefficient_covariance`: ``Sigma`` of rows given at every k-th sample (the
+  pieces' sums :func:`piece_sums`, added by :func:`covariance_of_sums`: a piece in several
+  folds' training data formed once);
 * :func:`prediction_variance`: ``diag(Y Sigma Y^T)`` per sample;
 * :func:`fit_factors`: each joint's factor of the fit's own spread over the noise's;
 * :func:`draw_margin`: each joint's factor from the part's mean to its mean plus one
@@ -58,10 +60,13 @@ from numpy.typing import NDArray
 __all__ = [
     "LOOSE_FOLDS",
     "MOST_FIT_FACTOR",
+    "PieceSums",
     "coefficient_covariance",
+    "covariance_of_sums",
     "draw_margin",
     "fit_factors",
     "loose_folds",
+    "piece_sums",
     "prediction_variance",
 ]
 
@@ -106,16 +111,44 @@ def coefficient_covariance(
         In the coefficients' units squared; zero rows and columns for a column no row
         excites.
     """
+    return covariance_of_sums(piece_sums(rows, noise_var, weighted=weighted), weighted=weighted)
+
+
+#: One piece's step ``k`` and the sums :func:`coefficient_covariance` adds up for it:
+#: ``sum_i Y_i^T S^{-1} Y_i`` (wls) or ``sum_i Y_i^T Y_i`` and ``sum_i Y_i^T S Y_i`` (ols).
+PieceSums = tuple[int, NDArray[np.float64], NDArray[np.float64] | None]
+
+
+def piece_sums(
+    rows: Sequence[tuple[int, NDArray[np.float64]]],
+    noise_var: NDArray[np.float64],
+    *,
+    weighted: bool,
+) -> list[PieceSums]:
+    """Per piece of ``rows`` (as :func:`coefficient_covariance` takes them), its step and
+    the products of its rows that the covariance sums (:data:`PieceSums`, (p, p) each):
+    computed once, a piece shared by several folds' training data is summed into each
+    (:func:`covariance_of_sums`) without forming them again."""
     s = np.asarray(noise_var, dtype=np.float64)
-    p = rows[0][1].shape[-1]
-    G, meat = np.zeros((p, p)), np.zeros((p, p))
+    out: list[PieceSums] = []
     for k, Y in rows:
-        flat = Y.reshape(-1, p)
         if weighted:
-            G += k * _weighted_gram(Y, 1.0 / s)
+            out.append((k, _weighted_gram(Y, 1.0 / s), None))
         else:
-            G += k * (flat.T @ flat)
-            meat += k * _weighted_gram(Y, s)
+            flat = Y.reshape(-1, Y.shape[-1])
+            out.append((k, flat.T @ flat, _weighted_gram(Y, s)))
+    return out
+
+
+def covariance_of_sums(sums: Sequence[PieceSums], *, weighted: bool) -> NDArray[np.float64]:
+    """:func:`coefficient_covariance` (p, p) of the pieces whose products ``sums``
+    (:func:`piece_sums`) holds, added in their order."""
+    p = sums[0][1].shape[-1]
+    G, meat = np.zeros((p, p)), np.zeros((p, p))
+    for k, A, B in sums:
+        G += k * A
+        if not weighted and B is not None:
+            meat += k * B
     Gp = _pinv(G)
     return Gp if weighted else Gp @ meat @ Gp
 

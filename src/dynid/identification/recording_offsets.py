@@ -42,6 +42,7 @@ from .log_rows import log_blocks
 from .model import IdentifiedModel
 from .recordings import Recordings, prepare_recordings
 from .selection import fitted_logs, identify_recordings
+from .shared_preparation import shared_preparations
 from .streaming import streams
 
 #: A recording's offset differs where it lies this many standard errors from the mean.
@@ -387,6 +388,7 @@ def _recorded(
     return dataclasses.replace(model, info=info)
 
 
+@shared_preparations()  # the recordings prepared again as the fit prepared them: read back
 def identify_with_offsets(
     robot: Robot,
     logs: Sequence[TorqueLog],

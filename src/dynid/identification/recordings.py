@@ -86,11 +86,20 @@ from .recorded_signs import recording_sign_findings
 from .reversed_among import reversed_among
 from .sanity import check_torque_log
 from .serial import Serial, serial_of_pieces
+from .shared_preparation import prepared_once
 from .spikes import despiked, spike_finding
 from .streaming import streams
 from .training_range import motion_ranges
 from .trim import common_cutoff, edge_seconds, within_edges
 from .velocity_noise import noise_band, pieces_noise_std
+
+# read back within shared_preparations: a run prepares the same recordings again
+# (identify_with_offsets with the cut-off the fit read; the spring trial)
+_spike_finding = prepared_once(spike_finding)
+_sign_findings = prepared_once(recording_sign_findings)
+_reversed_among = prepared_once(reversed_among)
+_check_torque_log = prepared_once(check_torque_log)
+_prepare_torque_log = prepared_once(prepare_torque_log)
 
 __all__ = [
     "WRAP_SPAN",
@@ -542,7 +551,7 @@ def prepare_recordings(
             raise ShapeError(
                 f"log has {log.n} joints; robot {robot.name!r} has {robot.n}", file=name
             )
-        if (spikes := spike_finding(name, log, robot.joint_names)) is not None:
+        if (spikes := _spike_finding(name, log, robot.joint_names)) is not None:
             warnings.warn(spikes, DynidWarning, stacklevel=caller_level())
             log = despiked(log)[0]  # before the filter spreads them
         mine, joints = recording_pieces(
@@ -559,12 +568,12 @@ def prepare_recordings(
     wholes = [joined([p for k, p in pieces if k == r]) for r in have]
     # signs: a fit would bend to mirrored motion, negate the masses, or average a joint's
     # friction to nothing
-    for bad in recording_sign_findings(robot, wholes, [names[r] for r in have], drive, first=True):
+    for bad in _sign_findings(robot, wholes, [names[r] for r in have], drive, first=True):
         raise DataError(bad.text, file=bad.name)
-    if (other := reversed_among(robot, wholes, [names[r] for r in have], drive)) is not None:
+    if (other := _reversed_among(robot, wholes, [names[r] for r in have], drive)) is not None:
         raise DataError(other.text, file=other.name)  # a wrist's the description cannot tell
     for r, whole in zip(have, wholes, strict=True):  # units, frozen joints: said once
-        for finding in check_torque_log(robot, joint_side_log(whole, drive), drive):
+        for finding in _check_torque_log(robot, joint_side_log(whole, drive), drive):
             found.setdefault(finding, []).append(names[r])
     for finding, which in wrapped.items():
         warnings.warn(f"{', '.join(which)}: {finding}", DynidWarning, stacklevel=caller_level())
@@ -696,7 +705,7 @@ def _prepared(
         report(f"preparing {names[r]}{several}")
         try:
             with _named_findings(names[r] if len(names) > 1 else None, r, said):
-                p = prepare_torque_log(robot, piece, drive=drive, check=False, **kw)
+                p = _prepare_torque_log(robot, piece, drive=drive, check=False, **kw)
         except DataError as exc:
             skipped.append(skipped_piece(names[r], piece, exc))
             left.append((k, str(exc)))

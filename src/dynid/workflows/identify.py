@@ -72,6 +72,7 @@ from ..identification.motor_constants import shared_gear_ratio
 from ..identification.recording_offsets import identify_with_offsets
 from ..identification.residual_dependence import outside_model_note, round_off_note
 from ..identification.selection import fitted_logs, identify_recordings
+from ..identification.shared_preparation import shared_preparations
 from ..identification.shared_search import shared_searches
 from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
@@ -643,7 +644,9 @@ def _fit_logs(
                 **heldout,
             )
 
-        with shared_searches():  # the spring trial's fit repeats the search without it
+        # the spring trial's fit repeats the search without it; the offsets' check and the
+        # spring trial prepare the recordings the fit prepared
+        with shared_searches(), shared_preparations():
             return _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
 
     separate = heldout.get("validate_on")
