@@ -34,6 +34,7 @@ from ..observer.calibration_check import CalibrationCheck
 from ..observer.detection import undetected_at_rest
 from ..observer.friction import standstill_margin
 from ..observer.gain_noise import GainNoise
+from ..observer.missed_reason import reason_words
 from ..observer.rest_margin import rest_margin_lines
 from ..observer.results import (
     LogObservation,
@@ -1235,7 +1236,9 @@ def _score_lines(result: ObserveResult, labels: list[str]) -> list[str]:
     for lab, sc in scored:
         for m in sc.missed:
             peak = "" if m.peak is None else f", peak true torque {m.peak:.3g} N m"
-            rows.append(f"  missed in {lab}: {m.start:.3f} s .. {m.end:.3f} s{peak}")
+            why = reason_words(m, result.model.robot.joint_names)
+            why = f"; {why}" if why else ""
+            rows.append(f"  missed in {lab}: {m.start:.3f} s .. {m.end:.3f} s{peak}{why}")
     for lab, x in zip(labels, result.logs, strict=True):
         if x.score is None:
             continue

@@ -91,7 +91,7 @@ from ..observer.carried_load import CarriedLoad, load_words
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
-from ..observer.scoring import ContactScore
+from ..observer.scoring import ContactScore, MissedContact
 from ..observer.thresholds import ModelFingerprint, RestMargin
 from ..observer.unmodelled_load import LOAD_FRAME
 from ..observer.wrench import FULL, WrenchKind, wrench_rank
@@ -235,6 +235,12 @@ _SCORE_FIELDS = {
                 "start": Field("number", required=True, unit="s"),
                 "end": Field("number", required=True, unit="s"),
                 "peak": Field("number", nullable=True, low=0.0, unit=_NM),
+                "reason": Field("string", choices=("below_at_rest", "below_moving", "unexplained")),
+                "joint": Field("integer", low=1),
+                "joint_name": Field("string", nullable=True),
+                "torque": Field("number", low=0.0, unit=_NM),
+                "threshold": Field("number", low=0.0, unit=_NM),
+                "torque_source": Field("string", choices=("true", "residual")),
             }
         ),
     ),
@@ -883,8 +889,8 @@ def _dropped_info(result: ObserveResult, joints: Sequence[str]) -> dict[str, Any
     }
 
 
-def _score_record(sc: ContactScore) -> dict[str, Any]:
-    """One score as ``events.json`` writes it (:data:`SCORE`)."""
+def _score_record(sc: ContactScore, names: Sequence[str]) -> dict[str, Any]:
+    """One score as ``events.json`` writes it (:data:`SCORE`), ``names`` the joints'."""
     return {
         "source": sc.source,
         "tolerance_s": sc.tolerance_s,
@@ -899,8 +905,27 @@ def _score_record(sc: ContactScore) -> dict[str, Any]:
         "delay_max_ms": None if sc.delay_max is None else 1e3 * sc.delay_max,
         "delays_look_ahead": sc.look_ahead,
         "early_ms": [1e3 * d for d in sc.early],
-        "missed_contacts": [{"start": m.start, "end": m.end, "peak": m.peak} for m in sc.missed],
+        "missed_contacts": [_missed_record(m, names) for m in sc.missed],
     }
+
+
+def _missed_record(m: MissedContact, names: Sequence[str]) -> dict[str, Any]:
+    """One missed contact as ``events.json`` writes it: its times [s], its largest true
+    torque ``peak`` [N m], and where read (:mod:`~dynid.observer.missed_reason`) the
+    ``reason``, the ``joint`` (1-based) and ``joint_name``, its ``torque`` and the
+    ``threshold`` it was compared with [N m], and ``torque_source`` (``true`` or
+    ``residual``)."""
+    out: dict[str, Any] = {"start": m.start, "end": m.end, "peak": m.peak}
+    if m.reason is not None and m.joint is not None:
+        out.update(
+            reason=m.reason,
+            joint=m.joint + 1,
+            joint_name=names[m.joint] if m.joint < len(names) else None,
+            torque=m.torque,
+            threshold=m.threshold,
+            torque_source="true" if m.true_torque else "residual",
+        )
+    return out
 
 
 def _score_info(result: ObserveResult, total: ContactScore) -> dict[str, Any]:
@@ -908,10 +933,11 @@ def _score_info(result: ObserveResult, total: ContactScore) -> dict[str, Any]:
     per log with labels (``logs``: the log's name, its score and its labelled
     ``contacts``, ``[start, end]`` [s])."""
     labels = log_labels([x.path for x in result.logs])
+    names = result.model.robot.joint_names
     per = [
         {
             "log": lab,
-            **_score_record(x.score),
+            **_score_record(x.score, names),
             "contacts": [list(c) for c in x.score.intervals],
             "false_alarm_events": [
                 {"start": x.events[k].start, "end": x.events[k].end} for k in x.score.false_events
@@ -920,7 +946,7 @@ def _score_info(result: ObserveResult, total: ContactScore) -> dict[str, Any]:
         for x, lab in zip(result.logs, labels, strict=True)
         if x.score is not None
     ]
-    return {**_score_record(total), "logs": per}
+    return {**_score_record(total, names), "logs": per}
 
 
 def _estimate_info(result: ObserveResult) -> dict[str, Any]:

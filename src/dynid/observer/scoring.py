@@ -233,11 +233,19 @@ def match_events(
 @dataclass(frozen=True, slots=True)
 class MissedContact:
     """A labelled contact no event overlaps: ``start``, ``end`` [s] and ``peak``, its
-    largest true external torque [N m] (None: not known, a label column)."""
+    largest true external torque [N m] (None: not known, a label column); where read
+    (:mod:`~dynid.observer.missed_reason`), the ``reason`` it was missed, the ``joint``
+    (0-based) whose ``torque`` came closest to its ``threshold`` [N m], and whether that
+    torque is the true one (``true_torque``) or the residual's peak."""
 
     start: float
     end: float
     peak: float | None = None
+    reason: str | None = None
+    joint: int | None = None
+    torque: float | None = None
+    threshold: float | None = None
+    true_torque: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -238,7 +238,47 @@ def _scored(doc: Any) -> str | None:
             from ..observer.scoring import LOOK_AHEAD_WORDS  # here: any run's page loads this
 
             said += f" ({LOOK_AHEAD_WORDS})"
-    return esc(said + ".")
+    return esc(said + "." + _missed_said(sc))
+
+
+#: Missed contacts a report names at most (events.json holds them all).
+MISSED_SHOWN = 10
+
+
+def _missed_said(sc: dict) -> str:
+    """The missed contacts of ``events.json``'s ``score`` (per log in ``logs``), each with
+    its times and, where read, why it was missed (``reason``, the joint, its torque and
+    the threshold compared), as sentences; empty without one."""
+    rows = []
+    for log in sc.get("logs") or []:
+        if not isinstance(log, dict):
+            continue
+        for m in log.get("missed_contacts") or []:
+            if isinstance(m, dict) and is_number(m.get("start")) and is_number(m.get("end")):
+                rows.append(
+                    f"{log.get('log', '?')} {m['start']:.3f} s to {m['end']:.3f} s" + _why(m)
+                )
+    if not rows:
+        return ""
+    more = len(rows) - MISSED_SHOWN
+    tail = f"; and {more} more in events.json" if more > 0 else ""
+    return " Missed: " + "; ".join(rows[:MISSED_SHOWN]) + tail + "."
+
+
+def _why(m: dict) -> str:
+    """`` (joint4 stood still: true torque 0.5 N m below its at-rest threshold 0.84 N m)``:
+    a missed contact's reason in ``events.json``, empty without one."""
+    reason, name = m.get("reason"), m.get("joint_name") or f"joint {m.get('joint')}"
+    torque, level = m.get("torque"), m.get("threshold")
+    if not (isinstance(reason, str) and is_number(torque) and is_number(level)):
+        return ""
+    what = "true torque" if m.get("torque_source") == "true" else "residual's peak"
+    size = f"{what} {torque:.3g} N m"
+    if reason == "below_at_rest":
+        return f" ({name} stood still: {size} below its at-rest threshold {level:.3g} N m)"
+    if reason == "below_moving":
+        return f" ({name}: {size} below its moving threshold {level:.3g} N m)"
+    return f" (unexplained: {name}'s {size} reached its threshold {level:.3g} N m)"
 
 
 #: Dropped crossings a report names at most (events.json holds more).

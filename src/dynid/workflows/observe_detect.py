@@ -30,6 +30,7 @@ from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
+from ..observer.calibration_check import detectable
 from ..observer.carried_load import (
     MIN_LOAD_S,
     CarriedLoad,
@@ -39,9 +40,13 @@ from ..observer.carried_load import (
     carried_loads,
     load_events,
 )
+from ..observer.detection import undetected_at_rest
 from ..observer.events import ContactEvent, EventDetector, time_slack
+from ..observer.friction import velocity_bands
+from ..observer.missed_reason import LabelledResidual, explained, interval_rows
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
+from ..observer.rest_margin import at_rest
 from ..observer.results import FigureSeries, LogObservation
 from ..observer.scoring import (
     DEFAULT_TOLERANCE_S,
@@ -243,6 +248,7 @@ def _detected_once(
     seen = model.friction
     if unmodelled is not None:
         unmodelled.new_log()
+    labelled = None if labels is None or ext is not None else LabelledResidual(labels.flags, n)
     less = LoadTorque(model.robot, carried, options.gains(n)) if carried else None
     with about_file(prep.path.name), table or nullcontext(None) as put:
         for blk in _less_load(
@@ -261,6 +267,8 @@ def _detected_once(
             if w is not None and keep is not None:
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
+            if labelled is not None:
+                labelled.add(a, blk.r)
             sign.add(log.tau[a:b], blk.r)
             _tallied(prep, levels[0], blk, unmodelled, load, samples)
             if keep is not None:
@@ -293,7 +301,15 @@ def _detected_once(
         figure=None if strided is None else strided.series(),
         peak_ratio=det.largest_ratio,
         friction=None if seen is model.friction else seen,
-        score=scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived),
+        score=with_reasons(
+            scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived),
+            log.t,
+            log.dq,
+            model,
+            thresholds,
+            ext,
+            labelled,
+        ),  # fmt: skip
         dropped=det.dropped,
         dropped_count=det.dropped_count,
         damped=None if fits is None else damped_shares(log.t, events, fits.damped),
@@ -567,6 +583,46 @@ def scored(
         lead_s=lead,
         slack_s=time_slack(t),
     )
+
+
+def with_reasons(
+    score: ContactScore | None,
+    t: NDArray,
+    dq: NDArray,
+    model: ObserverModel,
+    thresholds: Thresholds,
+    ext: NDArray | None,
+    labelled: LabelledResidual | None,
+) -> ContactScore | None:
+    """``score`` with the reason of each missed contact (:mod:`dynid.observer.missed_reason`)
+    of a log at times ``t`` (N,) [s] with velocities ``dq`` (N, n) [rad/s]: its torque the
+    true external torques ``ext`` (N, n) [N m], else the residual's kept over the labels
+    (``labelled``), against each joint's threshold standing still inside its standstill
+    band (:func:`~dynid.observer.detection.undetected_at_rest`; with thresholds that add
+    the standstill margin) or moving (:func:`~dynid.observer.calibration_check.detectable`);
+    unchanged with no missed contact or neither torque."""
+    if score is None or not score.missed or (ext is None and labelled is None):
+        return score
+    moving = detectable(thresholds, None)
+    rest = undetected_at_rest(model, thresholds, moving)
+    out = []
+    for m in score.missed:
+        i, j = interval_rows(t, m.start, m.end)
+        if j <= i:
+            out.append(m)
+            continue
+        if ext is not None:
+            with np.errstate(invalid="ignore"):
+                peak = np.nanmax(np.abs(np.where(np.isfinite(ext[i:j]), ext[i:j], np.nan)), 0)
+        else:
+            assert labelled is not None
+            peak = labelled.peak(i, j)
+        still = np.zeros(model.n, dtype=bool)
+        if thresholds.standstill and model.friction is not None:
+            bands = velocity_bands(model.friction, dq)
+            still = np.all(at_rest(model.friction, dq[i:j], bands), axis=0)
+        out.append(explained(m, peak, still, rest, moving, true_torque=ext is not None))
+    return replace(score, missed=tuple(out))
 
 
 def observed_wrench(
