@@ -86,7 +86,9 @@ report's events table; several false alarms that each start shortly before a mis
 contact and run into it get a note: the labels look shifted by about that much. The
 summary prints per log
 and in total the contacts labelled, detected and missed (each missed one with its times
-and, from tau_ext, its peak true torque), the false alarms and their rate per minute of
+and, from tau_ext, its peak true torque, and why where it can be read: the joint stood
+still and its torque is below its at-rest threshold, or below its moving one), the false
+alarms and their rate per minute of
 contact-free time, and the delays (event start less contact start, median and max;
 with velocities derived from the positions, the zero-phase low-pass sees ahead, and the
 delays, shorter than an online observer's, say so); events.json holds them under score;

@@ -30,7 +30,9 @@ Albu-Schaeffer, IEEE T-RO 2017), on any model dynid produces.
 * :mod:`~dynid.observer.events`: contact and collision events, from a whole log or a
   block of samples at a time (:class:`EventDetector`);
 * :mod:`~dynid.observer.scoring`: the events against labelled contacts (a 0/1 column or
-  the true external torques): detected, missed, false alarms and delays.
+  the true external torques): detected, missed, false alarms and delays;
+  :mod:`~dynid.observer.missed_reason` why a missed one was missed (its torque below the
+  threshold of its joint standing still or moving).
 * :mod:`~dynid.observer.unmodelled_load`: the weight of a load at the flange that the
   model lacks, fitted to the residual off contacts.
 """

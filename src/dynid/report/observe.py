@@ -220,7 +220,8 @@ def _scored(doc: Any) -> str | None:
     """The events against the labelled contacts in one escaped sentence (``events.json``'s
     ``score``: counts, false alarms per minute of contact-free time, delays, and beside
     them, where ``delays_look_ahead``, that a zero-phase filter's delays are shorter than
-    an online observer's), or None where the file has none."""
+    an online observer's; then the missed contacts and why, :func:`_missed_said`), or None
+    where the file has none."""
     sc = doc.get("score") if isinstance(doc, dict) else None
     keys = ("labelled", "detected", "missed", "false_alarms")
     if not isinstance(sc, dict) or not all(is_number(sc.get(k)) for k in keys):

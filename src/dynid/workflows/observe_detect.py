@@ -267,10 +267,8 @@ def _detected_once(
             if w is not None and keep is not None:
                 wrenches.append(w)
             stats.add(blk.r, blk.margin, None if ext is None else ext[a:b])
-            if labelled is not None:
-                labelled.add(a, blk.r)
             sign.add(log.tau[a:b], blk.r)
-            _tallied(prep, levels[0], blk, unmodelled, load, samples)
+            _tallied(prep, levels[0], blk, unmodelled, load, samples, labelled)
             if keep is not None:
                 keep.put(blk)
             if strided is not None:
@@ -301,15 +299,7 @@ def _detected_once(
         figure=None if strided is None else strided.series(),
         peak_ratio=det.largest_ratio,
         friction=None if seen is model.friction else seen,
-        score=with_reasons(
-            scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived),
-            log.t,
-            log.dq,
-            model,
-            thresholds,
-            ext,
-            labelled,
-        ),  # fmt: skip
+        score=_log_score(prep, model, thresholds, events, labels, ext, tolerance_s, labelled),
         dropped=det.dropped,
         dropped_count=det.dropped_count,
         damped=None if fits is None else damped_shares(log.t, events, fits.damped),
@@ -435,12 +425,15 @@ def _tallied(
     unmodelled: FrictionTally | None,
     load: LoadTally | None,
     samples: LoadSamples | None,
+    labelled: LabelledResidual | None = None,
 ) -> None:
     """One block fed to the tallies off contacts (``unmodelled``: the friction the model
     misses; ``load``: a load at the flange it misses) and its samples over the threshold
     to ``samples`` (a carried load's fit); ``contact`` (m, n) [N m] the block's contact
     threshold (:func:`~dynid.observer.thresholds.threshold_series`, NaN where not
-    observed)."""
+    observed); its residual over labelled contacts to ``labelled`` (why one was missed)."""
+    if labelled is not None:
+        labelled.add(blk.a, blk.r)
     if unmodelled is None and load is None and samples is None:
         return
     log = prep.log
@@ -583,6 +576,23 @@ def scored(
         lead_s=lead,
         slack_s=time_slack(t),
     )
+
+
+def _log_score(
+    prep: PreparedLog,
+    model: ObserverModel,
+    thresholds: Thresholds,
+    events: Sequence[ContactEvent],
+    labels: Labels | None,
+    ext: NDArray | None,
+    tolerance_s: float,
+    labelled: LabelledResidual | None,
+) -> ContactScore | None:
+    """The score of one log's ``events`` (:func:`scored`) with the reasons of its missed
+    contacts (:func:`with_reasons`)."""
+    log = prep.log
+    sc = scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived)
+    return with_reasons(sc, log.t, prep.dq, model, thresholds, ext, labelled)
 
 
 def with_reasons(
