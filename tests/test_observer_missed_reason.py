@@ -17,7 +17,7 @@ import dynid
 from dynid.cli.__main__ import main
 from dynid.friction.model import ClassicalFriction
 from dynid.io.friction_json import save_friction_json
-from dynid.io.observer_files import save_thresholds
+from dynid.io.observer_files import load_thresholds, save_thresholds
 from dynid.observer.missed_reason import (
     BELOW_AT_REST,
     BELOW_MOVING,
@@ -144,3 +144,22 @@ def test_with_a_label_column_alone_the_reason_reads_the_residuals_peak(observed,
     assert (m["reason"], m["joint"], m["torque_source"]) == (BELOW_AT_REST, 4, "residual")
     assert m["torque"] == pytest.approx(WEAK[2], abs=0.05)
     assert m["threshold"] == pytest.approx(CONTACT + FC[3], abs=1e-9)
+
+
+def test_the_moving_level_compared_is_the_calibrations_detectable_when_recorded(observed, capsys):
+    """Regression (a UR5's at-rest threshold said 0.833 N m beside thresholds.json's 0.838:
+    the fixed contact level stood for the calibration's ``detectable``): with
+    ``detectable`` 0.4 N m recorded, joint 4's threshold at rest is 0.4 + 0.54 N m."""
+    d, argv = observed
+    th = load_thresholds(d / "thresholds.json")
+    cal = {"samples": 1, "detectable": [0.4] * 7}
+    save_thresholds(d / "recorded.json", th, joints=[f"joint{j}" for j in range(1, 8)],
+                    calibration=cal)  # fmt: skip
+    assert load_thresholds(d / "recorded.json").detectable.tolist() == [0.4] * 7
+    at = argv.index("--thresholds") + 1
+    argv = [*argv[:at], str(d / "recorded.json"), *argv[at + 1 : -1], str(d / "rec")]
+    assert main(argv) == 0
+    capsys.readouterr()
+    (m,) = json.loads((d / "rec" / "events.json").read_text())["score"]["missed_contacts"]
+    assert (m["reason"], m["joint"]) == (BELOW_AT_REST, 4)
+    assert m["threshold"] == pytest.approx(0.4 + FC[3], abs=1e-9)

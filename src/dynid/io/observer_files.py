@@ -463,9 +463,21 @@ def load_thresholds(path: str | Path) -> Thresholds:
             model=model,
             sample_rate_hz=None if rate is None else float(rate),
             velocities=cal.get("velocities"),
+            detectable=_numbers_or_none(cal.get("detectable"), len(d["contact"])),
         )
     except DynidError as exc:
         raise DataError(str(exc), file=path.name) from None
+
+
+def _numbers_or_none(x: Any, n: int) -> NDArray[np.float64] | None:
+    """``x`` as an array of ``n`` finite numbers, else None (absent or not of that
+    form: a file of an earlier version)."""
+    if not isinstance(x, list) or len(x) != n:
+        return None
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in x):
+        return None
+    a = np.array(x, dtype=float)
+    return a if np.all(np.isfinite(a)) else None
 
 
 def save_events(

@@ -159,6 +159,11 @@ class Thresholds:
         The standstill margin at settled rests, calibrated from the calibration's rests
         (:mod:`dynid.observer.rest_margin`); None: the Coulomb level at every rest (a
         calibration without the rests read, a file of an earlier version).
+    detectable : ndarray, shape (n,), or None
+        The calibration's smallest torque detected while each joint moves [N m]
+        (``thresholds.json``'s ``calibration.detectable``,
+        :func:`~dynid.observer.calibration_check.detectable`), read back with the file;
+        None: not recorded (the fixed ``contact`` stands for it).
     """
 
     contact: NDArray[np.float64]
@@ -175,6 +180,7 @@ class Thresholds:
     sample_rate_hz: float | None = None
     velocities: str | None = None
     rest: RestMargin | None = None
+    detectable: NDArray[np.float64] | None = field(default=None)
 
     def __post_init__(self) -> None:
         if self.velocities not in (None, "measured", "derived", "mixed"):
@@ -187,7 +193,8 @@ class Thresholds:
         ):
             raise DataError(f"thresholds: sample_rate_hz must be > 0; got {self.sample_rate_hz}")
         n = np.shape(self.contact)[0]
-        for name in ("contact", "collision") + (("noise",) if self.noise is not None else ()):
+        given = tuple(x for x in ("noise", "detectable") if getattr(self, x) is not None)
+        for name in ("contact", "collision", *given):
             a = _checks.as_exact(name, getattr(self, name), (n,))
             if np.any(a < 0):
                 raise DataError(f"thresholds: {name} must be >= 0 [N m]; got {a.tolist()}")

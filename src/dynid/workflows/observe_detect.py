@@ -609,11 +609,14 @@ def with_reasons(
     true external torques ``ext`` (N, n) [N m], else the residual's kept over the labels
     (``labelled``), against each joint's threshold standing still inside its standstill
     band (:func:`~dynid.observer.detection.undetected_at_rest`; with thresholds that add
-    the standstill margin) or moving (:func:`~dynid.observer.calibration_check.detectable`);
+    the standstill margin) or moving (the calibration's ``detectable``, else
+    :func:`~dynid.observer.calibration_check.detectable`): ``thresholds.json``'s numbers;
     unchanged with no missed contact or neither torque."""
     if score is None or not score.missed or (ext is None and labelled is None):
         return score
-    moving = detectable(thresholds, None)
+    moving = thresholds.detectable
+    if moving is None:  # not recorded: the fixed contact level
+        moving = detectable(thresholds, None)
     rest = undetected_at_rest(model, thresholds, moving)
     out = []
     for m in score.missed:
