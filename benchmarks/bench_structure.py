@@ -13,7 +13,7 @@
   (:mod:`dynid.identification.stribeck_joints`).
 * the same log prepared again at the cut-off the search read, as the offsets' check of
   ``identify`` prepares the recordings the fit has just prepared: read back within one
-  run (:mod:`dynid.identification.shared_preparation`) against prepared again (the
+  run (:mod:`dynid.identification.once_per_run`) against prepared again (the
   reference: a run without the shared block).
 
 Before timing, the chosen structure is checked to be the simulated one (armature and
@@ -44,9 +44,9 @@ from dynid.exceptions import DynidWarning  # noqa: E402
 from dynid.friction.laws import LAWS  # noqa: E402
 from dynid.friction.model import ClassicalFriction, LawFriction  # noqa: E402
 from dynid.identification.classical import identify_from_log  # noqa: E402
+from dynid.identification.once_per_run import shared_run  # noqa: E402
 from dynid.identification.recordings import prepare_recordings  # noqa: E402
 from dynid.identification.selection import identify_recordings  # noqa: E402
-from dynid.identification.shared_preparation import shared_preparations  # noqa: E402
 from dynid.identification.structure import candidate_structures  # noqa: E402
 from dynid.simulation.measurement import (  # noqa: E402
     SensorNoise,
@@ -109,7 +109,7 @@ def _prepared_again(robot: dynid.Robot, log: dynid.TorqueLog, cutoff_hz: float |
     def fresh():
         return contextvars.Context().run(again)
 
-    with shared_preparations():
+    with shared_run():
         read, made = again(), fresh()
         same = all(
             np.array_equal(getattr(a.log, k), getattr(b.log, k))

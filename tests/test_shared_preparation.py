@@ -14,20 +14,20 @@ import pytest
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
 from dynid.identification import prepared_log, recording_offsets
+from dynid.identification.once_per_run import once_per_run, shared_run
 from dynid.identification.recording_offsets import identify_with_offsets
-from dynid.identification.shared_preparation import prepared_once, shared_preparations
 from dynid.simulation.measurement import SensorNoise
 
 from conftest import planar_2r, recordings
 
 
 def test_a_call_is_made_once_within_the_block_its_warnings_said_each_time():
-    """Within shared_preparations, equal arguments (by value) compute once and read the
+    """Within shared_run, equal arguments (by value) compute once and read the
     result back with the first call's warnings said again; other arguments, a call that
     raised, an argument without a digest and every call outside the block compute."""
     runs = []
 
-    @prepared_once
+    @once_per_run
     def prepare(x, *, cutoff=1.0):
         runs.append(cutoff)
         if cutoff == -1.0:
@@ -36,7 +36,7 @@ def test_a_call_is_made_once_within_the_block_its_warnings_said_each_time():
         return x.sum(), cutoff
 
     x = np.linspace(0.0, 1.0, 5)
-    with shared_preparations():
+    with shared_run():
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
             first = prepare(x, cutoff=2.0)
@@ -64,12 +64,12 @@ def test_results_beyond_the_budget_are_computed_again(monkeypatch):
     monkeypatch.setenv("DYNID_MAX_STACK_BYTES", str(4 * 8000))
     runs = []
 
-    @prepared_once
+    @once_per_run
     def prepare(size):
         runs.append(size)
         return np.zeros(size)
 
-    with shared_preparations():
+    with shared_run():
         for size in (500, 500, 2000, 2000):  # 4,000 and 16,000 bytes against 8,000
             assert prepare(size).shape == (size,)
     assert runs == [500, 2000, 2000]

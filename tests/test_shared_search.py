@@ -15,8 +15,8 @@ import pytest
 from dynid._memo import value_digest
 from dynid.exceptions import DynidWarning
 from dynid.identification import selection as selection_module
+from dynid.identification.once_per_run import once_per_run, shared_run
 from dynid.identification.selection import identify_recordings
-from dynid.identification.shared_search import searched_once, shared_searches
 from dynid.simulation.measurement import SensorNoise
 
 from conftest import recordings
@@ -46,22 +46,22 @@ def test_the_digest_reads_values_not_identities():
 
 
 def test_a_search_is_made_once_within_the_block_and_every_time_outside():
-    """Within shared_searches, equal arguments (by value) run the search once and read its
+    """Within shared_run, equal arguments (by value) run the search once and read its
     result back; other arguments run it again; outside the block, and with an argument
     that has no digest, every call runs."""
     runs = []
 
-    @searched_once
+    @once_per_run
     def search(data, *, folds=5):
         runs.append(folds)
         return {"folds": folds, "sum": float(np.sum(data))}
 
     data = np.linspace(0.0, 1.0, 7)
-    with shared_searches():
+    with shared_run():
         first = search(data, folds=5)
         assert search(data.copy(), folds=5) is first
         search(data, folds=4)
-        with shared_searches():  # nested: the outer memo
+        with shared_run():  # nested: the outer memo
             assert search(data, folds=4)["folds"] == 4
         search(data, folds={3})  # no digest: run
         search(data, folds={3})
@@ -85,12 +85,12 @@ def test_the_spring_trial_reads_the_search_without_the_spring_back(panda, monkey
         made.append(kw.get("candidates") is not None)
         return inner(*args, **kw)
 
-    monkeypatch.setattr(selection_module, "select_structure", searched_once(counted))
+    monkeypatch.setattr(selection_module, "select_structure", once_per_run(counted))
     noise = SensorNoise(tau_std=0.05, q_std=1e-5, dq_std=1e-3)
     logs = recordings(panda, (61, 62, 63), friction=panda.friction, duration=2.5, noise=noise)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynidWarning)
-        with shared_searches():
+        with shared_run():
             plain = identify_recordings(panda, logs)
             sprung = identify_recordings(panda, logs, spring_joints=(1,))
     assert made == [False, True], made

@@ -40,9 +40,9 @@ from .core import model_columns
 from .log import TorqueLog
 from .log_rows import log_blocks
 from .model import IdentifiedModel
+from .once_per_run import shared_run
 from .recordings import Recordings, prepare_recordings
 from .selection import fitted_logs, identify_recordings
-from .shared_preparation import shared_preparations
 from .streaming import streams
 
 #: A recording's offset differs where it lies this many standard errors from the mean.
@@ -388,7 +388,7 @@ def _recorded(
     return dataclasses.replace(model, info=info)
 
 
-@shared_preparations()  # the recordings prepared again as the fit prepared them: read back
+@shared_run()  # the recordings prepared again as the fit prepared them: read back
 def identify_with_offsets(
     robot: Robot,
     logs: Sequence[TorqueLog],

@@ -58,6 +58,7 @@ from .holdout import DEFAULT_FOLDS, block_labels
 from .info import IdentificationInfo, LogInfo
 from .log import DEFAULT_CUTOFF_HZ, TorqueLog, joint_side_log, log_digest
 from .log_rows import log_blocks, still_columns
+from .once_per_run import once_per_run
 from .pieces import (
     WRAP_SPAN,
     check_below_nyquist,
@@ -86,20 +87,19 @@ from .recorded_signs import recording_sign_findings
 from .reversed_among import reversed_among
 from .sanity import check_torque_log
 from .serial import Serial, serial_of_pieces
-from .shared_preparation import prepared_once
 from .spikes import despiked, spike_finding
 from .streaming import streams
 from .training_range import motion_ranges
 from .trim import common_cutoff, edge_seconds, within_edges
 from .velocity_noise import noise_band, pieces_noise_std
 
-# read back within shared_preparations: a run prepares the same recordings again
+# read back within shared_run: a run prepares the same recordings again
 # (identify_with_offsets with the cut-off the fit read; the spring trial)
-_spike_finding = prepared_once(spike_finding)
-_sign_findings = prepared_once(recording_sign_findings)
-_reversed_among = prepared_once(reversed_among)
-_check_torque_log = prepared_once(check_torque_log)
-_prepare_torque_log = prepared_once(prepare_torque_log)
+_spike_finding = once_per_run(spike_finding)
+_sign_findings = once_per_run(recording_sign_findings)
+_reversed_among = once_per_run(reversed_among)
+_check_torque_log = once_per_run(check_torque_log)
+_prepare_torque_log = once_per_run(prepare_torque_log)
 
 __all__ = [
     "WRAP_SPAN",

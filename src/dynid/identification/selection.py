@@ -109,6 +109,7 @@ from .log_rows import shared_steps
 from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded, sign_confirmed
+from .once_per_run import once_per_run
 from .outlying_recordings import (
     _burst_cuts,
     _Cut,
@@ -128,7 +129,6 @@ from .outlying_spans import Span
 from .recordings import Recordings
 from .rotor_sign import warned_negative_inertias
 from .shape_refinement import refined_shape
-from .shared_search import searched_once
 from .spring_candidate import tried_joints, with_spring
 from .stribeck_joints import per_joint_vst
 from .structural import absorbed_by
@@ -241,7 +241,7 @@ def _lacks(c: Candidate, best: Candidate) -> dict[str, float]:
     return {lab: r for lab, r in best.determined().items() if lab not in held}
 
 
-@searched_once
+@once_per_run
 @shared_steps()
 @shared_bases()
 @shared_eigen()

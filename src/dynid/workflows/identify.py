@@ -69,11 +69,10 @@ from ..identification.least_squares import LOOSE_ADVICE, STD_METHODS, StdMethod,
 from ..identification.log import TorqueLog, checked_log, checked_logs
 from ..identification.model import IdentifiedModel
 from ..identification.motor_constants import shared_gear_ratio
+from ..identification.once_per_run import shared_run
 from ..identification.recording_offsets import identify_with_offsets
 from ..identification.residual_dependence import outside_model_note, round_off_note
 from ..identification.selection import fitted_logs, identify_recordings
-from ..identification.shared_preparation import shared_preparations
-from ..identification.shared_search import shared_searches
 from ..identification.static import identify_static
 from ..identification.static_flange import data_flange_note
 from ..identification.structure import Structure
@@ -646,7 +645,7 @@ def _fit_logs(
 
         # the spring trial's fit repeats the search without it; the offsets' check and the
         # spring trial prepare the recordings the fit prepared
-        with shared_searches(), shared_preparations():
+        with shared_run():
             return _searched(fitted, parsed_terms(opt.terms), opt.drive, logs, separate)
 
     separate = heldout.get("validate_on")

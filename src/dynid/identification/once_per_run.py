@@ -1,19 +1,22 @@
-"""The recordings' checks and preparation made once per run: the same logs checked and
-prepared with the same settings read back, not computed again.
+"""Work made once per run: a structure search, the recordings' checks and their
+preparation, called again with equal arguments, read back rather than computed again.
 
 :func:`~dynid.identification.recording_offsets.identify_with_offsets` prepares the
 recordings the fit has just prepared a second time, with the cut-off the fit read (the
 same cut-off, trim and pieces), and the spring trial
-(:mod:`~dynid.identification.spring_candidate`) prepares them once more: each time the
-sign checks of the whole recordings, their torque findings and every piece's filtering
-(a Panda's three 5 s recordings: 0.44 s a time, of which the sign checks 0.33 s). Within
-:func:`shared_preparations`, :func:`prepared_once` keys a call by a digest of its
-arguments (:func:`~dynid._memo.value_digest`: arrays by their bytes, the robot and drive
-by their fields) and returns the first call's result, the warnings it gave said again;
-outside the block every call runs. The results held take at most a quarter of
-:func:`~dynid.identification.streaming.max_stack_bytes` (the memory a stacked regressor
+(:mod:`~dynid.identification.spring_candidate`) prepares them once more and begins with
+the search without the spring that the first fit made: each time the sign checks of the
+whole recordings, their torque findings, every piece's filtering (a Panda's three 5 s
+recordings: 0.44 s a time, of which the sign checks 0.33 s) and a structure search (7.3 s
+to identify with the spring trial, 3.6 s without). Within :func:`shared_run`,
+:func:`once_per_run` keys a call by a digest of its arguments
+(:func:`~dynid._memo.value_digest`: arrays by their bytes, the robot, drive, candidates
+and options by their fields) and returns the first call's result, the warnings it gave
+said again; outside the block every call runs. The results held take at most a quarter
+of :func:`~dynid.identification.streaming.max_stack_bytes` (the memory a stacked regressor
 may take; 32 MB by default, the Panda's three recordings 2.1 MB): a long log's
-preparation beyond it is made again, not held for the run beside its fit.
+preparation beyond it is made again, not held for the run beside its fit; a search's
+choice is a small record, and no regressor is ever held.
 """
 
 from __future__ import annotations
@@ -31,13 +34,13 @@ import numpy as np
 from .._memo import scoped, value_digest
 from .streaming import max_stack_bytes
 
-__all__ = ["prepared_once", "shared_preparations"]
+__all__ = ["once_per_run", "shared_run"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 
 class _Held:
-    """The results held while :func:`shared_preparations` is active: digest -> (result,
+    """The results held while :func:`shared_run` is active: digest -> (result,
     the warnings its call gave), and the bytes of their arrays, at most ``budget``
     (module docstring)."""
 
@@ -47,27 +50,27 @@ class _Held:
         self.budget = max_stack_bytes() // 4
 
 
-_PREPARED: ContextVar[_Held | None] = ContextVar("dynid_prepared", default=None)
+_HELD: ContextVar[_Held | None] = ContextVar("dynid_once_per_run", default=None)
 
 
 @contextmanager
-def shared_preparations() -> Iterator[None]:
-    """Within the block, a call of :func:`prepared_once` made again with equal arguments
+def shared_run() -> Iterator[None]:
+    """Within the block, a call of :func:`once_per_run` made again with equal arguments
     returns the first call's result (module docstring). Nested blocks share the outer
     one's; what it holds is dropped at its end."""
-    with scoped(_PREPARED, _Held):
+    with scoped(_HELD, _Held):
         yield
 
 
-def prepared_once(compute: F) -> F:
-    """``compute`` read back within :func:`shared_preparations` where it was called with
+def once_per_run(compute: F) -> F:
+    """``compute`` read back within :func:`shared_run` where it was called with
     equal arguments (positional and keyword, by value), the warnings its first call gave
     said again in their order; run as it is outside the block or where an argument has no
     digest. An exception is never held: a call that raised runs again."""
 
     @functools.wraps(compute)
     def once(*args: Any, **kw: Any) -> Any:
-        memo = _PREPARED.get()
+        memo = _HELD.get()
         if memo is None:
             return compute(*args, **kw)
         try:
