@@ -98,32 +98,42 @@ def test_a_time_column_in_ms_is_refused_naming_the_file_and_the_factor(panda, lo
         prepare_recordings(arm, [log], ["good.csv"], cutoff_hz=10.0)  # seconds: no word
 
 
-def test_validation_with_an_identity_drive_unwraps_like_identification(panda, log):
+def test_validation_with_an_identity_drive_unwraps_like_identification(panda, log, caplog):
     """An armature model is stored with an identity drive: validation skipped unwrapping
     then. Joint-side pieces with the drive now come back to the motion exactly, as
-    without a drive, with the joints named."""
+    without a drive, with the joints named (in a note: the joints are continuous)."""
     arm = _continuous(panda, [0, 6])
     wrapped = _wrap(log, [0, 6])
     for drive in (None, Drive.identity(7)):
-        with pytest.warns(DynidWarning, match=r"joint\(s\) 1, 7 recorded wrapped"):
+        caplog.clear()
+        with caplog.at_level(NOTE), warnings.catch_warnings():
+            warnings.simplefilter("error", DynidWarning)  # a note, no warning
             p = prepare_pieces(arm, [wrapped], ["w.csv"], cutoff_hz=None, drive=drive)
+        assert "joint(s) 1, 7 recorded wrapped" in caplog.text
         assert p.unwrapped == (0, 6)
         back = p.logs[0].q
         np.testing.assert_allclose(back - back[0], log.q - log.q[0], atol=1e-9)
 
 
-def test_recordings_wrapped_alike_are_said_once(panda, log):
+def test_recordings_wrapped_alike_are_said_once(panda, log, caplog):
     """Four recordings with joints 1 and 7 wrapped: four identical warnings, one per file;
-    now one, naming the files."""
+    now one, naming the files: a note where the joints turn without end (continuous in
+    the description, as the issue asks: unwrapping them is the reading), a warning where
+    their limits allow less than a turn (the Panda's own)."""
     arm = _continuous(panda, [0, 6])
     wrapped = _wrap(log, [0, 6])
     names = ["r1.csv", "r2.csv", "r3.csv", "r4.csv"]
-    with warnings.catch_warnings(record=True) as got:
+    with caplog.at_level(NOTE), warnings.catch_warnings(record=True) as got:
         warnings.simplefilter("always", DynidWarning)
         prepare_recordings(arm, [wrapped] * 4, names, cutoff_hz=10.0)
-    said = [str(w.message) for w in got if "recorded wrapped" in str(w.message)]
+    assert not [w for w in got if "recorded wrapped" in str(w.message)]
+    said = [r.getMessage() for r in caplog.records if "recorded wrapped" in r.getMessage()]
     assert said == [f"{', '.join(names)}: joint(s) 1, 7 recorded wrapped into [-pi, pi] "
                     "(jumps of a whole turn): unwrapped"], said  # fmt: skip
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always", DynidWarning)
+        prepare_recordings(panda, [wrapped] * 2, names[:2], cutoff_hz=10.0)
+    assert [w for w in got if "r1.csv, r2.csv: joint(s) 1, 7 recorded wrapped" in str(w.message)]
 
 
 def test_a_motor_side_log_is_unwrapped_at_its_motors(panda, log):

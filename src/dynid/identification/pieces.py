@@ -372,7 +372,7 @@ def recording_pieces(
     joints = tuple(sorted(turned))
     if joints and say_wrapped:
         said = wrapped_finding(joints, motors, robot=None if motors else robot, log=log)
-        warnings.warn(f"{name}: {said}", DynidWarning, stacklevel=caller_level())
+        tell_wrapped(said, joints, motors, robot, name)
     return pieces, joints
 
 
@@ -480,6 +480,27 @@ def wrapped_finding(
             "(not degrees: those would be 57 times the radians)"
         )
     return said
+
+
+def tell_wrapped(
+    finding: str, joints: Sequence[int], motors: bool, robot: Robot | None, names: str
+) -> None:
+    """Say :func:`wrapped_finding`'s ``finding`` of the recordings ``names`` (a prefix, as
+    ``"rec1.csv, rec2.csv"``): a note where every joint named turns without end in the
+    robot's description (a continuous joint, limits a turn or more apart: its angle read
+    within a turn is expected, and unwrapping it is the reading), a warning otherwise (a
+    joint whose limits do not allow a whole turn, or a motor)."""
+    span = None if robot is None else np.asarray(robot.q_max) - np.asarray(robot.q_min)
+    endless = (
+        span is not None
+        and robot is not None
+        and not motors
+        and all(not robot.prismatic[j] and span[j] >= 2 * np.pi * (1.0 - 1e-9) for j in joints)
+    )
+    if endless:
+        _log.log(NOTE, "%s: %s", names, finding)
+    else:
+        warnings.warn(f"{names}: {finding}", DynidWarning, stacklevel=caller_level())
 
 
 #: Slack [rad] of a recorded range against the turn it is said to be wrapped into.

@@ -69,6 +69,7 @@ from .pieces import (
     recording_pieces,
     skipped_piece,
     split_at_gaps,
+    tell_wrapped,
     timing_record,
     unwrapped,
     wrappable,
@@ -545,7 +546,7 @@ def prepare_recordings(
     cuts: list[int] = []
     gaps: list[tuple[tuple[float, float], ...]] = []
     found: dict[str, list[str]] = {}  # each finding and the recordings it holds for
-    wrapped: dict[str, list[str]] = {}  # each set of wrapped joints and its recordings
+    wrapped: dict[tuple[str, tuple[int, ...]], list[str]] = {}  # each finding, its files
     for r, (name, log) in enumerate(zip(names, logs, strict=True)):
         if log.n != robot.n:
             raise ShapeError(
@@ -560,7 +561,7 @@ def prepare_recordings(
         turned.update(joints)
         if joints:  # the joints named with their limits (a motor-side log: the motors)
             said = wrapped_finding(joints, motors, robot=robot, log=log)
-            wrapped.setdefault(said, []).append(name)
+            wrapped.setdefault((said, tuple(joints)), []).append(name)
         cuts.append(max(0, len(mine) - 1))
         gaps.append(gaps_between(mine))
         pieces += [(r, p) for p in mine]
@@ -575,8 +576,8 @@ def prepare_recordings(
     for r, whole in zip(have, wholes, strict=True):  # units, frozen joints: said once
         for finding in _check_torque_log(robot, joint_side_log(whole, drive), drive):
             found.setdefault(finding, []).append(names[r])
-    for finding, which in wrapped.items():
-        warnings.warn(f"{', '.join(which)}: {finding}", DynidWarning, stacklevel=caller_level())
+    for (finding, js), which in wrapped.items():  # a note of joints turning without end
+        tell_wrapped(finding, js, motors, robot, ", ".join(which))
     for finding, which in found.items():  # one warning a finding, its recordings named
         shown = finding if len(names) == 1 else f"{', '.join(which)}: {finding}"
         warnings.warn(shown, DynidWarning, stacklevel=caller_level())

@@ -31,6 +31,7 @@ from ..friction.model import FrictionModel, FrictionSum
 from ..identification.log import TorqueLog, default_max_gap, joint_side_log
 from ..identification.pieces import (
     recording_line,
+    tell_wrapped,
     timing_record,
     unwrapped,
     with_start_turns,
@@ -151,7 +152,7 @@ def prepared_log(
     log, turned = unwrapped(side, wrappable(model.robot))
     if turned:
         said = wrapped_finding(sorted(turned), robot=model.robot, log=side)
-        warnings.warn(f"{path.name}: {said}", DynidWarning, stacklevel=caller_level())
+        tell_wrapped(said, sorted(turned), False, model.robot, path.name)
     starts = _pieces(path, log, max_gap)
     fc = _derived_cutoff(path, log)
     dq = _piece_velocities(log, starts, fc)  # of a log of positions: from the unwrapped ones
