@@ -46,6 +46,7 @@ from .model_sign import (
 __all__ = [
     "opposite_among_pooled",
     "opposite_friction_among",
+    "reversal_hint",
     "reversed_joint",
     "recording_sign_findings",
     "SignFinding",
@@ -259,6 +260,31 @@ def _changes(
             yield ms, ts
 
 
+def reversal_hint(
+    reversed_: Sequence[tuple[int, bool]],
+    torque_alone: Sequence[int],
+    file: str | None,
+    motors: bool,
+    where: str = "",
+) -> str:
+    """The ``--units`` hint of columns recorded reversed: each of ``reversed_`` (column from
+    0, with its effort or not), the efforts ``torque_alone`` negated alone, of ``file``'s
+    own where given (``rec2.csv:q4=-1``), ``where`` said after "reads it so", the rates'
+    entries, and (``motors``) that they are a motor-side log's motors' columns."""
+    at = "" if file is None else f"{file}:"
+    cols = ",".join(
+        [f"{at}q{k + 1}=-1" + (f",{at}tau{k + 1}=-1" if tau else "") for k, tau in reversed_]
+        + [f"{at}tau{k + 1}=-1" for k in torque_alone]
+    )
+    rates = ", ".join(f"{at}dq{k + 1}=-1, {at}ddq{k + 1}=-1" for k, _ in reversed_)
+    return (
+        f"hint: --units {cols} reads {'it' if len(reversed_) == 1 else 'them'} so{where} "
+        f"(and {rates} for the log's velocity and acceleration columns, if it has them"
+        + ("; the motors' columns of this motor-side log" if motors else "")
+        + ")"
+    )
+
+
 def _reversed_line(
     robot: Robot,
     drive: Drive | None,
@@ -281,12 +307,6 @@ def _reversed_line(
         ("its " if one else f"{names[k]}'s ") + ("position and torque" if torque[k] else "position")
         for k in rev
     ] + [f"{names[k]}'s torque" for k in alone]
-    at = "" if file is None else f"{file}:"
-    cols = ",".join(
-        [f"{at}q{k + 1}=-1" + (f",{at}tau{k + 1}=-1" if torque[k] else "") for k in rev]
-        + [f"{at}tau{k + 1}=-1" for k in alone]
-    )
-    rates = ", ".join(f"{at}dq{k + 1}=-1, {at}ddq{k + 1}=-1" for k in rev)
     if not one and alone.size == 0 and len(set(torque[rev].tolist())) == 1:  # all alike
         what = ["their positions and torques" if torque[rev[0]] else "their positions"]
     single = len(what) == 1 and " and " not in what[0] and not what[0].startswith("their")
@@ -305,12 +325,13 @@ def _reversed_line(
         + f" leave a residual of {np.sqrt(left / total):.2g} of the links' RMS torque, "
         f"against {np.sqrt(read / total):.2g} as read): a motor or encoder mounted the "
         "other way; "
-        f"hint: --units {cols} reads {'it' if one else 'them'} so"
-        + (" in this recording alone (the others read right)" if file else "")
-        + f" (and {rates} for the log's "
-        "velocity and acceleration columns, if it has them"
-        + ("; the motors' columns of this motor-side log" if motors else "")
-        + ")"
+        + reversal_hint(
+            [(int(k), bool(torque[k])) for k in rev],
+            [int(k) for k in alone],
+            file,
+            motors,
+            " in this recording alone (the others read right)" if file else "",
+        )  # fmt: skip
         + (
             "; or a negative gear_ratio in the drive file, a motor turning the other way"
             if gears

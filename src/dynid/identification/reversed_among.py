@@ -27,7 +27,7 @@ from ..model.robot import Robot
 from ..regressors.torque import torque_regressor
 from .log import TorqueLog
 from .model_sign import MOTION_HALF_SPAN_S, MOTION_MIN_SAMPLES, motion_accelerations
-from .recorded_signs import SignFinding
+from .recorded_signs import SignFinding, reversal_hint
 
 __all__ = [
     "held_out_ratios",
@@ -409,7 +409,6 @@ def _line(
         if drive is not None
         else "joint's own friction and armature"
     )
-    at = f"{name}:"
     return (
         f"{who} looks recorded reversed: its position and torque have the opposite sign "
         f"to those of {', '.join(others)} (with it reversed, one fit of the robot's "
@@ -417,8 +416,5 @@ def _line(
         f"{np.sqrt(shares[0]):.2g} of that as read on {who}, and "
         f"{np.sqrt(shares[1]):.2g} of that with {who} of {', '.join(others)} reversed "
         "instead): a motor or encoder mounted the other way; "
-        f"hint: --units {at}q{k + 1}=-1,{at}tau{k + 1}=-1 reads it so (and {at}dq{k + 1}=-1, "
-        f"{at}ddq{k + 1}=-1 for the log's velocity and acceleration columns, if it has them"
-        + ("; the motors' columns of this motor-side log" if motors else "")
-        + ")"
+        + reversal_hint([(k, True)], [], name, motors)
     )
