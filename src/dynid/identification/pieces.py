@@ -48,6 +48,7 @@ from .log import (
     with_derived_velocities,
 )
 from .sanity import too_few_samples
+from .training_range import endless_joints
 
 _log = logging.getLogger(__name__)
 
@@ -250,9 +251,10 @@ def wrappable(robot: Robot, drive: Drive | None = None) -> NDArray[np.bool_]:
 
 def turn_limited(robot: Robot) -> NDArray[np.bool_]:
     """The revolute joints whose limits span less than a whole turn (n,): recorded
-    wrapped, they moved where their description does not let them."""
-    span = np.asarray(robot.q_max, dtype=np.float64) - np.asarray(robot.q_min, dtype=np.float64)
-    return ~np.asarray(robot.prismatic, dtype=bool) & (span < 2 * np.pi * (1.0 - 1e-9))
+    wrapped, they moved where their description does not let them (the revolute joints
+    not :func:`~dynid.identification.training_range.endless_joints`)."""
+    revolute = ~np.asarray(robot.prismatic, dtype=bool)
+    return revolute & ~endless_joints(robot.q_min, robot.q_max, robot.prismatic)
 
 
 def unwrapped(log: TorqueLog, revolute: NDArray[np.bool_]) -> tuple[TorqueLog, tuple[int, ...]]:
@@ -490,14 +492,8 @@ def tell_wrapped(
     robot's description (a continuous joint, limits a turn or more apart: its angle read
     within a turn is expected, and unwrapping it is the reading), a warning otherwise (a
     joint whose limits do not allow a whole turn, or a motor)."""
-    span = None if robot is None else np.asarray(robot.q_max) - np.asarray(robot.q_min)
-    endless = (
-        span is not None
-        and robot is not None
-        and not motors
-        and all(not robot.prismatic[j] and span[j] >= 2 * np.pi * (1.0 - 1e-9) for j in joints)
-    )
-    if endless:
+    ends = None if robot is None else endless_joints(robot.q_min, robot.q_max, robot.prismatic)
+    if ends is not None and not motors and all(ends[j] for j in joints):
         _log.log(NOTE, "%s: %s", names, finding)
     else:
         warnings.warn(f"{names}: {finding}", DynidWarning, stacklevel=caller_level())
