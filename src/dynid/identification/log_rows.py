@@ -164,12 +164,22 @@ def log_blocks(
                     cutoff_hz, upsample, slice(lo, hi), stamps, fine,
                 )  # fmt: skip
             Y[..., steps] = held[a - lo : a - lo + Y.shape[0]]
-        if drive is not None and drive.rotor_inertia is not None:  # known: subtracted
-            tau = tau - drive.rotor_torques(ddq, drive.rotor_inertia)
+        tau = less_known_rotors(tau, ddq, drive)
         m = Y.shape[0]
         W = Y.reshape(m * n, -1)
         _checks.finite("regressor", W)
         yield RegressorBlock(W=W, y=tau.reshape(-1), groups=np.tile(np.arange(n), m))
+
+
+def less_known_rotors(
+    tau: NDArray[np.float64], ddq: NDArray[np.float64], drive: Drive | None
+) -> NDArray[np.float64]:
+    """The torques ``tau`` [N m] (N, n) less the rotor torques of ``drive``'s known rotor
+    inertias at the accelerations ``ddq`` [rad/s^2] (N, n): what the fit's rows target
+    (:func:`log_blocks`); ``tau`` itself without a drive or known rotor inertias."""
+    if drive is None or drive.rotor_inertia is None:
+        return tau
+    return tau - drive.rotor_torques(ddq, drive.rotor_inertia)
 
 
 #: Prepared samples whose stepping columns are filtered at once (with their margins):

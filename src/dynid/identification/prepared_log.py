@@ -27,7 +27,7 @@ from ..model.robot import Robot
 from .dataset import ModelColumns, RegressorBlock, TorqueRoute
 from .info import IdentificationInfo, LogInfo
 from .log import LogCleaning, TorqueLog, joint_side_log
-from .log_rows import log_blocks, still_columns, still_friction
+from .log_rows import less_known_rotors, log_blocks, still_columns, still_friction
 from .model_sign import opposite_sign
 from .prepare import (
     Preprocessing,
@@ -173,10 +173,7 @@ class PreparedLog(TorqueRoute):
         (default the prepared log's; the raw torques of the same samples) less the rotor
         torques of the drive's known rotor inertias, which the rows take off."""
         out = self.log.tau if tau is None else tau
-        drive = self.drive
-        if drive is None or drive.rotor_inertia is None or self.log.ddq is None:
-            return out
-        return out - drive.rotor_torques(self.log.ddq, drive.rotor_inertia)
+        return out if self.log.ddq is None else less_known_rotors(out, self.log.ddq, self.drive)
 
     def blocks(self, robot: Robot, columns: ModelColumns) -> Iterator[RegressorBlock]:
         """One block (:func:`log_blocks`); several when the log is too long to stack."""
