@@ -29,6 +29,8 @@ __all__ = [
     "CLEAR_LEAST",
     "CLEAR_SHARE",
     "CLEAR_SPAN",
+    "HEDGE_CLAUSE",
+    "OUTSIDE_CLAUSE",
     "SPEED_TOLERANCE",
     "TOLERANCE",
     "OutsideTraining",
@@ -49,6 +51,13 @@ CLEAR_SHARE = 0.2
 CLEAR_SPAN = 0.2
 #: ... and at least this far [rad or m] (positions; velocities the same in rad/s or m/s).
 CLEAR_LEAST = 0.05
+
+#: How the clause of a recording outside the training's motion begins
+#: (:meth:`OutsideTraining.sentence`; the report cuts the verdict's reason at it).
+OUTSIDE_CLAUSE = "outside the identification's motion: "
+#: How the clause begins that puts the extrapolation before the verdict's cause
+#: (:meth:`OutsideTraining.hedge`).
+HEDGE_CLAUSE = "the model extrapolates there first: "
 
 Ranges = tuple[tuple[float, float], ...]
 
@@ -135,7 +144,7 @@ class OutsideTraining:
                 f"{o.training[0]:.3g}..{o.training[1]:.3g}; {100 * o.share:.3g} % of samples "
                 f"outside, up to {o.beyond:.2g} {unit} beyond)"
             )
-        return "outside the identification's motion: " + "; ".join(parts)
+        return OUTSIDE_CLAUSE + "; ".join(parts)
 
     def concerned(self, joints: set[int]) -> tuple[int, ...]:
         """Of ``joints`` (0-based: those the residual concerns), those clearly outside the
@@ -149,7 +158,7 @@ class OutsideTraining:
         which = ", ".join(joint_names[j] for j in joints)
         cause = " or ".join(causes) if causes else "what it follows along the motion"
         return (
-            f"the model extrapolates there first: the recording lies clearly outside the "
+            f"{HEDGE_CLAUSE}the recording lies clearly outside the "
             f"identification's poses on {which}, so {cause} is not confirmed as the "
             "residual's cause; hint: validate on a recording within those poses, or identify "
             "from recordings that cover these poses too"

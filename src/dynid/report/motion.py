@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from ..identification.training_range import HEDGE_CLAUSE, OUTSIDE_CLAUSE
 from .html import cell, esc, is_number, section, table
 
 __all__ = [
@@ -31,12 +32,9 @@ __all__ = [
     "split_reason",
 ]
 
-#: How the clause of a recording outside the training's motion begins
-#: (:meth:`~dynid.identification.training_range.OutsideTraining.sentence`).
-OUTSIDE = "outside the identification's motion: "
-#: How the clause begins that puts the extrapolation before the verdict's cause
-#: (:meth:`~dynid.identification.training_range.OutsideTraining.hedge`).
-HEDGE = "the model extrapolates there first: "
+#: How the clause of a recording outside the training's motion begins, and the clause that
+#: puts the extrapolation before the verdict's cause (the verdict's own words).
+OUTSIDE, HEDGE = OUTSIDE_CLAUSE, HEDGE_CLAUSE
 
 
 def split_reason(reason: str) -> tuple[str, str | None, str | None]:
