@@ -1,4 +1,5 @@
-"""Where a validation's error sits in a few short spans: a contact or a logging fault.
+"""Where a validation's error sits in a few short spans: a contact, a logging fault, or
+friction's step at a velocity reversal.
 
 A model validated on a log with a burst of torque it does not hold (a contact, a logging
 fault on one joint for a fraction of a second) leaves an error far above the noise there
@@ -7,7 +8,12 @@ off (:func:`~dynid.identification.outlying_spans.outlying_spans`) and judges the
 the error when, together no longer than :data:`SHORT_SHARE` of the recording's samples,
 they hold at least :data:`MOST_SHARE` of its squared error above the noise
 (``sum e^2 - N sum noise^2``). A model missing a term leaves its error spread over the
-motion and is not judged so. Times [s] as the log holds them, torques [N m].
+motion and is not judged so. Given the velocities and the model's friction, a span where
+each of its joints reverses and that stands off by no more than the model's friction
+steps there (:func:`~dynid.identification.friction_steps.friction_step`) is said to be
+friction's step at those reversals, which the model's friction does not follow at the
+instant (its standstill band, its velocities derived through a filter), not a contact.
+Times [s] as the log holds them, torques [N m], velocities [rad/s].
 """
 
 from __future__ import annotations
@@ -19,15 +25,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._times import offset_text, stamp_text
-from .outlying_spans import MIN_SHARE, SPANS_SHOWN, Span, outlying_spans
+from .friction_steps import friction_step
+from .outlying_spans import MIN_SHARE, SPANS_SHOWN, Span, outlying_spans, robust_levels
 from .verdict import FLOOR_GOOD
 
-__all__ = ["MOST_SHARE", "SHORT_SHARE", "ErrorSpans", "error_spans"]
+__all__ = ["CONTACT_CLAUSE", "MOST_SHARE", "SHORT_SHARE", "ErrorSpans", "error_spans"]
 
 #: The spans' least share of the recording's squared error above the noise [1].
 MOST_SHARE = 0.5
 #: The spans' largest share of the recording's samples [1].
 SHORT_SHARE = 0.1
+#: What a span that is not friction's step at a reversal is said to be.
+CONTACT_CLAUSE = "a contact or a logging fault there, not the model"
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,6 +56,10 @@ class ErrorSpans:
         noise's RMS, all joints [1]: 1 at the noise floor.
     t0 : float or None
         The log's first stamp [s] (the spans' offsets are said from it).
+    reversal : tuple of bool
+        Per span, whether it is friction's step at its joints' velocity reversals
+        (:func:`~dynid.identification.friction_steps.friction_step`), not a contact;
+        empty: none is.
     """
 
     name: str
@@ -54,34 +67,74 @@ class ErrorSpans:
     share: float
     rest_ratio: float
     t0: float | None = None
+    reversal: tuple[bool, ...] = ()
+
+    @property
+    def contact(self) -> bool:
+        """Whether some span is not friction's step at a reversal (a contact or a logging
+        fault)."""
+        return not all(self._at_reversal())
+
+    def _at_reversal(self) -> tuple[bool, ...]:
+        """Per span, whether it is friction's step at a reversal."""
+        return (
+            self.reversal if len(self.reversal) == len(self.spans) else (False,) * len(self.spans)
+        )
 
     def sentence(self, joint_names: tuple[str, ...], named: bool = False) -> str:
         """``92 % of the error above the noise sits in t = 3.008 to 3.184 s on elbow_joint
         (up to 50 N m): a contact or a logging fault there, not the model; the rest of the
-        recording at 1.1 x the noise floor``; ``named``: the recording named."""
+        recording at 1.1 x the noise floor``; the spans at reversals said as friction's
+        (``...: friction at elbow_joint's velocity reversals (its step as the velocity
+        changes sign, which the model's friction does not follow at the instant), not a
+        contact or a logging fault``); ``named``: the recording named."""
+        at = self._at_reversal()
+        contacts = [s for s, r in zip(self.spans, at, strict=True) if not r]
+        steps = [s for s, r in zip(self.spans, at, strict=True) if r]
+        parts = []
+        if contacts:
+            parts.append(f"{self._said(contacts, joint_names)}: {CONTACT_CLAUSE}")
+        if steps:
+            joints = sorted({j for s in steps for j in s.joints})
+            whose = (
+                f"{joint_names[joints[0]]}'s velocity reversals"
+                if len(joints) == 1
+                else f"the velocity reversals of {', '.join(joint_names[j] for j in joints)}"
+            )
+            parts.append(
+                f"{self._said(steps, joint_names)}: friction at {whose} (its step as the "
+                "velocity changes sign, which the model's friction does not follow at the "
+                "instant), not a contact or a logging fault"
+            )
+        where = f" of {self.name}" if named else ""
+        return (
+            f"{100 * self.share:.0f} % of the error above the noise{where} sits in "
+            f"{'; and in '.join(parts)}; the rest of the recording at "
+            f"{self.rest_ratio:.3g} x the noise floor"
+        )
+
+    def _said(self, spans: list[Span], joint_names: tuple[str, ...]) -> str:
+        """``t = 3.008 to 3.184 s on elbow_joint (up to 50 N m); ...``: ``spans``' times
+        (with their offsets into the log), joints and peaks."""
         said = []
-        for s in self.spans:
+        for s in spans:
             into = offset_text([s.t0 - float(self.t0 or 0.0)], self.t0, self.name)
             said.append(
                 f"t = {stamp_text(s.t0)} to {stamp_text(s.t1)} s"
                 + (f" ({into})" if into else "")
                 + f" on {', '.join(joint_names[j] for j in s.joints)} (up to {s.peak:.3g} N m)"
             )
-        where = f" of {self.name}" if named else ""
-        return (
-            f"{100 * self.share:.0f} % of the error above the noise{where} sits in "
-            f"{'; '.join(said)}: a contact or a logging fault there, not the model; the rest "
-            f"of the recording at {self.rest_ratio:.3g} x the noise floor"
-        )
+        return "; ".join(said)
 
     def as_dict(self) -> dict[str, Any]:
-        """``file``, ``spans`` (each ``t0``, ``t1`` [s], ``joints`` from 0, ``peak`` [N m]),
-        ``share`` [1] and ``rest_ratio`` [1], as ``validation.json`` records them."""
+        """``file``, ``spans`` (each ``t0``, ``t1`` [s], ``joints`` from 0, ``peak`` [N m],
+        ``reversal``: friction's step at a velocity reversal, not a contact), ``share`` [1]
+        and ``rest_ratio`` [1], as ``validation.json`` records them."""
         return {
             "file": self.name,
             "spans": [
-                {"t0": s.t0, "t1": s.t1, "joints": list(s.joints), "peak": s.peak}
-                for s in self.spans
+                {"t0": s.t0, "t1": s.t1, "joints": list(s.joints), "peak": s.peak, "reversal": r}
+                for s, r in zip(self.spans, self._at_reversal(), strict=True)
             ],
             "share": self.share,
             "rest_ratio": self.rest_ratio,
@@ -94,6 +147,10 @@ def error_spans(
     noise_rms: NDArray[np.float64],
     name: str = "",
     t0: float | None = None,
+    *,
+    dq: NDArray[np.float64] | None = None,
+    friction: NDArray[np.float64] | None = None,
+    band: NDArray[np.float64] | float = 0.0,
 ) -> ErrorSpans | None:
     """The short spans holding most of a recording's error above the noise, or None.
 
@@ -109,6 +166,14 @@ def error_spans(
         The recording's name.
     t0 : float, optional
         The log's first stamp [s].
+    dq : ndarray, shape (N, n), optional
+        The joint velocities the model was evaluated at [rad/s]; with ``friction``, the
+        spans of friction's step at a reversal are told (``ErrorSpans.reversal``).
+    friction : ndarray, shape (N, n), optional
+        The model's friction torques [N m] at those samples.
+    band : ndarray, shape (n,), or float
+        The velocities' standstill band [rad/s]
+        (:func:`~dynid.identification.friction_steps.reverses`).
 
     Returns
     -------
@@ -133,4 +198,9 @@ def error_spans(
     if share < MOST_SHARE or inside.mean() > SHORT_SHARE or inside.all():
         return None
     rest = float(np.sqrt(sq[~inside].mean() / noise2))
-    return ErrorSpans(name, spans, min(share, 1.0), rest, t0)
+    at: tuple[bool, ...] = ()
+    if dq is not None and friction is not None:
+        dev, level = robust_levels(e)
+        v, f = np.asarray(dq, dtype=np.float64), np.asarray(friction, dtype=np.float64)
+        at = tuple(friction_step(s, t, dev, level, v, f, band) for s in spans)
+    return ErrorSpans(name, spans, min(share, 1.0), rest, t0, at)

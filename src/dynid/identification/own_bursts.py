@@ -13,8 +13,9 @@ residual is judged on filtered torques), and judges each by the rule of a valida
 noise), no more than :data:`~dynid.identification.outlying_spans.SPANS_SHOWN` spans
 standing off (more recur with the motion: friction at each start of a point-to-point
 log's moves). A span at a reversal of its joints that stands off by no more than the
-model's friction steps there (:data:`STEP_MARGIN`) is friction's step, placed
-differently by the fit and the model, and left out; a burst there stands off beyond it.
+model's friction steps there is friction's step, placed differently by the fit and the
+model (:func:`~dynid.identification.friction_steps.friction_step`), and left out; a
+burst there stands off beyond it.
 A clean recording stays near the noise; an effect the model lacks (a
 spring, a tilted base) spreads over the motion: neither is judged so. Times [s]
 as the logs hold them, torques [N m].
@@ -33,11 +34,12 @@ from ..regressors.terms import ModelTerm
 from ..signals import lowpass_noise_gain
 from .core import model_columns
 from .error_spans import ErrorSpans, error_spans
+from .friction_steps import friction_step
 from .model import IdentifiedModel, IdentifiedTerm
-from .outlying_spans import MIN_SHARE, OFF_SIGMAS, SPANS_SHOWN, outlying_spans, robust_levels
+from .outlying_spans import MIN_SHARE, SPANS_SHOWN, outlying_spans, robust_levels
 from .recordings import Recordings
 
-__all__ = ["STEP_MARGIN", "fit_residuals", "own_bursts"]
+__all__ = ["fit_residuals", "own_bursts"]
 
 
 #: A recording's times [s] (N,), residual [N m] (N, n), noise [N m] (N, n), joint
@@ -50,13 +52,6 @@ _Residual = tuple[
     NDArray[np.float64],
     NDArray[np.float64],
 ]
-
-#: A span at a reversal is friction's step, placed differently by the fit and the model,
-#: when its residual would not stand off with this many times the step the model's
-#: friction makes across it taken off each of its joints [1] (a misplaced step misfits
-#: by at most its height; the margin: the fit's step against the truth's, a filter's
-#: overshoot). A burst there larger than that is judged as any other span.
-STEP_MARGIN = 1.5
 
 
 def fit_residuals(
@@ -166,39 +161,19 @@ def _friction_steps(
 ) -> NDArray[np.bool_]:
     """The samples (N,) of the spans where the residual ``z`` (N, n) [noise units] at times
     ``t`` [s] stands off (:func:`~.outlying_spans.outlying_spans`) as friction's step at a
-    reversal does: each of its joints reverses (its velocity ``dq`` (N, n) [rad/s] at zero
-    or changing sign within the span and one sample either side) and no more than the
-    model's friction ``f`` (N, n) [noise units] steps there (:func:`_within_step`). The
+    reversal does (:func:`~dynid.identification.friction_steps.friction_step`): each of
+    its joints reverses (its velocity ``dq`` (N, n) [rad/s] at zero or changing sign
+    within the span and one sample either side) and no more than the model's friction
+    ``f`` (N, n) [noise units] steps there. The
     fit on filtered torques and the model's sharp step place that step differently (a
     Panda's 3 N m Coulomb: single samples 27 times the noise); a burst at a reversal stands
     off beyond the step and is not left out."""
     out = np.zeros(t.size, dtype=bool)
     dev, level = robust_levels(z)
     for s in outlying_spans(t, z):
-        i0, i1 = int(np.searchsorted(t, s.t0)), int(np.searchsorted(t, s.t1, side="right"))
-        near = slice(max(i0 - 1, 0), min(i1 + 1, t.size))
-        joints = list(s.joints)
-        sign = np.sign(dq[near][:, joints])
-        reverses = (sign == 0).any(axis=0) | (np.diff(sign, axis=0) != 0).any(axis=0)
-        if sign.shape[0] and np.all(reverses) and _within_step(dev[i0:i1], level, f[near], joints):
-            out[i0:i1] = True
+        if friction_step(s, t, dev, level, dq, f):
+            out[(t >= s.t0) & (t <= s.t1)] = True
     return out
-
-
-def _within_step(
-    dev: NDArray[np.float64],
-    level: NDArray[np.float64],
-    f: NDArray[np.float64],
-    joints: list[int],
-) -> bool:
-    """Whether a span's residual ``dev`` (M, n) [noise units, less each joint's median]
-    would not stand off (:data:`~.outlying_spans.OFF_SIGMAS` robust levels ``level`` (n,))
-    with :data:`STEP_MARGIN` times the step of the model's friction ``f`` (K, n) [noise
-    units] across it (its range over the span and one sample either side) taken off, on
-    each of ``joints``."""
-    step = np.ptp(f[:, joints], axis=0) if f.shape[0] else np.zeros(len(joints))
-    peak = np.abs(dev[:, joints]).max(axis=0) if dev.shape[0] else np.zeros(len(joints))
-    return bool(np.all(peak <= OFF_SIGMAS * level[joints] + STEP_MARGIN * step))
 
 
 def _recurring(t: NDArray[np.float64], z: NDArray[np.float64]) -> bool:

@@ -36,7 +36,10 @@ with every policy the command applies, so that the Python API behaves as the com
 * An error above the noise that sits in a few short spans of a recording (a contact, a
   logging fault) is said first, with the rest of the recording's error over the noise
   (:func:`~dynid.identification.error_spans.error_spans`), and the residual is then not
-  diagnosed for a spring, a tilt or a load.
+  diagnosed for a spring, a tilt or a load; a span at a velocity reversal of its joints
+  that stands off by no more than the model's friction steps there is said to be
+  friction's step at those reversals, not a contact
+  (:func:`~dynid.identification.friction_steps.friction_step`).
 """
 
 from __future__ import annotations
@@ -81,6 +84,7 @@ from ..identification.residual_spring import ResidualSpring
 from ..identification.spikes import SPIKES_BEFORE_JUDGING
 from ..identification.torque_delay import AppliedDelay, TorqueDelay, applied_delay
 from ..identification.training_range import OutsideTraining, endless_joints
+from ..identification.velocity_noise import noise_band
 from ..identification.verdict import LEVELS, Verdict, with_hint, with_replaced_spikes
 from ..io.feasible import load_feasible_drive, load_feasible_linear_friction
 from ..io.friction_json import load_friction_json
@@ -731,18 +735,25 @@ def _error_spans(
 ) -> ErrorSpans | None:
     """Above the noise floor, the recording whose error above the noise sits in a few short
     spans (:func:`~dynid.identification.error_spans.error_spans`, each recording's pieces
-    joined against the noise per joint), the largest error first; None: none."""
+    joined against the noise per joint; the spans of friction's step at the prepared
+    velocities' reversals, their standstill band that of the pieces' velocity noise, told
+    from a contact), the largest error first; None: none."""
     if verdict.level == "good":
         return None
     found = []
+    band = noise_band(val.pieces.dq_noise_std)
     for k, name in enumerate(val.pieces.names):
         mine = [v for v, r in zip(val.parts, val.pieces.recording, strict=True) if r == k]
         if not mine:
             continue
         t = np.concatenate([np.asarray(v.log.t, dtype=np.float64) for v in mine])
         e = np.concatenate([v.log.tau - v.tau_hat for v in mine])
+        dq = np.concatenate([np.asarray(v.log.dq, dtype=np.float64) for v in mine])
+        f = np.concatenate(
+            [np.zeros_like(v.tau_hat) if v.tau_friction is None else v.tau_friction for v in mine]
+        )
         t0 = float(logs[k].t[0]) if k < len(logs) and len(logs[k].t) else None
-        spans = error_spans(t, e, noise.total, name, t0)
+        spans = error_spans(t, e, noise.total, name, t0, dq=dq, friction=f, band=band)
         if spans is not None:
             found.append((float(np.sum(e**2)), spans))
     return max(found, key=lambda f: f[0])[1] if found else None
