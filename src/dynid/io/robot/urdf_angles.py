@@ -99,20 +99,26 @@ HARMFUL_FACTOR = 10.0
 def rounding_message(
     source: str, found: dict[str, float], as_written: Robot, snapped: Robot
 ) -> tuple[str, bool]:
-    """One line naming the joints whose angles are rounded and read as written, with the
-    condition numbers, the leftovers the rounding puts in the base-parameter expressions
-    and the option that snaps them; and whether the rounding matters (the condition number
+    """One line naming the joints whose angles are rounded (those of one offset together)
+    and read as written, with the condition numbers, the leftovers the rounding puts in
+    the base-parameter expressions (said only where the rounding matters) and the option
+    that snaps them; and whether the rounding matters (the condition number
     as written over :data:`HARMFUL_FACTOR` times the snapped one)."""
     c_written, c_snapped = structural_condition(as_written), structural_condition(snapped)
     harmful = not c_written <= HARMFUL_FACTOR * c_snapped
     size = max(found.values())
+    if not harmful:
+        return (
+            f"{_named(source, found)}, read as written (harmless here: the structural "
+            f"regressor's unscaled condition number is {c_written:.3g} as written, "
+            f"{c_snapped:.3g} with the angles snapped); --snap-angles snaps them"
+        ), harmful
     return (
         f"{_named(source, found)}, read as written: the base-parameter expressions may "
         f"hold coefficients near {size:.2g} (the sine of the rounding; the exact angles give "
         f"none) and the structural regressor's unscaled condition number is {c_written:.3g} "
-        f"as written, {c_snapped:.3g} with the angles snapped"
-        f"{'' if harmful else ' (harmless here)'}; hint: --snap-angles (snap_angles=True) "
-        "snaps them to the multiples of pi/2"
+        f"as written, {c_snapped:.3g} with the angles snapped; hint: --snap-angles "
+        "(snap_angles=True) snaps them to the multiples of pi/2"
     ), harmful
 
 
@@ -123,5 +129,8 @@ def snapped_message(source: str, found: dict[str, float]) -> str:
 
 def _named(source: str, found: dict[str, float]) -> str:
     """The opening both messages share: the file and the joints with their offsets."""
-    names = ", ".join(f"{j} ({off:.2g} rad off)" for j, off in found.items())
+    by_off: dict[str, list[str]] = {}
+    for j, off in found.items():
+        by_off.setdefault(f"{off:.2g}", []).append(j)
+    names = ", ".join(f"{', '.join(js)} ({off} rad off)" for off, js in by_off.items())
     return f"{source}: joint origin angles rounded near multiples of pi/2 on {names}"
