@@ -116,7 +116,7 @@ def test_the_offset_is_left_out_in_place_of_the_coulomb_coefficient_it_equals():
     its offset (one constant column), the offset is the one left out; a Coulomb coefficient
     named by another combination stays as named (the solver named fc3 on a UR5 log and took
     the Coulomb friction from the candidates without an offset too)."""
-    from dynid.identification.largest import _offset_instead
+    from dynid.identification.one_way_friction import offset_instead as _offset_instead
 
     assert _offset_instead("fc3", ("fc3 + 1*fo3",)) == "fo3"
     assert _offset_instead("jfc2", ("0.5*jfc2 - jfo2",)) == "jfo2"

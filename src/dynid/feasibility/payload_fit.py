@@ -3,6 +3,9 @@
 * :func:`fit_load`: the least squares of the load's ``p`` parameters (and the friction
   beside them), refused when the data do not excite every direction of the load's
   parameters (a load rotated about one axis only), the unexcited ones named;
+* :func:`friction_told_apart`: the friction columns beside the load without those the
+  data do not tell apart (a joint that turns one way throughout: its Coulomb friction is
+  its offset), and the note that names them;
 * :func:`load_parameters`: the estimate checked for a positive mass and, for the full 10,
   moved into the physically consistent set by the pseudo-inertia LMI when it is not in it
   (the closest point in the metric of the data; Wensing, Kim, Slotine, RA-L 2018);
@@ -23,15 +26,19 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, RankDeficientError, SolverError
 from ..identification.least_squares import LeastSquaresFit, fit_least_squares
+from ..identification.one_way_friction import offset_instead, one_way_joints
+from ..identification.solvers import unexcited_columns, unexcited_combinations
 from ..model.inertia import inertia6_from_matrix, inertial_from_phi
 from ..regressors.base import RANK_FLOOR
 from ..regressors.terms import friction_labels
 from .lmi import pseudo_inertia, pseudo_inertia_margin
 
 __all__ = [
+    "FIT_RTOL",
     "HELD_OUT_BLOCKS",
     "block_jackknife_covariance",
     "fit_load",
+    "friction_told_apart",
     "held_out_widening",
     "load_parameters",
     "misfit_covariance",
@@ -41,6 +48,11 @@ __all__ = [
 
 #: Contiguous time blocks of :func:`block_jackknife_covariance`.
 HELD_OUT_BLOCKS = 10
+
+#: The relative rank tolerance of the load's least squares without ``rtol``
+#: (:func:`fit_load`), and of the friction columns told apart beside it
+#: (:func:`friction_told_apart`).
+FIT_RTOL = 1e-10
 
 
 def summary(phi: NDArray[np.float64], cov: NDArray[np.float64], full: bool):
@@ -118,11 +130,15 @@ def fit_load(
     Without ``rtol``, every direction of the load's ``p`` parameters must be excited
     (:func:`_excited`): a load rotated about one axis only excites some of its 10
     parameters, and the noise of the measured positions would otherwise fill the others.
+    The friction columns ``kept`` are those the data tell apart
+    (:func:`friction_told_apart`).
 
     Raises
     ------
     RankDeficientError
-        Naming the load's parameters the data do not excite, and what would excite them.
+        Naming the load's parameters the data do not excite, and what would excite them;
+        or, when the columns not told apart are friction columns alone (``kept`` holding
+        some the data do not tell apart), naming those and not the load.
     """
     labels = _LOAD_LABELS[:p] + friction_labels((W.shape[1] - p) // 3)
     if rtol is None:
@@ -131,12 +147,114 @@ def fit_load(
             raise _not_excited(r, p, names, static)
     try:
         return fit_least_squares(
-            W, y, kept=kept, rtol=1e-10 if rtol is None else rtol, std="robust"
+            W, y, kept=kept, rtol=FIT_RTOL if rtol is None else rtol, std="robust"
         )
     except RankDeficientError as exc:
         by_column = {f"column {i}": label for i, label in enumerate(labels)}
         shown = tuple(by_column.get(d, d) for d in exc.dependent)
+        if shown and not set(shown) & set(_LOAD_LABELS[:p]):
+            raise _not_told_apart(exc.rank, exc.needed, shown) from None
         raise _not_excited(exc.rank, exc.needed, shown, static) from None
+
+
+def friction_told_apart(
+    W: NDArray[np.float64],
+    kept: NDArray[np.bool_],
+    labels: tuple[str, ...],
+    p: int,
+    rtol: float = FIT_RTOL,
+) -> tuple[NDArray[np.bool_], str | None]:
+    """``kept`` without the friction columns the data do not tell apart, and the note
+    that says which (None when none).
+
+    The friction columns (those after the load's first ``p``, labelled ``labels``) kept
+    are scaled to unit norm and their rank read from the pivoted QR's diagonal at
+    ``rtol`` (the least squares' own tolerance, :data:`FIT_RTOL`). Each combination they
+    do not excite (:func:`~dynid.identification.solvers.unexcited_combinations`) loses
+    the column that names it, the offset in place of a Coulomb coefficient it holds with
+    it (:func:`~dynid.identification.one_way_friction.offset_instead`, as identification
+    does): a joint that turns one way throughout has ``sign(dq_j)`` constant, its offset's
+    column. This is the friction's confound, not the load's, whose columns
+    :func:`fit_load` then judges against the friction left.
+
+    Parameters
+    ----------
+    W : ndarray, shape (N, p + f)
+        The rows: the load's ``p`` columns, then ``f`` friction columns.
+    kept : ndarray of bool, shape (p + f,)
+        The columns fitted.
+    labels : tuple of str, length f
+        The friction columns' labels (``fv1, fc1, fo1, ...``).
+    p : int
+        The load's columns, left as they are.
+    rtol : float
+        The relative rank tolerance.
+
+    Returns
+    -------
+    kept : ndarray of bool, shape (p + f,)
+    note : str or None
+    """
+    out = np.array(kept, dtype=bool)
+    combinations: list[str] = []
+    for _ in range(len(labels)):  # each round leaves one column out at least
+        idx = np.flatnonzero(out[p:])
+        named = _not_told_apart_columns(W[:, p + idx], tuple(labels[i] for i in idx), rtol)
+        if named is None:
+            break
+        combinations += named[1]
+        out[[p + labels.index(lab) for lab in named[0]]] = False
+    if not combinations:
+        return out, None
+    left = [lab for i, lab in enumerate(labels) if kept[p + i] and not out[p + i]]
+    return out, _told_apart_note(tuple(combinations), left)
+
+
+def _not_told_apart_columns(
+    F: NDArray[np.float64], names: tuple[str, ...], rtol: float
+) -> tuple[set[str], tuple[str, ...]] | None:
+    """The columns of ``F`` (N, f), labelled ``names``, whose leaving out gives the others
+    full rank at ``rtol`` (an offset in place of a Coulomb coefficient it makes a
+    combination with) and the combinations; None at full rank (or fewer rows than
+    columns: the least squares says so)."""
+    import scipy.linalg  # as the rest of the module: scipy on first use
+
+    if not names or F.shape[0] < F.shape[1]:
+        return None
+    norms = np.linalg.norm(F, axis=0)
+    scale = np.where(norms > 0, norms, 1.0)
+    R, piv = scipy.linalg.qr(F / scale, mode="r", pivoting=True)
+    d = np.abs(np.diag(R))
+    rank = int(np.sum(d > rtol * d[0])) if d[0] > 0 else 0
+    if rank == len(names):
+        return None
+    R = R[: len(names), np.argsort(piv)]  # the columns back in their order
+    combinations = unexcited_combinations(R, scale, rank, names)
+    columns = unexcited_columns(R, scale, rank)
+    return {offset_instead(names[i], combinations) for i in columns}, combinations
+
+
+def _told_apart_note(combinations: tuple[str, ...], left: list[str]) -> str:
+    """The note of :func:`friction_told_apart`: the joints that turn one way named, the
+    combinations and the columns left out."""
+    joints = one_way_joints(combinations)
+    which = ", ".join(str(j) for j in joints)
+    why, kept = (
+        (
+            f"joint(s) {which} turn one way throughout the data: the Coulomb friction of "
+            "each is a constant torque, which the data do not tell from its offset",
+            "its Coulomb coefficient holding both",
+        )
+        if joints
+        else (
+            "the data do not tell apart the friction coefficients beside the load",
+            "the coefficients kept holding them",
+        )
+    )
+    return (
+        f"{why} ({'; '.join(combinations)}): {', '.join(left)} left out, {kept} (a "
+        "confound of the friction, not of the load, which is fitted beside it)"
+    )
 
 
 def _excited(
@@ -179,6 +297,21 @@ def _not_excited(
     return RankDeficientError(
         f"the data do not excite the load's parameters (rank {rank} of {needed}; "
         f"unexcited combinations of {', '.join(names) or '?'}); hint: {hint}",
+        rank=rank,
+        needed=needed,
+        dependent=names,
+    )
+
+
+def _not_told_apart(
+    rank: int | None, needed: int | None, names: tuple[str, ...]
+) -> RankDeficientError:
+    """The friction columns beside the load, not the load's, not told apart by the data."""
+    return RankDeficientError(
+        f"the data do not tell apart the friction coefficients estimated beside the load "
+        f"(rank {rank} of {needed}; nearly dependent: {', '.join(names)}); the load's "
+        "parameters are not among them; hint: terms=... with fewer friction parts, or a "
+        "log in which each moving joint reverses",
         rank=rank,
         needed=needed,
         dependent=names,

@@ -42,6 +42,7 @@ from ..regressors.static import static_regressor_columns, static_rows, static_ve
 from ..regressors.torque import torque_regressor
 from ..signals import lowpass_noise_gain
 from .payload_arm import ArmModel, FrictionTorques
+from .payload_fit import friction_told_apart
 from .payload_friction import friction_term
 
 __all__ = [
@@ -179,9 +180,12 @@ def log_rows(
     that of ``friction``, :func:`~dynid.feasibility.payload_friction.friction_term`),
     targets (measured torques minus the arm's) of prepared recordings, the columns fitted
     (a ``still`` joint's friction is not, but for its offset: its velocity is noise, taken
-    as zero), and the arm's torques subtracted [N m] (its friction included when
-    subtracted). The rows are held whole (``N n`` rows of ``10 + 3 n`` columns for the
-    classical friction), not the ``10 n`` columns of every link.
+    as zero; nor a friction column the data do not tell from the others, the offset of a
+    joint that turns one way throughout, noted:
+    :func:`~dynid.feasibility.payload_fit.friction_told_apart`), and the arm's torques
+    subtracted [N m] (its friction included when subtracted). The rows are held whole
+    (``N n`` rows of ``10 + 3 n`` columns for the classical friction), not the ``10 n``
+    columns of every link.
 
     The arm's own friction is kept in its torques when the rows explain the targets with
     it better than without it (a smaller least-squares residual, the same columns
@@ -212,6 +216,7 @@ def log_rows(
     kept = np.ones(Ws[0].shape[-1], dtype=bool)
     kept[10:] = [not (still[_joint(lab)] and not lab.startswith("fo")) for lab in classical.labels]
     W, y = np.concatenate(Ws), np.concatenate(ys)
+    kept, confounded = friction_told_apart(W, kept, classical.labels, 10)
     if fs:
         y = _with_own_friction(W[:, kept], y, np.concatenate(fs), arm, notes, alongside)
     else:
@@ -226,6 +231,8 @@ def log_rows(
             f"joint(s) {which} never leave their velocity noise band: taken as still, "
             "their friction fv, fc is not identifiable and is zero (not fitted from noise)"
         )
+    if confounded is not None:
+        notes.append(confounded)
     k = len(data.names)
     route = "torque log" if k == 1 else f"{k} torque logs"
     return W, y, route, kept, np.concatenate(taus) - y

@@ -13,7 +13,6 @@ velocity noise, against the banded sign).
 
 from __future__ import annotations
 
-import re
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -29,6 +28,7 @@ from ..regressors.terms import ModelTerm
 from .core import Judge, identify
 from .estimators import Estimator
 from .model import IdentifiedModel
+from .one_way_friction import FRICTION_LABEL, offset_instead
 from .recordings import Recordings
 from .structural import held_by
 from .structure import (
@@ -275,9 +275,9 @@ def _unexcited_coefficients(
         try:
             fit(classical, drop | more)
         except RankDeficientError as exc:
-            named = {_offset_instead(lab, exc.combinations) for lab in exc.redundant}
+            named = {offset_instead(lab, exc.combinations) for lab in exc.redundant}
             new = named - drop - more
-            if not new or not all(_FRICTION_LABEL.fullmatch(lab) for lab in new):
+            if not new or not all(FRICTION_LABEL.fullmatch(lab) for lab in new):
                 return frozenset(), [], [], frozenset()
             more |= new
             own |= new if exc.structural else set()  # then it names the structural ones
@@ -312,25 +312,6 @@ def _unexcited_text(why: list[str], structural: list[str]) -> str:
     if why:
         parts.append(f"the data do not excite {'; '.join(why)}")
     return "; ".join(parts)
-
-
-def _offset_instead(label: str, combinations: tuple[str, ...]) -> str:
-    """The joint's torque offset (``fo3``) in place of its Coulomb coefficient (``fc3``)
-    where a combination the data do not excite holds both (a joint that never reverses:
-    its Coulomb friction is a constant torque). Without the offset, the candidates that
-    hold no offset keep their Coulomb friction (left out, it took the rotor inertia with
-    it: 1.098 for 0.15 kg m^2 on a UR5 joint that turned one way); those with one lose
-    nothing, the Coulomb column being that constant."""
-    m = re.fullmatch(r"(j?)fc([0-9]+)", label)
-    if m is None:
-        return label
-    offset = f"{m.group(1)}fo{m.group(2)}"
-    words = [set(re.findall(r"j?f[a-z]+[0-9]+", c)) for c in combinations]
-    return offset if any({label, offset} <= w for w in words) else label
-
-
-#: A friction coefficient of one joint (motor): ``fc3``, ``jfv7``.
-_FRICTION_LABEL = re.compile(r"j?f[a-z]+[0-9]+")
 
 
 def _order(label: str) -> tuple[int, str]:

@@ -55,7 +55,6 @@ structure chosen (or given).
 
 from __future__ import annotations
 
-import re
 import warnings
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, replace
@@ -110,6 +109,7 @@ from .metrics import noise_floor_percent
 from .model import IdentifiedModel
 from .model_sign import gravity_loaded, sign_confirmed
 from .once_per_run import once_per_run
+from .one_way_friction import FRICTION_LABEL
 from .outlying_recordings import (
     _burst_cuts,
     _Cut,
@@ -1597,7 +1597,7 @@ def _combined(
     ``{"fv6": "fv6 + 0.0005556*jfv7"}``); empty when it leaves none such out."""
     out: dict[str, str] = {}
     for lab in structure.drop:
-        if not _FRICTION_LABEL.fullmatch(lab):
+        if not FRICTION_LABEL.fullmatch(lab):
             continue
         held = replace(structure, drop=tuple(d for d in structure.drop if d != lab))
         model_drive, terms = _terms_of(held, drive, robot.n, data)
@@ -1605,10 +1605,6 @@ def _combined(
         for k, expr in absorbed_by(robot, columns, lab).items():
             out[k] = expr if k not in out else f"{out[k]}{expr[len(k) :]}"
     return out
-
-
-#: A friction coefficient of one joint (motor): ``fc3``, ``jfv7``.
-_FRICTION_LABEL = re.compile(r"j?f[a-z]+[0-9]+")
 
 
 def _fitted_structure(
