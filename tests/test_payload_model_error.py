@@ -94,6 +94,35 @@ def test_block_jackknife_against_refits_without_each_block():
     assert block_jackknife_covariance(W[: 2 * n * K - n], y[: 2 * n * K - n], n, K) is None
 
 
+def test_block_jackknife_of_the_load_where_one_block_alone_tells_two_friction_columns_apart():
+    """Regression (a joint turning one way except in the log's first block: its Coulomb
+    and offset columns alike in every fit without that block, and the jackknife gave up,
+    saying a block alone excites some direction of the load). With the load's columns
+    wanted, each fold's load estimate is the minimum-norm least squares' (np.linalg.lstsq,
+    unique in those columns) and the covariance (K-1)/K times their scatter."""
+    rng = np.random.default_rng(4)
+    n, samples, K = 2, 120, 6
+    load = rng.standard_normal((n * samples, 3)) * [1.0, 5.0, 0.2]
+    coulomb = np.ones(n * samples)
+    coulomb[: n * 10] = -1.0  # reverses in the first block only
+    W = np.column_stack([load, coulomb, np.ones(n * samples)])
+    y = W @ [1.0, -2.0, 3.0, 0.4, 0.1] + 0.1 * rng.standard_normal(n * samples)
+    assert block_jackknife_covariance(W, y, n, K) is None  # every column wanted: gives up
+    edges = np.linspace(0, samples, K + 1).astype(int) * n
+    fits = []
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        keep = np.r_[0:a, b : W.shape[0]]
+        fits.append(np.linalg.lstsq(W[keep], y[keep], rcond=1e-12)[0][:3])
+    d = np.array(fits) - np.mean(fits, axis=0)
+    got = block_jackknife_covariance(W, y, n, K, wanted=3)
+    assert got is not None and got.shape == (3, 3)
+    np.testing.assert_allclose(got, (K - 1) / K * d.T @ d, rtol=1e-8, atol=1e-14)
+    # the load's own columns alike without a block: still refused
+    W2 = W.copy()
+    W2[n * 10 :, 1] = W2[n * 10 :, 0]
+    assert block_jackknife_covariance(W2, y, n, K, wanted=3) is None
+
+
 def _with_spring(log, scale):
     """``log`` with a joint spring the arm's model lacks on joints 2 and 4 [N m / rad]."""
     import dataclasses

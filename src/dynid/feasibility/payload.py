@@ -798,8 +798,10 @@ def _held_out_spread(
     (:func:`~dynid.feasibility.payload_fit.block_jackknife_covariance`; the correlations
     kept), and a note when it widened a standard deviation by more than
     10 %: an error of the arm's model that varies along the motion, which the residual's
-    covariance does not see."""
-    jack = block_jackknife_covariance(W, yv, n)
+    covariance does not see. Each block's fit need determine the load's parameters only
+    (``W``'s first ``p`` columns): a friction direction that block alone excites (a joint
+    reversing there only) is taken out of them, not blamed on the load."""
+    jack = block_jackknife_covariance(W, yv, n, wanted=cov.shape[0])
     if jack is None:
         notes.append(
             "the standard deviations were not checked on held-out time blocks (a block alone "

@@ -431,7 +431,11 @@ def misfit_covariance(
 
 
 def block_jackknife_covariance(
-    W: NDArray[np.float64], y: NDArray[np.float64], n: int, blocks: int = HELD_OUT_BLOCKS
+    W: NDArray[np.float64],
+    y: NDArray[np.float64],
+    n: int,
+    blocks: int = HELD_OUT_BLOCKS,
+    wanted: int | None = None,
 ) -> NDArray[np.float64] | None:
     """The delete-one-block jackknife covariance of the least squares ``W b = y``.
 
@@ -450,12 +454,18 @@ def block_jackknife_covariance(
         Rows per sample.
     blocks : int
         ``K`` (at least 2).
+    wanted : int, optional
+        Only the first ``wanted`` columns' estimates are wanted (a load's, before the
+        arm's friction columns): a fit without a block need determine just those, the
+        other columns' directions that block alone excites (a joint's Coulomb and offset
+        columns alike where it reverses in that block only) taken out of them
+        (:func:`_fold_wanted`). Default: every column's.
 
     Returns
     -------
-    ndarray, shape (p, p), or None
-        None when there are fewer than ``2 K`` samples or a fit without a block is
-        singular (that block alone excites some direction).
+    ndarray, shape (p, p) or (wanted, wanted), or None
+        None when there are fewer than ``2 K`` samples or a fit without a block does not
+        determine the wanted columns (that block alone excites some direction of them).
     """
     import scipy.linalg  # as the rest of the module: scipy on first use
 
@@ -468,15 +478,42 @@ def block_jackknife_covariance(
     G = [(W[a:b] / s).T @ (W[a:b] / s) for a, b in zip(edges[:-1], edges[1:], strict=True)]
     h = [(W[a:b] / s).T @ y[a:b] for a, b in zip(edges[:-1], edges[1:], strict=True)]
     G_all, h_all = sum(G), sum(h)
+    k = W.shape[1] if wanted is None else min(wanted, W.shape[1])
     est = []
     for Gi, hi in zip(G, h, strict=True):
-        A = G_all - Gi
+        A, rhs = G_all - Gi, h_all - hi
+        if k < A.shape[0]:
+            got = _fold_wanted(A, rhs, k)
+            if got is None:
+                return None
+            est.append(got / s[:k])
+            continue
         if np.linalg.cond(A) > 1.0 / RANK_FLOOR**2:  # the normal equations square it
             return None
-        est.append(scipy.linalg.solve(A, h_all - hi, assume_a="pos") / s)
+        est.append(scipy.linalg.solve(A, rhs, assume_a="pos") / s)
     b = np.asarray(est)
     d = b - b.mean(axis=0)
     return (blocks - 1) / blocks * (d.T @ d)
+
+
+def _fold_wanted(
+    A: NDArray[np.float64], rhs: NDArray[np.float64], k: int
+) -> NDArray[np.float64] | None:
+    """The first ``k`` entries of a least-squares solution of the normal equations
+    ``A x = rhs`` (``A`` (p, p) of column-scaled rows), which are unique where the
+    Schur complement ``S = A_kk - A_kr A_rr^+ A_rk`` of the other columns is regular
+    (the other columns' null directions are those of their rows, which ``A_kr`` and
+    ``rhs_r`` do not see); None where ``S``'s condition number exceeds ``1 /
+    RANK_FLOOR^2`` (the normal equations square it). ``A_rr^+``: the pseudo-inverse,
+    eigenvalues below ``RANK_FLOOR^2`` of the largest left out."""
+    Akk, Akr, Arr = A[:k, :k], A[:k, k:], A[k:, k:]
+    w, V = np.linalg.eigh(Arr)
+    keep = w > RANK_FLOOR**2 * max(float(w.max(initial=0.0)), 0.0)
+    P = (V[:, keep] / w[keep]) @ V[:, keep].T
+    S = Akk - Akr @ P @ Akr.T
+    if not np.all(np.isfinite(S)) or np.linalg.cond(S) > 1.0 / RANK_FLOOR**2:
+        return None
+    return np.asarray(np.linalg.solve(S, rhs[:k] - Akr @ P @ rhs[k:]), dtype=np.float64)
 
 
 def held_out_widening(
