@@ -2,28 +2,30 @@
 
 Sensor filtering and bus latency put the measured torques a few milliseconds behind the
 positions they belong to: ``tau_measured(t) = tau(t - delta)``. To first order
-``tau(t - delta) = tau(t) - delta d(tau)/dt``, so the residual ``e = tau_measured -
-tau_model`` holds ``-delta d(tau_model)/dt``; the fit takes what of it its own columns can
-(a Panda's joint 2: ``delta dg2/dq2`` on the viscous column, +0.087 N m s/rad for 2 ms),
-the rest stays in the residual. :func:`torque_delay` fits the residual, each joint weighed by
-its RMS, with the column ``-d(tau_model)/dt`` beside the model's own columns (their share
-of the delay taken back: the coefficient is ``delta`` itself), the derivative taken
-within each prepared piece (never across a gap) of the rigid-body prediction (friction's
-steps at a reversal are no first-order term). One delay common to every joint (a bus)
-with its standard deviation over the pieces' serially correlated residual
+``tau(t - delta) = tau(t) - delta d(tau)/dt``, so the residual
+``e = tau_measured - tau_model`` holds
+``-delta d(tau_model)/dt``; the fit takes what of it its own columns can (a Panda's joint 2:
+``delta dg2/dq2`` on the viscous column, +0.087 N m s/rad for 2 ms), the rest stays in the
+residual. :func:`torque_delay` fits the residual, each joint weighed by its RMS less what
+the columns beside take, with the column ``-d(tau_model)/dt`` beside the model's own columns
+(their share of the delay taken back: the coefficient is ``delta`` itself), the derivative
+taken within each prepared piece (never across a gap) of the rigid-body prediction
+(friction's steps at a reversal are no first-order term). One delay common to every joint (a
+bus) with its standard deviation over the pieces' serially correlated residual
 (:mod:`~dynid.identification.serial`: Newey-West) or, when larger, over the spread of
 :data:`BLOCKS` contiguous time blocks' delays (a model error the residual holds, correlated
 over seconds, moves the delay from block to block more than the noise does), and each
 joint's alone for the report.
 
-The delay is named (:attr:`TorqueDelay.named`) when it stands :data:`SIGNIFICANT`
-standard deviations clear and explains at least :data:`SHARE` of the residual's weighted
-sum of squares; :meth:`TorqueDelay.sentence` then says it with the hint to
-``--torque-delay``, which reads the states that much earlier before filtering
-(:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); of a model's
-validation, :meth:`TorqueDelay.sentence` with ``refit`` says to identify again with the
-whole delay (the model's coefficients bent to it). :class:`AppliedDelay` is the delay a
-command prepared its logs with and where it came from (given, or the model's record).
+The delay is named (:attr:`TorqueDelay.named`) when it stands :data:`SIGNIFICANT` standard
+deviations clear, explains at least :data:`SHARE` of the residual's weighted sum of squares
+and is at most :data:`MAX_DELAY_S` (a sensor's or a bus's); :meth:`TorqueDelay.sentence`
+then says it with the hint to ``--torque-delay``, which reads the states that much earlier
+before filtering (:attr:`~dynid.identification.prepare.Preprocessing.torque_delay_s`); of a
+model's validation, :meth:`TorqueDelay.sentence` with ``refit`` says to identify again with
+the whole delay (the model's coefficients bent to it), and of a description's, without a
+fit, only the pairing. :class:`AppliedDelay` is the delay a command prepared its logs with
+and where it came from (given, or the model's record).
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from .solvers import tall_r
 
 __all__ = [
     "BLOCKS",
+    "MAX_DELAY_S",
     "SHARE",
     "SIGNIFICANT",
     "AppliedDelay",
@@ -55,6 +58,11 @@ __all__ = [
 SIGNIFICANT = 3.0
 #: Smallest share of the residual's weighted sum of squares the delay must explain.
 SHARE = 0.01
+#: The largest delay [s] named: a sensor's filter or a bus lags the torques a few
+#: milliseconds to a few tens (a first-order 10 Hz filter's group delay is 16 ms); beyond
+#: it the first-order column stands in for a model error (a description's friction ten
+#: times off read as the torques leading by 155 ms), not a lag.
+MAX_DELAY_S = 0.05
 #: Contiguous time blocks of the pieces whose delays' spread the standard deviation covers.
 BLOCKS = 8
 #: Fewest samples of a piece whose derivative is taken.
@@ -87,18 +95,27 @@ class TorqueDelay:
     joints_std_s: tuple[float, ...]
 
     @property
-    def named(self) -> bool:
-        """Whether the delay stands :data:`SIGNIFICANT` standard deviations clear and
-        explains at least :data:`SHARE` of the residual."""
-        clear = abs(self.delay_s) > SIGNIFICANT * self.std_s
-        return bool(clear and self.share >= SHARE)
+    def plausible(self) -> bool:
+        """Whether the delay is within :data:`MAX_DELAY_S` of 0 (a sensor's filter or a
+        bus; beyond it, a model error the first-order column took, not a lag)."""
+        return bool(abs(self.delay_s) <= MAX_DELAY_S)
 
-    def sentence(self, applied_s: float = 0.0, *, refit: bool = False) -> str:
+    @property
+    def named(self) -> bool:
+        """Whether the delay stands :data:`SIGNIFICANT` standard deviations clear,
+        explains at least :data:`SHARE` of the residual and is :attr:`plausible`."""
+        clear = abs(self.delay_s) > SIGNIFICANT * self.std_s
+        return bool(clear and self.share >= SHARE and self.plausible)
+
+    def sentence(self, applied_s: float = 0.0, *, refit: bool = False, fit: bool = True) -> str:
         """The delay in words with the option that removes it: ``--torque-delay`` with the
         whole delay, ``applied_s`` [s] (the one the logs were prepared with, to which the
         residual's is added) and this one. ``refit``: of an identified model's
         validation, whose coefficients were fitted to torques this late (viscous friction
-        bends to the lag), so that the remedy is to identify again with it."""
+        bends to the lag), so that the remedy is to identify again with it. ``fit``
+        (without ``refit``): the residual is a fit's, on these logs (``identify``'s), which
+        bends to the lag; False: a prediction without a fit (a robot description
+        validated), of which only the pairing is said."""
         ms, sd = 1e3 * self.delay_s, 1e3 * self.std_s
         late = "lag" if ms > 0 else "lead"
         d = delay_decimals(sd)  # the delay to its std's first digit (2.06 +- 0.03, not 2.1)
@@ -116,9 +133,10 @@ class TorqueDelay:
                 f"then validate the new model (validate --torque-delay {whole} only pairs "
                 "this log's torques with its positions)"
             )
+        bends = ": the fit bends to it (viscous friction first)" if fit else ""
         return (
-            f"{said}: the fit bends to it (viscous friction first); hint: --torque-delay "
-            f"{whole} pairs the torques with the positions they belong to before filtering"
+            f"{said}{bends}; hint: --torque-delay {whole} pairs the torques with the "
+            "positions they belong to before filtering"
         )
 
     @property
@@ -249,7 +267,7 @@ def torque_delay(
     lag = -(-lag // every)  # in the rows kept
     C = None if columns is None else [np.asarray(columns[k], dtype=np.float64) for k in keep]
     n = E[0].shape[1]
-    rms = np.sqrt(np.mean(np.concatenate(E) ** 2, axis=0))
+    rms = _left_rms(E, C)
     w = np.where(rms > 0, 1.0 / np.where(rms > 0, rms, 1.0), 0.0)
     sizes = [e.shape[0] for e in E]
     common = _fit(D, E, C, w, sizes, lag, range(n))
@@ -301,6 +319,26 @@ def _fit(
     var = float(meat.result()[0, 0]) / xx**2 * m / max(m - 1, 1)
     var = max(var, _blocks_var(x * r, sizes, len(j)) / xx**2)
     return delta, float(np.sqrt(max(var, 0.0))), delta**2 * xx / yy
+
+
+def _left_rms(
+    E: list[NDArray[np.float64]], C: list[NDArray[np.float64]] | None
+) -> NDArray[np.float64]:
+    """Each joint's RMS [N m] (n,) of the residual ``E`` less what the columns ``C`` take of
+    it (least squares over every joint, unweighted): the weights' scale. A residual the
+    columns explain (a description's viscous friction ten times off: 5 N m on a joint whose
+    noise is 0.2 N m) does not weigh that joint down against the others (an xArm7's torques
+    10 ms late read as 5.4 +- 1.7 ms by the raw RMS, as 10.4 +- 0.4 ms by this one)."""
+    e = np.concatenate(E)
+    if C is not None:
+        A = np.concatenate(C)
+        A = A.reshape(-1, A.shape[-1])
+        A = A[:, np.any(A != 0, axis=0)]
+        if A.shape[1]:
+            A = A / np.linalg.norm(A, axis=0)
+            y = e.ravel()
+            e = (y - A @ _projected(A, y[:, None])[:, 0]).reshape(e.shape)
+    return np.asarray(np.sqrt(np.mean(e**2, axis=0)), dtype=np.float64)
 
 
 def _projected(A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -626,7 +626,7 @@ def _with_delay(
     if delay is not None and delay.named:
         before = 0.0 if applied is None else applied.delay_s
         refit = isinstance(model, IdentifiedModel) and model.info.log is not None
-        verdict = with_hint(verdict, delay.sentence(before, refit=refit))
+        verdict = with_hint(verdict, delay.sentence(before, refit=refit, fit=False))
     return verdict, delay, applied
 
 
