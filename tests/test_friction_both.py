@@ -22,7 +22,7 @@ from dynid.feasibility.convex.fit import consistent_from_identified
 from dynid.friction.model import ClassicalFriction, FrictionSum, friction_of
 from dynid.friction.validation import own_friction
 from dynid.identification.selection import identify_recordings
-from dynid.identification.structure import Structure, joint_side_joints
+from dynid.identification.structure import Structure, friction_placements, joint_side_joints
 from dynid.io.feasible import load_feasible_linear_friction
 from dynid.io.feasible_bundle import save_feasible_bundle
 from dynid.io.model_json import model_from_dict, model_to_dict
@@ -52,6 +52,22 @@ def _logs(panda, joint_side: bool):
     added = (lambda log: joint.torques(log.dq)) if joint_side else None
     logs = recordings(panda, (91, 92), friction=motor, drive=drive, duration=4.0, added=added)
     return logs, motor, joint
+
+
+def test_a_drive_that_says_where_its_friction_acts_is_not_searched_elsewhere():
+    """The placements judged: every one through a coupled drive that does not say where
+    its friction acts; only the drive's own (``""``) where it says (``friction_at``), and
+    through a drive without coupling (the same model either side)."""
+    coupled = _drive()
+    assert friction_placements(coupled) == ("motor", "joint", "both")
+    for at in ("motor", "joint"):
+        said = Drive.from_gears(
+            np.ones(7), [(7, 6, 0.8)], rotor_inertia=np.zeros(7), friction_at=at
+        )
+        assert friction_placements(said) == ("",)
+        assert said.friction_place == at
+    assert friction_placements(Drive.from_gears(np.full(7, 50.0))) == ("",)
+    assert friction_placements(None) == ("",)
 
 
 @pytest.fixture(scope="module")

@@ -501,12 +501,13 @@ def width_key(width: float | Sequence[float]) -> tuple[float, ...]:
 
 
 def friction_placements(drive: Drive | None) -> tuple[str, ...]:
-    """Where the candidates' friction may act: at the motors or at the joints for a drive
-    whose transmission couples joints (a coupled wrist: one motor turns with two joints,
-    so ``K^T f(K dq)`` and ``f(dq)`` are different models); ``("",)``, where the drive
-    says, otherwise (through a diagonal ``K`` both are the same model up to the units of
-    the coefficients)."""
-    if drive is None:
+    """Where the candidates' friction may act: at the motors, at the joints or both for a
+    drive whose transmission couples joints (a coupled wrist: one motor turns with two
+    joints, so ``K^T f(K dq)`` and ``f(dq)`` are different models) and that does not say
+    where itself (``friction_at`` not given); ``("",)``, where the drive says, otherwise
+    (through a diagonal ``K`` both are the same model up to the units of the
+    coefficients; a drive file's ``friction_at`` is the user's word)."""
+    if drive is None or drive.friction_at is not None:
         return ("",)
     return ("motor", "joint", "both") if drive.is_coupled else ("",)
 
