@@ -918,3 +918,20 @@ def test_a_note_opening_with_a_file_name_keeps_its_case(said, shown):
     from dynid.report.html import capitalised
 
     assert capitalised(said) == shown
+
+
+def test_the_reports_logged_notes_name_options_by_their_flags(caplog):
+    """A note the library logs names its Python option (``max_std_percent=...``); the run's
+    record of it, which the report lists, says it as the command line prints it
+    (``--max-std-percent``)."""
+    import logging
+
+    from dynid.cli.run_report import RunRecord
+    from dynid.progress import NOTE
+
+    log = logging.getLogger("dynid.identification.least_squares")
+    caplog.set_level(NOTE, logger="dynid")  # as the command sets it
+    with RunRecord() as rec:
+        log.log(NOTE, "2 coefficient(s) loose; max_std_percent=... removes them")
+    (said,) = [m for m in rec.lines("note: ") if "loose" in m]
+    assert "--max-std-percent removes them" in said and "max_std_percent" not in said

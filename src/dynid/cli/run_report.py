@@ -113,16 +113,19 @@ class RunRecord:
 
 class _Collect(logging.Handler):
     """Keeps the messages of the warnings and of the notes (:data:`~dynid.progress.NOTE`)
-    logged during a run."""
+    logged during a run, in the command line's words (:func:`~dynid.cli.common.cli_text`:
+    ``--max-std-percent``, not the Python option ``max_std_percent=...``)."""
 
     def __init__(self, warned: list[str], noted: list[str]) -> None:
         super().__init__(NOTE)
         self._warned, self._noted = warned, noted
 
     def emit(self, record: logging.LogRecord) -> None:
+        from .common import cli_text  # as the console prints them: options by their flags
+
         with contextlib.suppress(Exception):
             into = self._warned if record.levelno >= logging.WARNING else self._noted
-            into.append(record.getMessage())
+            into.append(cli_text(record.getMessage()))
 
 
 def option_text(value: object) -> str:
