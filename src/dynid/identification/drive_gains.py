@@ -1137,27 +1137,24 @@ def _common_scale(
     samples: NDArray[np.bool_] | None = None,
 ) -> tuple[NDArray[np.float64], bool]:
     """The gains ``g`` (m,) at the description's scale and True: the parameters fitted to
-    the efforts the gains weigh, the fitted parameters' gravity torques over the
-    description's (pooled over the loaded joints); without a description's gravity, at
-    geometric mean 1 over the positive gains, and False. ``g`` is NaN on the motors left
-    out: the joints their efforts reach are left out of the fit and of the comparison, at
-    the ``samples`` (N,) given (default all). Fitted beside the model's columns instead,
-    as free columns, those efforts' noise is noise in the regressors: the least squares
-    shrinks their coefficients and the parameters take up the rest (a simulated 6-axis
-    arm's current log of 1 % noise, motors 1 and 6 left out, every constant exact: gains
-    0.937 to 0.945, std 0.002; with their joints left out, 0.99 to 1.01)."""
+    the efforts the gains weigh, at the ``samples`` (N,) given (default all), the fitted
+    parameters' gravity torques over the description's (pooled over the loaded joints);
+    without a description's gravity, at geometric mean 1 over the positive gains, and
+    False. ``g`` is NaN on the motors left out, whose efforts are free columns beside the
+    model's, each instrumented by the model's columns (:func:`_instrumented`)."""
     fitted = np.isfinite(g)
     if described is not None:
         d = described
         at = slice(None) if samples is None else np.asarray(samples, dtype=bool)
-        reached = np.any(d.B[at][..., ~fitted] != 0, axis=(0, 2))  # their efforts' joints
-        A, B = d.A[at][:, ~reached], d.B[at][:, ~reached]
+        A, B = d.A[at], d.B[at]
         p = A.shape[-1]
+        free = _instrumented(A, B[..., ~fitted])
+        X = np.concatenate([A, free], axis=-1).reshape(-1, p + free.shape[-1])
         y = (B[..., fitted] @ g[fitted]).reshape(-1)
-        rcond = np.finfo(np.float64).eps * max(y.size, p)
-        x = np.linalg.lstsq(A.reshape(-1, p), y, rcond=rcond)[0]
-        gm = d.G[at][:, ~reached] @ x
-        gd = d.gd[at][:, ~reached]
+        rcond = np.finfo(np.float64).eps * max(y.size, X.shape[1])
+        x = np.linalg.lstsq(X, y, rcond=rcond)[0]
+        gm = d.G[at] @ x[:p]
+        gd = d.gd[at]
         loaded = np.any(gd != 0, axis=0)
         dd, f = gd[:, loaded].ravel(), gm[:, loaded].ravel()
         if dd @ dd > 0 and dd @ f > 0:
@@ -1165,3 +1162,21 @@ def _common_scale(
     pos = g[fitted & (np.nan_to_num(g) > 0)]
     mean = float(np.exp(np.mean(np.log(pos)))) if pos.size else 1.0
     return g / mean, False
+
+
+def _instrumented(A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The efforts ``B`` (N, n, f) of the motors left out, each joint's rows fitted by the
+    model's columns ``A`` (N, n, p) on that joint (least squares, its own coefficients per
+    joint): the part the motion explains, without the efforts' noise (two-stage least
+    squares, the model's columns the instruments). Fitted as logged, their noise is noise
+    in the regressors: the least squares shrinks their coefficients and the parameters
+    take up the rest (a simulated 6-axis arm's current log of 1 % noise, motors 1 and 6
+    left out, every constant exact: gains 0.937 to 0.945, std 0.002)."""
+    out = np.zeros_like(B)
+    rcond = np.finfo(np.float64).eps * max(A.shape[0], A.shape[-1])
+    for j in range(A.shape[1]):
+        reached = np.any(B[:, j] != 0, axis=0)
+        if reached.any():
+            c = np.linalg.lstsq(A[:, j], B[:, j][:, reached], rcond=rcond)[0]
+            out[:, j, reached] = A[:, j] @ c
+    return out
