@@ -449,3 +449,32 @@ def test_the_constants_line_says_what_the_data_check_and_what_they_cannot(panda)
     assert "a known payload or a torque sensor checks them)" in words
     assert words.endswith("(docs: tutorials/motor-currents.md#what-the-data-check)")
     assert current.as_dict()["constants"] == words
+
+
+def test_the_noise_of_a_motor_left_out_does_not_move_the_common_scale():
+    """Regression: the effort of a motor left out (a base joint gravity does not load,
+    its inertial signal below its current noise) was fitted as logged beside the model's
+    columns for the gains' common scale; its noise shrank its coefficient and an inertial
+    parameter it shares with the loaded joints, which slow motion barely tells from their
+    gravity there, pulled the gravity parameter (exact constants read 0.86). With the
+    effort instrumented by the model's columns, the gains are within 3 spreads of 1."""
+    rng = np.random.default_rng(1)
+    t = np.linspace(0.0, 20.0, 1000)
+    q2, q3 = 0.8 * np.sin(0.5 * t), 0.6 * np.sin(0.7 * t + 1.0)
+    W = np.zeros((t.size, 3, 4))
+    W[:, 1, 0], W[:, 2, 0] = np.cos(q2), np.cos(q2 + q3)  # a link's gravity [N m per kg m]
+    W[:, 0, 1] = 0.3 * np.cos(0.9 * t)  # an inertia on the base joint, and on joints 2, 3
+    W[:, 1, 1] = np.cos(q2) + 0.03 * np.sin(2 * q2)
+    W[:, 2, 1] = np.cos(q2 + q3) + 0.03 * np.sin(2 * q3)
+    W[:, 0, 2] = np.sin(0.4 * t + 0.3)  # the base joint's viscous friction
+    W[:, 2, 3] = np.sin(q3)  # the last link's gravity
+    G = np.zeros_like(W)
+    G[..., 0], G[..., 3] = W[..., 0], W[..., 3]
+    theta = np.array([5.0, 2.0, 1.0, 1.0])
+    noise = np.array([1.0, 0.1, 0.1])
+    logged = W @ theta + rng.normal(size=(t.size, 3)) * noise
+    found = drive_gains(W, logged, noise, None, G, G @ theta)
+    assert found is not None and found.scaled and found.heldout_std is not None
+    assert np.isnan(found.factor[0]) and found.named == ()
+    off = np.abs(found.factor[1:] - 1.0)
+    assert np.all(off <= 3 * found.heldout_std[1:]), (found.factor, found.heldout_std)

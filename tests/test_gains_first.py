@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import warnings
 
 import numpy as np
@@ -413,6 +414,10 @@ def test_constants_given_at_the_motors_over_one_shared_gear_ratio_are_read_times
     _said_once(said)
     msg = [str(w.message) for w in said if "the gear ratio every joint shares" in str(w.message)]
     assert len(msg) == 1 and "torque_constant x 100" in msg[0], msg
+    found = re.search(r"times ([0-9.]+)(?: to ([0-9.]+))? \(the fitted model's gravity", msg[0])
+    assert found is not None, msg  # the masses exact: the factor beyond the gear ratio 1
+    factors = [float(v) for v in found.groups() if v is not None]
+    np.testing.assert_allclose(factors, 1.0, atol=0.03)
     assert got.model.drive is not None and got.model.drive.torque_constant is not None
     np.testing.assert_allclose(got.model.drive.torque_constant, KT, rtol=1e-12)
     assert msg[0] in got.model.info.notes

@@ -305,9 +305,14 @@ def test_a_load_the_description_lacks_is_still_named_as_a_mass(so101):
 
 
 def test_a_shared_gear_ratio_names_a_remaining_factor_beyond_the_masses():
-    """Constants given at the motors over gear ratio 345: a remaining factor within 20 %
-    of 1 is the masses' error, one of 2.34 to 2.47 is not called so."""
-    far = SharedGearRatio(345.0, np.array([2.34, 2.47])).sentence()
+    """Constants given at the motors over gear ratio 345: a remaining factor of the fitted
+    model's gravity torques within 20 % of 1 is the masses' error, one of 2.34 to 2.47 is
+    not called so; the torques as logged over the gravity torques (friction and the rotors'
+    inertia in them) are not called the masses' error."""
+    far = SharedGearRatio(345.0, np.ones(2), np.array([2.34, 2.47])).sentence()
     assert "times 2.34 to 2.47 (beyond the description's masses' error" in far
-    near = SharedGearRatio(345.0, np.array([0.95, 1.05])).sentence()
-    assert "times 0.95 to 1.05 (the masses' error)" in near
+    near = SharedGearRatio(345.0, np.array([1.1, 1.14]), np.array([0.95, 1.05])).sentence()
+    said = "times 0.950 to 1.05 (the fitted model's gravity torques over the description's: "
+    assert said + "the masses' error)" in near, near
+    raw = SharedGearRatio(345.0, np.array([1.1, 1.14])).sentence()
+    assert "times 1.10 to 1.14 (the currents as logged: friction and the rotors' inertia" in raw

@@ -36,7 +36,9 @@ from numpy.typing import NDArray
 from ..model.drive import Drive
 from ..model.robot import Robot
 from .drive_gains import MASSES, DriveGains
+from .gravity_scale import gravity_ratios
 from .log import TorqueLog, joint_side_log
+from .model import IdentifiedModel
 from .sanity import gravity_torque_scale
 
 __all__ = [
@@ -61,6 +63,8 @@ _DISTINCT = 1.2
 #: Smallest gear ratio shared by every joint whose factor the description's masses cannot
 #: make: above it ``[G / 3, 3 G]`` and :data:`_COMMON` do not meet.
 SHARED_MIN = _COMMON[1] / _COMMON[0]
+#: Most configurations the fitted model's gravity ratios are read at.
+_SAMPLES = 2_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,7 +88,7 @@ class GearRatioPattern:
     def sentence(self) -> str:
         """The finding in words (``torque_constant looks given at the motors: ...``)."""
         lo, hi = float(self.common.min()), float(self.common.max())
-        span = f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g} to {hi:.3g}"
+        span = f"{lo:#.3g}" if f"{lo:#.3g}" == f"{hi:#.3g}" else f"{lo:#.3g} to {hi:#.3g}"
         which = ", ".join(str(k + 1) for k in self.motors)
         return (
             "torque_constant looks given at the motors: the currents' gains follow the gear "
@@ -143,12 +147,20 @@ class SharedGearRatio:
     gear_ratio : float
         The gear ratio every joint shares [-].
     common : ndarray, shape (k,)
-        Per recording, its torques over the description's gravity torques times the gear
-        ratio [-] (the masses' error).
+        Per recording, its torques as logged over the description's gravity torques times
+        the gear ratio [-]: friction and the rotors' inertia in them as well as the masses'
+        error (a simulated 6-axis arm of exact masses, 0.1 kg m^2 reflected rotor inertia
+        and friction: 1.1 to 1.14).
+    fitted : ndarray, shape (j,), optional
+        Per joint gravity loads, the fitted model's gravity torques over the description's
+        [-] (:func:`~dynid.identification.gravity_scale.gravity_ratios`), the currents read
+        through the corrected constants: the masses' error alone (the same arm: 1.00);
+        None before the fit.
     """
 
     gear_ratio: float
     common: NDArray[np.float64]
+    fitted: NDArray[np.float64] | None = None
 
     def corrected(self, drive: Drive) -> Drive:
         """``drive`` with each torque constant times the gear ratio."""
@@ -156,19 +168,37 @@ class SharedGearRatio:
         kt = np.asarray(drive.torque_constant, dtype=np.float64) * self.gear_ratio
         return dataclasses.replace(drive, torque_constant=kt)
 
+    def with_fit(
+        self, robot: Robot, model: IdentifiedModel, q: Sequence[NDArray[np.float64]]
+    ) -> SharedGearRatio:
+        """The finding with :attr:`fitted` read from ``model`` (identified from the currents
+        read through :meth:`corrected`) at the joint positions ``q`` (one (N, n) array [rad]
+        per recording); unchanged where gravity loads no joint or a ratio is not positive."""
+        every = np.concatenate([np.asarray(a, dtype=np.float64) for a in q])
+        qs = every[:: max(1, every.shape[0] // _SAMPLES)]
+        r, _, loaded = gravity_ratios(robot, model, qs)
+        if not loaded.any() or not np.all(r[loaded] > 0):
+            return self
+        return dataclasses.replace(self, fitted=r[loaded])
+
     def sentence(self) -> str:
-        """The finding and what was done, in words."""
-        lo, hi = float(self.common.min()), float(self.common.max())
-        span = f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g} to {hi:.3g}"
+        """The finding and what was done, in words: the factor beyond the gear ratio the
+        fitted model's gravity torques read (:attr:`fitted`), else that of the torques as
+        logged, which is not the masses' alone."""
+        ratios = self.common if self.fitted is None else self.fitted
+        lo, hi = float(ratios.min()), float(ratios.max())
+        span = f"{lo:#.3g}" if f"{lo:#.3g}" == f"{hi:#.3g}" else f"{lo:#.3g} to {hi:#.3g}"
         g = f"{self.gear_ratio:.4g}"
-        mid = abs(float(np.mean(np.log(self.common))))
-        far = mid >= np.log1p(MASSES)
-        why = (
-            f"beyond the description's masses' error ({100 * MASSES:g} %): a further factor "
-            "of the constants, which the gravity torques of the fitted model name"
-            if far
-            else "the masses' error"
-        )
+        far = abs(float(np.mean(np.log(ratios)))) >= np.log1p(MASSES)
+        if far:
+            why = (
+                f"beyond the description's masses' error ({100 * MASSES:g} %): a further "
+                "factor of the constants, which the gravity torques of the fitted model name"
+            )
+        elif self.fitted is None:
+            why = "the currents as logged: friction and the rotors' inertia with the masses' error"
+        else:
+            why = "the fitted model's gravity torques over the description's: the masses' error"
         return (
             f"torque_constant looks given at the motors: the currents read through it are "
             f"1/{g} (the gear ratio every joint shares) times the description's gravity "

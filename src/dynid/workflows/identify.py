@@ -587,10 +587,10 @@ def identify_logs(
     shared = shared_gear_ratio(robot, logs, opt.drive)
     if shared is None:
         return _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
-    said = shared.sentence()
-    warnings.warn(said, DynidWarning, stacklevel=caller_level())
     opt = dataclasses.replace(opt, drive=shared.corrected(opt.drive))  # type: ignore[arg-type]
     got = _fit_logs(robot, logs, names, opt, kw, _prior(robot, opt))
+    said = shared.with_fit(robot, got.model, [log.q for log in logs]).sentence()
+    warnings.warn(said, DynidWarning, stacklevel=caller_level())
     info = got.model.info
     info = dataclasses.replace(info, notes=(*info.notes, said))
     return dataclasses.replace(got, model=dataclasses.replace(got.model, info=info))
