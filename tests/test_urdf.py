@@ -368,7 +368,9 @@ def test_a_moving_branch_past_the_tip_is_lumped_at_zero_and_fixed_links_merged(c
     them (the same phi, 1.115 kg), and a note names them with their 0.015 kg and inertia
     (2 x 1e-4 kg m^2 plus 0.012 kg at 0.02 m and 0.003 kg at 0.08 m from their CoM);
     the fixed TCP is logged as merged into the arm, and noted with its 0.1 kg as it lies
-    beyond the tip; nothing is warned."""
+    beyond the tip; nothing is warned. Regression (a Z1 trial: the note called the gripper
+    at rest "the best description of them there is" though its joint was recorded moving):
+    it names the tip that keeps the jaw's joint, pad, the one leaf below it."""
     import logging
 
     with caplog.at_level(logging.INFO, logger="dynid"), warnings.catch_warnings():
@@ -379,9 +381,10 @@ def test_a_moving_branch_past_the_tip_is_lumped_at_zero_and_fixed_links_merged(c
         "URDF text: links moving on joints of their own past the tip lumped into the last "
         "body at their joints' zero position (0.015 kg in all): jaw and 1 link(s) below it "
         "(0.015 kg, inertia up to 0.000224 kg m^2 about its CoM, through revolute joint "
-        "'jaw_joint' on arm); they ride on the arm at whatever opening they have, and at "
-        "rest is the best description of them there is (for an arm run without them, leave "
-        "them out of the URDF)"
+        "'jaw_joint' on arm); they ride on the arm at whatever opening they have, held at "
+        "rest in the model: the best description there is when their joints are not "
+        "recorded (where a recording holds them moving: tip_link='pad' keeps jaw_joint as "
+        "joint(s) of the model); for an arm run without them, leave them out of the URDF"
     ]
     merged = [r.getMessage() for r in caplog.records if "merged" in r.getMessage()]
     assert merged == [

@@ -118,7 +118,12 @@ def build_parser(commands: Sequence[str] = SUBCOMMANDS) -> argparse.ArgumentPars
                 help="replace read-only files, files of another command's outputs and files "
                 "no dynid run wrote in --out",
             )
-        p.set_defaults(_run=mod.run, _output=output, _applies=getattr(mod, "APPLIES", ()))
+        p.set_defaults(
+            _run=mod.run,
+            _output=output,
+            _report=getattr(mod, "REPORT", True),
+            _applies=getattr(mod, "APPLIES", ()),
+        )
     return parser
 
 
@@ -267,6 +272,8 @@ def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOu
     if kind is None or out is None:
         yield None
         return
+    if callable(kind):  # a command whose --out is a file or a folder by its inputs
+        kind = kind(args)
     with run_output(
         out, command=args.command, kind=kind, force=args.force, argv=["dynid", *argv]
     ) as run:
@@ -360,7 +367,7 @@ def _main(argv: Sequence[str] | None) -> int:
         ):
             code = int(args._run(args, console) or 0)
             _raise_if_terminated()
-            if run is not None and run.kind == "folder":
+            if run is not None and run.kind == "folder" and args._report:
                 save_run_report(run, record, args, argv, code)
                 console.print(f"report: {Path(args.out) / REPORT_NAME}")
         if record.stdout_closed:

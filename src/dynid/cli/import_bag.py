@@ -21,9 +21,19 @@ without one, as joint torques (tau [N m]). --model identification.json takes the
 and drive of an identified model instead of --robot and --drive.
 
 Writes the torque log (--out .csv or .npz) that identify, friction and validate read.
+Several recordings, or a folder holding bags (ROS 2 bag folders, ROS 1 .bag files), are
+imported in one run: --out is then a folder, holding one torque log per recording named
+for it (train1/ -> train1.csv), which --data takes as it is (several recordings are given
+to identify as a folder or as several files).
+
+A URDF chain cut before a recorded joint (--tip before a gripper's jointGripper) holds
+that joint's links at rest past the tip; where the recording shows the joint moving, or
+resting away from 0, a note gives its recorded range and the --tip that keeps it.
 
 examples:
   dynid import recording/ --out log.csv --robot panda --topic /joint_states
+  dynid import train1/ train2/ --out logs --robot arm.urdf   (logs/train1.csv, train2.csv)
+  dynid import bags/ --out logs --robot arm.urdf              (every bag bags/ holds)
   dynid import joint_states.csv --out log.csv --robot arm.urdf   (rostopic echo -p)
   dynid import recording/ --out log.csv --model id/identification.json
 """
@@ -35,15 +45,19 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from ..exceptions import OptionError
 from ..io.joint_states import JointStateImport
 from ..io.model_json import load_model_json
-from ..io.ros_recordings import load_joint_state_recording
+from ..io.robot.urdf_parse import joints_past_tip
+from ..io.ros_recordings import load_joint_state_recording, recording_paths
+from ..io.rosbag import held_bags
 from ..io.torque_log import save_torque_log
 from .applies import Applies, urdf_chain
 from .common import (
     add_drive_option,
     add_robot_options,
     add_subcommand,
+    cli_text,
     load_drive_arg,
     load_robot,
     output_path,
@@ -51,8 +65,19 @@ from .common import (
 from .console import Console
 
 NAME = "import"
-#: ``--out`` is the one file written (:mod:`dynid.outputs.run_output`).
-OUTPUT = "file"
+
+
+def _output(args: argparse.Namespace) -> str:
+    """What ``--out`` names (:mod:`dynid.outputs.run_output`): the one file written, or
+    the folder of one log per recording of several (or of a folder holding bags)."""
+    several = len(args.bag) > 1 or bool(held_bags(args.bag[0]))
+    return "folder" if several else "file"
+
+
+#: ``--out`` as :func:`_output` decides (the command line asks it before the run).
+OUTPUT = _output
+#: A folder of torque logs gets no report page (``--data`` reads the folder as it is).
+REPORT = False
 #: Options that apply to one route only (:mod:`dynid.cli.applies`).
 APPLIES = (
     urdf_chain(),
@@ -76,11 +101,17 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument(
         "bag",
         type=Path,
+        nargs="+",
         metavar="RECORDING",
-        help="ROS 1 .bag file, ROS 2 bag folder, or .csv export (rostopic echo -p, PlotJuggler)",
+        help="ROS 1 .bag file, ROS 2 bag folder, or .csv export (rostopic echo -p, "
+        "PlotJuggler); several, or a folder holding bags: one torque log each",
     )
     p.add_argument(
-        "--out", type=output_path, required=True, help="torque log to write (.csv or .npz)"
+        "--out",
+        type=output_path,
+        required=True,
+        help="torque log to write (.csv or .npz); of several recordings, the folder of "
+        "their logs (one NAME.csv per recording)",
     )
     p.add_argument(
         "--topic",
@@ -101,12 +132,16 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default=None,
         help="the recording's joint names in the robot's order, comma-separated",
     )
-    p.add_argument("--json", action="store_true", help="print the import summary as JSON")
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help='print the import summary as JSON (of several recordings: {"recordings": [...]})',
+    )
     return p
 
 
 def run(args: argparse.Namespace, console: Console) -> int:
-    """Read the recording, write the log, print what was found; returns the exit code."""
+    """Read the recordings, write their logs, print what was found; returns the exit code."""
     if args.model is not None:
         model = load_model_json(args.model)
         robot, drive = model.robot, model.drive
@@ -114,15 +149,32 @@ def run(args: argparse.Namespace, console: Console) -> int:
         robot = load_robot(args)
         drive = None
     joints = None if args.joints is None else [s.strip() for s in args.joints.split(",")]
-    res = load_joint_state_recording(args.bag, robot.joint_names, topic=args.topic, joints=joints)
+    several = _output(args) == "folder"
+    recordings = recording_paths(args.bag)
+    if several and args.out.suffix.lower() in (".csv", ".npz"):
+        raise OptionError(
+            f"--out {args.out}: several recordings, or a folder of bags, write one torque log "
+            "each into a folder; give a folder (--out logs)"
+        )
+    past_tip = {}
+    if args.model is None and Path(args.robot).suffix.lower() == ".urdf":
+        past_tip = joints_past_tip(args.robot, args.base, args.tip)
     if args.model is None:
         drive = load_drive_arg(args, robot.n)
     unit = "N m" if drive is None else drive.effort_unit
-    path = save_torque_log(args.out, res.log, tau_unit=unit)
+    summaries = []
+    for bag, name in recordings.items():
+        res = load_joint_state_recording(
+            bag, robot.joint_names, topic=args.topic, joints=joints, past_tip=past_tip
+        )
+        path = save_torque_log(args.out / name if several else args.out, res.log, tau_unit=unit)
+        summaries.append(_summary(bag, res, robot.joint_names, path, unit))
+        if not args.json:
+            if several:
+                console.print(f"{bag}:")
+            print_import(console, res, robot.joint_names, path, unit)
     if args.json:
-        console.json(_summary(args.bag, res, robot.joint_names, path, unit))
-        return 0
-    print_import(console, res, robot.joint_names, path, unit)
+        console.json({"recordings": summaries} if several else summaries[0])
     return 0
 
 
@@ -177,6 +229,6 @@ def print_import(
     for rj, bj in zip(names, res.joints, strict=True):
         console.print(f"  {rj} <- {bj}")
     for note in res.notes:
-        console.print(f"note: {note}")
+        console.print(f"note: {cli_text(note)}")  # an option named by its flag
     currents = " (tau in A: motor currents, as the drive's effort is current)"
     console.print(f"wrote {path}" + (currents if tau_unit == "A" else ""))

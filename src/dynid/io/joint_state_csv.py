@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import csv
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
@@ -155,6 +155,7 @@ def load_joint_state_csv(
     joints: Sequence[str] | None = None,
     velocity_cutoff_hz: float = DEFAULT_CUTOFF_HZ,
     gap_factor: float = 1.5,
+    past_tip: Mapping[str, tuple[str | None, str]] | None = None,
 ) -> JointStateImport:
     """Read a CSV export of a JointState topic (module docstring) into a torque log.
 
@@ -167,7 +168,7 @@ def load_joint_state_csv(
     topic : str
         The JointState topic of a PlotJuggler export (``rostopic echo -p`` writes one
         topic, unnamed: ``topic`` only names it in messages).
-    joints, velocity_cutoff_hz, gap_factor
+    joints, velocity_cutoff_hz, gap_factor, past_tip
         As :func:`~dynid.io.rosbag.load_joint_state_bag`.
 
     Returns
@@ -221,6 +222,7 @@ def load_joint_state_csv(
         velocity_cutoff_hz,
         gap_factor,
         source="file",
+        past_tip=past_tip,
     )
 
 

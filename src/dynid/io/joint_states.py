@@ -10,7 +10,10 @@ into :class:`JointStateMessages`; :func:`assemble` makes the torque log of them:
   name, else the one whose prefix matches the most robot joints (franka_ros's
   ``panda_finger_joint1`` does not take ``joint1`` from ``panda_joint1``; see
   :func:`match_joints`). Recorded joints that match no robot joint (fingers) are left
-  out, said in ``notes``. A missing or ambiguous match is an error unless ``joints=``
+  out, said in ``notes``; one the robot's description holds at rest past its tip
+  (``past_tip``: a gripper's joint, the chain cut before it) that the recording shows
+  moving or away from 0 is said with its recorded range and the tip that keeps it.
+  A missing or ambiguous match is an error unless ``joints=``
   names the recorded joints in the robot's joint order (the message gives the value to
   pass).
 * **Signals.** ``position`` -> ``q`` [rad or m], ``velocity`` -> ``dq``, ``effort`` ->
@@ -32,7 +35,7 @@ into :class:`JointStateMessages`; :func:`assemble` makes the torque log of them:
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +50,7 @@ __all__ = [
     "JointStateMessages",
     "assemble",
     "match_joints",
+    "past_tip_notes",
     "unused_joints",
 ]
 
@@ -357,6 +361,50 @@ class JointStateMessages:
         return out[0], out[1], out[2], has
 
 
+#: A recorded position [rad or m] that the model at 0 misdescribes: a joint past the tip
+#: moving more than this, or never nearer 0 than this.
+AWAY_FROM_ZERO = 1e-3
+
+
+def past_tip_notes(
+    source: str,
+    msgs: JointStateMessages,
+    extra: Sequence[str],
+    past_tip: Mapping[str, tuple[str | None, str]],
+) -> dict[str, str]:
+    """The note of each recorded joint of ``extra`` (matching no robot joint) that
+    ``past_tip`` names (a URDF joint past the chain's tip, held at 0 in the model: its
+    tip link that keeps it, or None, and its unit; :func:`~dynid.io.robot.urdf_parse.
+    joints_past_tip`) and that the recording shows moving, or resting away from 0, by
+    more than :data:`AWAY_FROM_ZERO`: its recorded range and the tip that keeps it."""
+    out: dict[str, str] = {}
+    for bag in extra:
+        robot = next((r for r in past_tip if _prefix(bag, r) is not None), None)
+        if robot is None:
+            continue
+        q = msgs.arrays([bag])[0][:, 0]
+        q = q[np.isfinite(q)]
+        if q.size == 0:
+            continue
+        lo, hi = float(q.min()), float(q.max())
+        nearest = 0.0 if lo <= 0.0 <= hi else min(abs(lo), abs(hi))
+        if max(hi - lo, nearest) <= AWAY_FROM_ZERO:
+            continue
+        tip, unit = past_tip[robot]
+        where = (
+            f"held at {lo:.3g} {unit}"
+            if hi - lo <= AWAY_FROM_ZERO
+            else f"moving from {lo:.3g} to {hi:.3g} {unit}" + (", never at 0" if nearest else "")
+        )
+        keep = f"; tip_link={tip!r} keeps it as a joint of the model" if tip else ""
+        out[bag] = (
+            f"{source} joint {bag} lies past the robot's tip, where the model holds its links "
+            f"at rest (its joint at 0), but the {source} records it {where}: the model "
+            f"misdescribes what the arm carries there{keep}"
+        )
+    return out
+
+
 def assemble(
     name: str,
     topic: str,
@@ -367,13 +415,14 @@ def assemble(
     cutoff_hz: float,
     gap_factor: float,
     source: str = "bag",
+    past_tip: Mapping[str, tuple[str | None, str]] | None = None,
 ) -> JointStateImport:
     """The torque log of ``msgs`` (the module docstring's rules) and what was found.
 
     ``name`` is the recording's file name and ``source`` what messages call it (``"bag"``,
     ``"file"``); ``n_total`` counts the recording's messages on every topic (those on
-    other topics are counted as skipped); ``joints``, ``cutoff_hz`` and ``gap_factor`` as
-    in :func:`~dynid.io.rosbag.load_joint_state_bag`.
+    other topics are counted as skipped); ``joints``, ``cutoff_hz``, ``gap_factor`` and
+    ``past_tip`` as in :func:`~dynid.io.rosbag.load_joint_state_bag`.
 
     Raises
     ------
@@ -388,8 +437,10 @@ def assemble(
     stamps = msgs.stamp[:n_msg]
     notes = []
     extra = unused_joints(msgs.names(), mapping)
-    if extra:
-        notes.append(f"{source} joint(s) {', '.join(extra)} match no robot joint: left out")
+    past = past_tip_notes(source, msgs, extra, past_tip or {})
+    if rest := [b for b in extra if b not in past]:
+        notes.append(f"{source} joint(s) {', '.join(rest)} match no robot joint: left out")
+    notes += past.values()
     if np.any(stamps == 0):
         stamps = msgs.recv[:n_msg]
         time_source = "receive"

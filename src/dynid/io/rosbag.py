@@ -9,7 +9,7 @@ log and what was found. Joints are matched by name, signals, times and cleaning 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from .. import _checks
@@ -18,9 +18,34 @@ from ..identification.log import DEFAULT_CUTOFF_HZ
 from .input_files import regular_file
 from .joint_states import JointStateImport, JointStateMessages, assemble
 
-__all__ = ["JOINT_STATE_TYPES", "joint_state_topics", "load_joint_state_bag"]
+__all__ = ["JOINT_STATE_TYPES", "held_bags", "joint_state_topics", "load_joint_state_bag"]
 
 JOINT_STATE_TYPES = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
+
+#: The store files of a ROS 2 bag (its folder is the bag).
+STORES = (".db3", ".mcap")
+
+
+def held_bags(folder: str | Path) -> list[Path]:
+    """The ROS bags ``folder`` holds, in name order: its ROS 1 ``.bag`` files and its
+    sub-folders with ``metadata.yaml`` (ROS 2 bags); empty when ``folder`` is a bag itself
+    (a ``metadata.yaml`` or a ``.db3``/``.mcap`` store in it), is not a folder, or cannot
+    be read. Not looking deeper."""
+    folder = Path(folder)
+    try:
+        if not folder.is_dir() or (folder / "metadata.yaml").exists():
+            return []
+        entries = sorted(folder.iterdir())
+        if any(f.suffix.lower() in STORES for f in entries):
+            return []
+        return [
+            f
+            for f in entries
+            if (f.suffix.lower() == ".bag" and f.is_file())
+            or (f.is_dir() and (f / "metadata.yaml").exists())
+        ]
+    except OSError:  # unreadable: its reader says so
+        return []
 
 
 def _open(path: Path):  # noqa: ANN202 (a rosbags reader)
@@ -34,6 +59,13 @@ def _open(path: Path):  # noqa: ANN202 (a rosbags reader)
     if not path.exists():
         raise DataError(f"bag not found: {str(path)!r}")
     if path.is_dir() and not (path / "metadata.yaml").exists():
+        if bags := held_bags(path):
+            raise DataError(
+                f"a folder holding {len(bags)} ROS bag(s) ({_checks.names(b.name for b in bags)}), "
+                "not one bag; hint: give one of them, or give the folder to dynid import, which "
+                "writes one torque log per bag into the folder --out names",
+                file=path.name,
+            )
         raise DataError("a ROS 2 bag folder needs metadata.yaml", file=path.name)
     if not path.is_dir():
         regular_file(path)  # not a device (/dev/zero) that rosbags fails on unexpectedly
@@ -89,6 +121,7 @@ def load_joint_state_bag(
     joints: Sequence[str] | None = None,
     velocity_cutoff_hz: float = DEFAULT_CUTOFF_HZ,
     gap_factor: float = 1.5,
+    past_tip: Mapping[str, tuple[str | None, str]] | None = None,
 ) -> JointStateImport:
     """Read ``sensor_msgs/JointState`` messages of a ROS 1 or ROS 2 bag into a torque log.
 
@@ -108,6 +141,11 @@ def load_joint_state_bag(
         none (the returned log's ``dq``, never saved).
     gap_factor : float
         See :meth:`TorqueLog.from_raw`.
+    past_tip : mapping, optional
+        The robot description's joints past its tip, held at 0 in the model (a URDF
+        chain's: :func:`~dynid.io.robot.urdf_parse.joints_past_tip`), each with the tip
+        that keeps it (or None) and its unit: a recorded one that moves, or rests away
+        from 0, is said in ``notes`` with its range and that tip.
 
     Returns
     -------
@@ -155,5 +193,13 @@ def load_joint_state_bag(
     finally:
         reader.close()
     return assemble(
-        path.name, topic, msgs, n_total, robot_joints, joints, velocity_cutoff_hz, gap_factor
+        path.name,
+        topic,
+        msgs,
+        n_total,
+        robot_joints,
+        joints,
+        velocity_cutoff_hz,
+        gap_factor,
+        past_tip=past_tip,
     )

@@ -35,7 +35,7 @@ from ..exceptions import in_file as about_file
 from ..identification.data import StaticDataset
 from ..identification.log import MILLISECONDS_HINT, TorqueLog
 from ..identification.unit_mix import unit_findings
-from ..io.bag_hint import ROBOT, bag_hint
+from ..io.bag_hint import ROBOT, bag_hint, several_bags_hint
 from ..io.column_hint import commanded_torques, missing_joints
 from ..io.columns import (
     ColumnMap,
@@ -246,7 +246,7 @@ def with_import_robot(message: str, options: Sequence[str]) -> str:
     if "--robot" not in options and "--model" not in options:
         return message
     return re.sub(
-        r"(dynid import \S+ )" + re.escape(ROBOT),
+        r"(dynid import (?:\S+ )+?)" + re.escape(ROBOT),
         lambda m: m.group(1) + shlex.join(options),
         message,
     )
@@ -668,10 +668,13 @@ def data_files(paths: str | Path | Sequence[str | Path]) -> list[Path]:
         Neither a path nor a list or tuple of paths (a :class:`TorqueLog` read already:
         ``identify_logs``, ``validate_torques``).
     DataError
-        No path, a folder without data files, a file named twice (however written), or
-        two files of identical content.
+        No path, a folder without data files, a file named twice (however written), two
+        files of identical content, or two or more ROS bags (the one ``dynid import``
+        that converts them all).
     """
     given = _checks.one_or_many("data", paths, (str, Path), PATHS_EXPECTED)
+    if said := several_bags_hint(given):  # one import for them all, not the first's
+        raise DataError(said)
     out: list[Path] = []
     for p in map(Path, given):
         if p.is_dir():

@@ -53,6 +53,14 @@ class Branch:
     lumpable : bool
         Every joint of the branch is revolute, continuous, prismatic or fixed: the branch
         has a rigid pose at its joints' zero.
+    joints : tuple of str
+        The branch's moving joints: ``joint``, then those below it.
+    prismatic : tuple of bool
+        Which of ``joints`` are prismatic (their positions in m, the others' in rad).
+    tip : str or None
+        The link a chain through the branch ends at, which keeps ``joints`` as joints of
+        the model: the branch's one leaf, reached through joints a serial chain holds
+        (none mimicking another); None when there is no such one link.
     """
 
     joint: str
@@ -63,6 +71,9 @@ class Branch:
     body: int = 0
     phi: NDArray[np.float64] = field(default_factory=lambda: np.zeros(10))
     lumpable: bool = False
+    joints: tuple[str, ...] = ()
+    prismatic: tuple[bool, ...] = ()
+    tip: str | None = None
 
     @property
     def inertia(self) -> float:
@@ -131,13 +142,19 @@ class OffChain:
         if not said:
             return None
         total = sum(b.mass for b in said)
+        keeps = [
+            f"tip_link={b.tip!r} keeps {', '.join(b.joints)} as joint(s) of the model"
+            for b in said
+            if b.tip is not None
+        ]
         return (
             f"{self.source}: links moving on joints of their own past the tip lumped into "
             f"the last body at their joints' zero position ({total:.4g} kg in all): "
             + "; ".join(b.said() for b in said)
-            + "; they ride on the arm at whatever opening they have, and at rest is the "
-            "best description of them there is (for an arm run without them, leave them out "
-            "of the URDF)"
+            + "; they ride on the arm at whatever opening they have, held at rest in the "
+            "model: the best description there is when their joints are not recorded"
+            + (f" (where a recording holds them moving: {'; '.join(keeps)})" if keeps else "")
+            + "; for an arm run without them, leave them out of the URDF"
         )
 
     @property
@@ -181,6 +198,22 @@ def _below(link: str, child_joints: Mapping[str, Sequence[_Joint]]) -> list[str]
         out.append(cur)
         stack.extend(j.child for j in reversed(child_joints.get(cur, ())))
     return out
+
+
+def _moving(
+    joint: _Joint, below: Sequence[str], child_joints: Mapping[str, Sequence[_Joint]]
+) -> tuple[tuple[str, ...], tuple[bool, ...], str | None]:
+    """The moving joints of the branch through ``joint`` (its links ``below``), which of
+    them are prismatic, and the tip that keeps them (:class:`Branch`)."""
+    every = [joint, *(j for x in below for j in child_joints.get(x, ()))]
+    moving = [j for j in every if j.type != "fixed"]
+    leaves = [x for x in below if not child_joints.get(x)]
+    chain_holds = all(
+        j.type in _RIGID_AT_ZERO and (j.type == "fixed" or _child(j.elem, "mimic") is None)
+        for j in every
+    )
+    tip = leaves[0] if len(leaves) == 1 and chain_holds else None
+    return tuple(j.name for j in moving), tuple(j.type == "prismatic" for j in moving), tip
 
 
 def off_chain(
@@ -229,7 +262,17 @@ def off_chain(
             if lumpable and branch_phi is not None:
                 phi = branch_phi(joint, T_k_link)
             branches.append(
-                Branch(joint.name, joint.type, link, tuple(below), mass, k, phi, lumpable)
+                Branch(
+                    joint.name,
+                    joint.type,
+                    link,
+                    tuple(below),
+                    mass,
+                    k,
+                    phi,
+                    lumpable,
+                    *_moving(joint, below, child_joints),
+                )
             )
     merged = tuple(
         (link, link_names[k], _mass(links[link], link))

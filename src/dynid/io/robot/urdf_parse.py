@@ -87,7 +87,7 @@ from .urdf_tree import (
     _subtree_leaves,
 )
 
-__all__ = ["chain_with_branches", "load_urdf", "robot_from_urdf_string"]
+__all__ = ["chain_with_branches", "joints_past_tip", "load_urdf", "robot_from_urdf_string"]
 
 _log = logging.getLogger(__name__)
 
@@ -303,6 +303,35 @@ def chain_with_branches(
         As :func:`robot_from_urdf_string`.
     """
     return _read_chain(text, base_link, tip_link, source, AngleRounding())
+
+
+def joints_past_tip(
+    path: str | Path, base_link: str | None = None, tip_link: str | None = None
+) -> dict[str, tuple[str | None, str]]:
+    """The moving joints past the tip of a URDF file's chain, whose links the chain lumps
+    into its last body at their zero (a gripper's past a tip chosen before it), each with
+    the tip link that keeps it a joint of the model (None: no one link does, as for two
+    fingers) and the unit of its position (``"rad"``, ``"m"`` for a prismatic joint).
+    Nothing is said or warned (the robot's reader says it).
+
+    Raises
+    ------
+    ModelError, UnknownNameError
+        As :func:`load_urdf`.
+    """
+    p = Path(path)
+    try:
+        data = file_bytes(p)
+    except OSError as exc:
+        raise ModelError(f"cannot read URDF file {str(p)!r}: {exc.strerror or exc}") from exc
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynidWarning)
+        _, off = chain_with_branches(data, base_link, tip_link, source=f"URDF file {str(p)!r}")
+    return {
+        joint: (b.tip, "m" if prismatic else "rad")
+        for b in off.lumped
+        for joint, prismatic in zip(b.joints, b.prismatic, strict=True)
+    }
 
 
 def _chain_ends(
