@@ -250,3 +250,36 @@ def test_identify_s_held_out_verdict_is_validate_s_on_the_same_log(identified, t
     assert held.verdict.level == val.verdict.level, (held.verdict.reason, val.verdict.reason)
     assert held.verdict.ratio == pytest.approx(val.verdict.ratio, rel=0.05)
     assert held.noise_floor_percent == pytest.approx(val.noise_floor_percent, rel=0.05)
+
+
+def test_a_friction_of_each_joints_own_velocity_carries_the_noise_as_the_closed_form():
+    """Two joints, tau_j = m_j ddq_j + fc_j sign(dq_j), velocity noise s_j: with the joints'
+    nodes taken at once (each joint's friction of its own velocity alone), every joint's
+    variance is its closed form m_j^2 s_a^2 + (2 fc_j)^2 Phi(-|dq_j| / s_j) (within the 16
+    nodes' resolution), the same numbers as the nodes taken joint by joint."""
+    m, fc = np.array([0.025, 0.4]), np.array([0.1, 0.3])
+    sv, sa = np.array([0.002, 0.005]), np.array([0.03, 0.01])
+    dq = np.column_stack([np.linspace(-0.01, 0.01, 2000), np.linspace(0.02, -0.03, 2000)])
+    q, ddq = np.zeros_like(dq), np.ones_like(dq)
+    noise = StateNoise(sv, sa)
+    args = (lambda q, dq, ddq: m * ddq, lambda dq: fc * np.sign(dq), q, dq, ddq, noise)
+    V = input_noise_var(*args, separable=True)
+    exact = (m * sa) ** 2 + (2 * fc) ** 2 * norm.cdf(-np.abs(dq) / sv)
+    assert np.all(np.abs(V - exact) <= (2 * fc) ** 2 / 16 + 1e-12)
+    assert np.array_equal(V, input_noise_var(*args))
+
+
+def test_friction_through_a_coupled_drive_is_not_each_joints_own():
+    """Friction at the joints, or at the motors of an uncoupled drive, is each joint's own;
+    at the motors of a drive that couples joint 3 to joint 2, joint 2's velocity moves
+    motor 3's friction, which acts on joint 2 and 3: not separable."""
+    from dynid.friction.model import joint_separable
+    from dynid.model.drive import Drive
+
+    fr = ClassicalFriction(FV[:3], FC[:3], np.zeros(3))
+    plain = Drive.from_gears([10.0, 20.0, 5.0])
+    coupled = Drive.from_gears([10.0, 20.0, 5.0], coupling=[(3, 2, 4.0)])
+    assert joint_separable(fr) and joint_separable(fr.at(plain)) and joint_separable(None)
+    assert not joint_separable(fr.at(coupled))
+    moved = fr.at(coupled).torques(np.array([[0.0, 1.0, 0.0]]))  # joint 2 alone moves
+    assert moved[0, 2] != 0.0  # joint 3's torque moves with it

@@ -94,6 +94,7 @@ from ..model.robot import Robot
 from ..model.units import units_said
 from ..regressors.terms import LinearFriction
 from .fit import model_drive, torques_through
+from .model import joint_separable
 from .pooled import joined_validation
 from .validation import KEPT_SAMPLES, Validation, own_friction, validate_torques
 
@@ -945,7 +946,7 @@ def _input_noise(
 
     friction = own_friction(model)
     fr = None if friction is None else friction.torques
-    inputs = prediction_input_noise(rigid, fr, [v.log], noise)
+    inputs = prediction_input_noise(rigid, fr, [v.log], noise, joint_separable(friction))
     return None if inputs is None else tuple(inputs)
 
 

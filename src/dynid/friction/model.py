@@ -68,6 +68,7 @@ __all__ = [
     "combined",
     "friction_parts",
     "friction_words",
+    "joint_separable",
     "through_drive",
     "coulomb_sign",
     "friction_of",
@@ -258,6 +259,21 @@ def friction_parts(friction: Friction | FrictionSum | None) -> tuple[Friction, .
     if friction is None:
         return ()
     return friction.parts if isinstance(friction, FrictionSum) else (friction,)
+
+
+def joint_separable(friction: Friction | FrictionSum | None) -> bool:
+    """Whether each joint's friction torque [N m] depends on that joint's velocity alone:
+    every part a :class:`Friction` at the joints, or at the motors of a drive whose
+    friction transmission ``K_f`` has no entry off its diagonal (a coupled wrist's does).
+    Then a velocity moved on one joint moves that joint's friction torque only, exactly
+    (the others' are computed from the same numbers)."""
+    for part in friction_parts(friction):
+        if not isinstance(part, Friction):
+            return False
+        K = part.transmission
+        if np.any(K[~np.eye(K.shape[0], dtype=bool)] != 0):
+            return False
+    return True
 
 
 #: Joint velocities [rad/s] at which :func:`friction_words` reads what a model adds: from

@@ -63,12 +63,14 @@ def prediction_input_noise(
     friction: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None,
     logs: Sequence[TorqueLog],
     noise: StateNoise | None,
+    separable: bool = False,
 ) -> list[tuple[int, NDArray[np.float64]]] | None:
     """Per prepared piece ``logs`` (with ``ddq``), every k-th of its samples (at most
     :data:`INPUT_SAMPLES`) and the variance [N^2 m^2] (N_k, n) the states' ``noise`` puts
     into the prediction ``rigid(q, dq, ddq) + friction(dq)`` there
-    (:func:`~dynid.identification.input_noise.input_noise_var`); None when the states'
-    noise is not known."""
+    (:func:`~dynid.identification.input_noise.input_noise_var`, ``separable`` passed on:
+    each joint's friction of its own velocity alone); None when the states' noise is not
+    known."""
     if noise is None:
         return None
     out = []
@@ -76,7 +78,7 @@ def prediction_input_noise(
         assert p.ddq is not None  # prepared: always with ddq
         k = input_step(p.n_samples)
         q, dq, ddq = (np.ascontiguousarray(x[::k]) for x in (p.q, p.dq, p.ddq))
-        out.append((k, input_noise_var(rigid, friction, q, dq, ddq, noise)))
+        out.append((k, input_noise_var(rigid, friction, q, dq, ddq, noise, separable)))
     return out
 
 

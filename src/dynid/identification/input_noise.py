@@ -254,6 +254,7 @@ def input_noise_var(
     dq: NDArray[np.float64],
     ddq: NDArray[np.float64],
     noise: StateNoise,
+    separable: bool = False,
 ) -> NDArray[np.float64]:
     """The variance (N, n) [N^2 m^2] the states' ``noise`` puts into the prediction
     ``rigid(q, dq, ddq) + friction(dq)`` [N m] of each joint at each sample.
@@ -280,11 +281,21 @@ def input_noise_var(
     q, dq, ddq : ndarray, shape (N, n)
         The prepared states [rad, rad/s, rad/s^2].
     noise : StateNoise
+    separable : bool
+        Each joint's friction depends on its own velocity alone
+        (:func:`~dynid.friction.model.joint_separable`): then every joint's velocity is
+        moved to a node at once, one ``friction`` call per node instead of one per node
+        and joint, the same numbers (a joint whose velocity did not move adds exactly 0).
     """
     base = rigid(q, dq, ddq)
     var = np.zeros(base.shape)
     f0 = None if friction is None else friction(dq)
     z = _nodes(NODES)
+    each = (
+        None
+        if friction is None or f0 is None or not separable
+        else _node_terms(friction, f0, dq, noise, z)
+    )
     for i in range(q.shape[1]):
         if noise.ddq[i] > 0:
             a = ddq.copy()
@@ -296,11 +307,35 @@ def input_noise_var(
             up[:, i] += s
             down[:, i] -= s
             var += ((rigid(q, up, ddq) - rigid(q, down, ddq)) / 2.0) ** 2
-            if friction is not None and f0 is not None:
+            if each is not None:  # joint i's own column: the others' terms are 0
+                for d in each:
+                    var[:, i] += d[:, i]
+            elif friction is not None and f0 is not None:
                 for e in z:
                     up[:, i] = dq[:, i] + s * e
                     var += (friction(up) - f0) ** 2 / z.size
     return var
+
+
+def _node_terms(
+    friction: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    f0: NDArray[np.float64],
+    dq: NDArray[np.float64],
+    noise: StateNoise,
+    z: NDArray[np.float64],
+) -> list[NDArray[np.float64]]:
+    """Per node ``e`` of ``z``, ``(friction(dq + s e) - f0)^2 / z.size`` (N, n) [N^2 m^2]
+    with every joint's velocity moved by its own noise ``s`` (those without noise not
+    moved): column ``i`` the term :func:`input_noise_var` adds for joint ``i``'s node when
+    each joint's friction depends on its own velocity alone."""
+    s = np.asarray(noise.dq, dtype=np.float64)
+    moved = np.flatnonzero(s > 0)
+    out = []
+    for e in z:
+        up = dq.copy()
+        up[:, moved] = dq[:, moved] + s[moved] * e
+        out.append((friction(up) - f0) ** 2 / z.size)
+    return out
 
 
 @dataclass(frozen=True, slots=True)

@@ -262,12 +262,21 @@ def _conditioning(
     cond(R D), v)`` with ``v`` the unit right singular vector of the smallest singular
     value of ``R``.
     """
+    cond, v = _scaled_conditioning(R)
+    return cond, _unscaled_cond(R, scale), v
+
+
+def _scaled_conditioning(R: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+    """``cond(R)`` and the weakest direction of :func:`_conditioning`."""
     _, sv, Vt = np.linalg.svd(R)
     cond = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else float("inf")
+    return cond, Vt[-1] if sv.size else np.zeros(0)
+
+
+def _unscaled_cond(R: NDArray[np.float64], scale: NDArray[np.float64]) -> float:
+    """``cond(R D)`` of :func:`_conditioning`."""
     su = np.linalg.svd(R * scale[None, :], compute_uv=False)
-    cond_u = float(su[0] / su[-1]) if su.size and su[-1] > 0 else float("inf")
-    v = Vt[-1] if sv.size else np.zeros(0)
-    return cond, cond_u, v
+    return float(su[0] / su[-1]) if su.size and su[-1] > 0 else float("inf")
 
 
 def _solve_semi_normal(
@@ -301,11 +310,12 @@ def _solve_semi_normal(
     R, info = scipy.linalg.lapack.dpotrf(Gs, lower=0, clean=1, overwrite_a=1)
     if info != 0:
         return None
-    cond, cond_u, vmin = _conditioning(R, scale)
+    cond, vmin = _scaled_conditioning(R)  # the unscaled one only once this path holds
     if not np.isfinite(cond):
         return None
     if not (cond <= _CSNE_MAX_COND and cond * rtol < _CSNE_RANK_MARGIN):
         return None
+    cond_u = _unscaled_cond(R, scale)
     # R^T R z = D^{-1} W^T y, then one correction with the residual (Björck 1987)
     z = scipy.linalg.cho_solve((R, False), _rmatvec(Wk, blk, y) / scale, check_finite=False)
     e, g = _residual(Wk, blk, y, z / scale, "rmatvec")  # g = W^T e

@@ -299,12 +299,8 @@ def _fit(
     x = np.concatenate([d[:, j] * w[j] for d in D]).ravel()
     y = np.concatenate([e[:, j] * w[j] for e in E]).ravel()
     if C is not None:
-        A = np.concatenate([c[:, j, :] * w[j][None, :, None] for c in C])
-        A = A.reshape(-1, A.shape[-1])
-        A = A[:, np.any(A != 0, axis=0)]
+        A = _scaled_columns(C, j, w)
         if A.shape[1]:
-            scale = np.linalg.norm(A, axis=0)
-            A = A / scale
             both = _projected(A, np.stack([x, y], axis=1))
             x, y = x - A @ both[:, 0], y - A @ both[:, 1]
     xx = float(x @ x)
@@ -339,6 +335,34 @@ def _left_rms(
             y = e.ravel()
             e = (y - A @ _projected(A, y[:, None])[:, 0]).reshape(e.shape)
     return np.asarray(np.sqrt(np.mean(e**2, axis=0)), dtype=np.float64)
+
+
+def _scaled_columns(
+    C: list[NDArray[np.float64]], j: NDArray[np.intp], w: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The columns ``C`` (each (N_k, n, p)) at the rows of the joints ``j``, each joint's
+    times its weight ``w`` (n,) [1/(N m)], the pieces stacked (sum N_k * len(j), p')
+    column-major, the columns that are zero on every row left out and each of the others
+    scaled to unit norm. Written into one array in place (the delay's check of a 10 s,
+    1 kHz Panda log: 50 MB a copy), the same numbers as the weighted pieces
+    concatenated, their zero columns dropped (a column-major copy) and divided by their
+    norms."""
+    p = C[0].shape[-1]
+    rows = [c.shape[0] * j.size for c in C]
+    A = np.empty((sum(rows), p), order="F")
+    wj = w[j][None, :, None]
+    every = j.size == C[0].shape[1] and bool(np.all(j == np.arange(j.size)))
+    start = 0
+    for c, m in zip(C, rows, strict=True):
+        piece = A.T[:, start : start + m].reshape(p, c.shape[0], j.size)  # a view
+        np.multiply(c if every else c[:, j, :], wj, out=piece.transpose(1, 2, 0))
+        start += m
+    scale = np.linalg.norm(A, axis=0)
+    if not np.all(scale > 0):  # a column zero on every row (or of norm below range)
+        A = A[:, np.any(A != 0, axis=0)]
+        scale = np.linalg.norm(A, axis=0)
+    A /= scale
+    return A
 
 
 def _projected(A: NDArray[np.float64], B: NDArray[np.float64]) -> NDArray[np.float64]:

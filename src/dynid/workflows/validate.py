@@ -61,7 +61,13 @@ from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError
 from ..friction.delay_check import validations_delay
 from ..friction.fit import model_drive, same_drive, torques_through
-from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
+from ..friction.model import (
+    FrictionModel,
+    FrictionSum,
+    joint_separable,
+    own_at_motors_note,
+    placed_friction,
+)
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction, recorded_cutoff
 from ..identification.drive_gains import DriveGains
@@ -695,7 +701,9 @@ def _input_noise(
         return np.asarray(torques_through(model, drive, q, dq, ddq), dtype=np.float64)
 
     fr = None if friction is None else friction.torques
-    return prediction_input_noise(rigid, fr, [v.log for v in val.parts], val.pieces.state_noise)
+    logs = [v.log for v in val.parts]
+    separable = joint_separable(friction)
+    return prediction_input_noise(rigid, fr, logs, val.pieces.state_noise, separable)
 
 
 def _judged(
