@@ -118,3 +118,15 @@ def test_a_quantized_slow_joints_derived_velocities_keep_their_sign_and_its_band
     band = derived_velocity_band([(t, logged)], CUTOFF, lowpassed=True)
     assert band is not None
     assert band[0] < 0.01 * white and band[1] == pytest.approx(white, rel=0.1)
+
+
+def test_the_friction_table_says_why_a_band_is_near_zero():
+    """Under identify's friction table, bands below 1e-6 rad/s (a quantized wrist's
+    1.8e-15) are named by their joint with why no band is needed; bands of measured noise
+    (2e-3 rad/s) add nothing."""
+    from dynid.cli.summaries import _scales_lines
+
+    lines = _scales_lines({"band": (2e-3, 1.83e-15, 0.0)}, None)
+    (said,) = [x for x in lines if "near 0" in x]
+    assert "(2, 3)" in said and "quantized" in said and "sign" in said
+    assert not any("near 0" in x for x in _scales_lines({"band": (2e-3, 8.8e-3)}, None))

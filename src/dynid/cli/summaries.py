@@ -294,6 +294,9 @@ def _negative_viscous_line(t: Any, differences: frozenset[str] = frozenset()) ->
 COMBINED = "combined"
 
 
+#: A standstill band below this [rad/s] is said to be near 0 under the friction table.
+NEAR_ZERO_BAND = 1e-6
+
 #: The cell of a joint's friction at the joint that the motor's friction holds.
 MOTORS = "motor's"
 
@@ -335,6 +338,13 @@ def _scales_lines(scales: dict[str, tuple[float, ...]], model: IdentifiedModel) 
         "  band: the standstill band of the velocities as prepared (5 std of their noise; of "
         "velocities derived from positions, the positions' noise through the derivative filter)"
     ]
+    near_zero = [k + 1 for k, b in enumerate(scales.get("band", ())) if 0 <= b < NEAR_ZERO_BAND]
+    if near_zero:
+        out.append(
+            f"  a band near 0 ({', '.join(map(str, near_zero))}): no white noise read there "
+            "(exact, or positions quantized to encoder steps, which keep the derived "
+            "velocity's sign: no band is needed; docs: validation.md)"
+        )
     if "width" in scales:
         given = [str(x) for x in model.info.extra.get("terms", ()) if str(x).startswith("smooth")]
         k = given[0].split(":")[1] if given and ":" in given[0] else "K"
