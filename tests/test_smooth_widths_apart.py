@@ -87,7 +87,9 @@ def _selection(logs):
     judged = {
         c.structure.width
         for c in sel.candidates
-        if c.structure.at == "motor" and c.structure.friction == ("viscous", "smooth")
+        # the drive says its friction acts at the motors: the candidates are judged there
+        # alone, at the drive's own place ("")
+        if c.structure.at == "" and c.structure.friction == ("viscous", "smooth")
     }
     return sel, judged
 
