@@ -16,6 +16,7 @@ import re
 import numpy as np
 import pytest
 
+import dynid
 from dynid.cli.__main__ import main
 from dynid.feasibility.convex.data_term import coefficient_term
 from dynid.feasibility.convex.fit import consistent_from_identified
@@ -23,7 +24,11 @@ from dynid.friction.model import ClassicalFriction, FrictionSum, friction_of
 from dynid.friction.validation import own_friction
 from dynid.identification.selection import identify_recordings
 from dynid.identification.structure import Structure, friction_placements, joint_side_joints
-from dynid.io.feasible import load_feasible_linear_friction
+from dynid.io.feasible import (
+    load_feasible_drive,
+    load_feasible_json,
+    load_feasible_linear_friction,
+)
 from dynid.io.feasible_bundle import save_feasible_bundle
 from dynid.io.model_json import model_from_dict, model_to_dict
 from dynid.io.torque_log import save_torque_log
@@ -147,7 +152,8 @@ def test_motor_friction_alone_does_not_choose_both(panda):
 def test_the_consistent_result_holds_both_and_exports_them(panda, tmp_path):
     """The one-step consistent fit of exact data with friction on both sides: its friction
     is the sum of both (the truth, to round-off), feasible.json holds the part at the joints
-    as ``joint_friction`` and reads back the same sum, and URDF and MJCF add both to each
+    as ``joint_friction`` and reads back the same sum (on the robot ``load_feasible_json``
+    gives too, which predicts the recording's torques), and URDF and MJCF add both to each
     joint's damping and dry friction."""
     logs, motor, joint = _logs(panda, joint_side=True)
     terms = Structure.parse("viscous, coulomb, offset, at:both")
@@ -163,6 +169,13 @@ def test_the_consistent_result_holds_both_and_exports_them(panda, tmp_path):
     np.testing.assert_allclose(doc["joint_friction"]["fv"], np.eye(7)[6] * JFV, atol=1e-6)
     back = load_feasible_linear_friction(tmp_path / "feasible.json")
     np.testing.assert_allclose(back.torques(v), res.friction.torques(v), atol=1e-12)
+    # the robot read back carries that sum: its torques are the truth's (regression: none)
+    robot = load_feasible_json(tmp_path / "feasible.json")
+    np.testing.assert_allclose(robot.friction.torques(v), back.torques(v), atol=1e-12)
+    log = logs[0]
+    drive = load_feasible_drive(tmp_path / "feasible.json")
+    tau = dynid.model_torques(robot, log.q, log.dq, log.ddq, drive=drive)
+    assert np.linalg.norm(tau - log.tau) <= 1e-6 * np.linalg.norm(log.tau)
     urdf = next(p for p in files if p.suffix == ".urdf").read_text()
     # diag(K^T diag(fv) K) of the motors plus the joint's own: joint 6 feels motor 7 too
     assert _damping(urdf, 5) == pytest.approx(FV[5] + 0.8**2 * FV[6], abs=1e-6)

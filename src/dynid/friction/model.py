@@ -334,14 +334,22 @@ def robot_friction(robot: Robot, drive: Drive | None = None) -> Friction | Frict
     friction, not where a description's acts (an MJCF exported from a model identified
     through a gear-50..100 drive, read back with the same drive file, validated at
     6.3e5 %). A part that names its own drive (a robot TOML's ``[friction]`` table with
-    ``at``) acts as it says. This is the one place a robot's own friction is placed:
-    simulation, validation, payload identification and the observer all read it here.
-    Without ``drive``: as held (what a robot description file writes)."""
+    ``at``) acts as it says, and so does every part of a sum that holds one: its parts
+    without a drive are the joints' by placement (friction identified at the motors and at
+    the joints of a coupled drive, a ``feasible.json``'s ``joint_friction``, a TOML's
+    ``[joint_friction]``), not moved. This is the one place a robot's own friction is
+    placed: simulation, validation, payload identification and the observer all read it
+    here. Without ``drive``: as held (what a robot description file writes)."""
     own = cast(Friction | FrictionSum | None, robot.friction)
-    if own is None or drive is None or drive.friction_at != "motor":
+    if own is None or drive is None or drive.friction_at != "motor" or _placed(own):
         return own
-    parts = tuple(p.at(drive) if p.drive is None else p for p in friction_parts(own))
+    parts = tuple(p.at(drive) for p in friction_parts(own))
     return parts[0] if len(parts) == 1 else FrictionSum(parts)
+
+
+def _placed(friction: Friction | FrictionSum) -> bool:
+    """Whether a part of ``friction`` names its drive: each part then acts as held."""
+    return any(p.drive is not None for p in friction_parts(friction))
 
 
 def own_at_motors_note(robot: Robot, drive: Drive | None) -> str | None:
@@ -356,8 +364,8 @@ def own_at_motors_note(robot: Robot, drive: Drive | None) -> str | None:
         return None
     if np.allclose(drive.transmission, np.eye(robot.n)):
         return None
-    if not any(p.drive is None for p in friction_parts(cast(Any, robot.friction))):
-        return None  # every part records its own place and holds it
+    if _placed(cast(Any, robot.friction)):
+        return None  # its parts record their places and hold them
     return (
         f"the robot's own friction ({robot.name}: a description's, the joints' by "
         "definition) is read at the motors because the drive file says friction_at = "

@@ -8,7 +8,9 @@ link, in the schema of the robot description's inertials (:mod:`dynid.io.robot.t
 (:func:`fitted_robot`: the input robot's sigmoid only when the fit identified no friction
 and was not on a torque log; the friction identified with the links in ``linear_friction``,
 :mod:`dynid.io.law_friction`), so that it loads back as a complete
-:class:`~dynid.model.robot.Robot`::
+:class:`~dynid.model.robot.Robot` (:func:`load_feasible_json`: its friction the identified
+one, acting where it was identified; :func:`dynid.model_torques` of it with the file's
+drive predicts the fit's torques)::
 
     {"schema": "dynid-feasible-parameters/1", "dynid_version": ..., "name": ...,
      "links": [{"name": "link1", "mass": 4.97, "com": [...], "inertia": [...]}, ...],
@@ -100,6 +102,8 @@ __all__ = [
     "load_feasible_json",
     "fitted_robot",
     "combined_coefficients",
+    "feasible_drive",
+    "feasible_linear_friction",
     "load_feasible_linear_friction",
     "load_feasible_spring",
     "robot_from_feasible_dict",
@@ -426,14 +430,24 @@ def save_feasible_json(path: str | Path, source: FeasibleResult | Robot, **recor
 def robot_from_feasible_dict(
     d: Mapping[str, Any], robot: Robot | None = None, *, source: str = "feasible parameters"
 ) -> Robot:
-    """A robot with the link parameters of a :func:`feasible_to_dict` dictionary.
+    """A robot with the link parameters of a :func:`feasible_to_dict` dictionary and the
+    model terms identified with them.
+
+    The friction identified with the links (``linear_friction``, with ``joint_friction``
+    their :class:`~dynid.friction.model.FrictionSum`; per motor through the file's drive
+    where its friction acts at the motors: :func:`feasible_linear_friction`) and the joint
+    springs (``spring``) are the fitted model's, which its links predict torques with:
+    they are put on the robot in either case below.
 
     Parameters
     ----------
     d : mapping
     robot : Robot, optional
-        Kinematics to put the parameters on (its link names must match the file's);
-        default the kinematics and friction held in the file.
+        Kinematics to put the parameters on (its link names must match the file's); its
+        own friction and spring are kept where the file holds none identified (the
+        sigmoid ``friction`` of a retrieval, the input robot's, is not put on it). Default:
+        the kinematics held in the file, with its friction (the identified one, else the
+        sigmoid ``friction``) and springs.
     source : str
         The file named in messages.
 
@@ -442,7 +456,8 @@ def robot_from_feasible_dict(
     DataError
         Wrong schema, an unknown key, a missing or malformed field, a mass beyond
         ``MAX_LINK_MASS`` or a CoM beyond :data:`MAX_COM_DISTANCE` (:mod:`dynid.io.schema`),
-        link names that do not match ``robot``.
+        link names that do not match ``robot``, a friction law's parameter missing or not
+        one per joint.
 
     Warns
     -----
@@ -465,16 +480,13 @@ def robot_from_feasible_dict(
                 robot = robot.with_friction(SigmoidFriction.from_array(F))
             except (ModelError, ShapeError) as exc:
                 raise fault(source, "friction", str(exc)) from exc
-        try:  # the joint springs identified with the links
-            robot = robot.with_spring(spring_from_record(d.get("spring")))
-        except ShapeError as exc:
-            raise fault(source, "spring", str(exc)) from exc
     if len(links) != robot.n:
         raise fault(
             source,
             "links",
             f"expected one per link of robot {robot.name!r} ({robot.n}); got {len(links)} links",
         )
+    robot = _with_identified_terms(d, robot, source)
     mass = np.empty(robot.n)
     com = np.empty((robot.n, 3))
     I6 = np.empty((robot.n, 6))
@@ -494,6 +506,19 @@ def robot_from_feasible_dict(
         raise DataError(str(exc), file=source) from exc
 
 
+def _with_identified_terms(d: Mapping[str, Any], robot: Robot, source: str) -> Robot:
+    """``robot`` with the friction and the joint springs the checked document ``d`` holds
+    identified with its links, each where ``d`` holds it (the robot's own kept else)."""
+    try:
+        spring = spring_from_record(d.get("spring"))
+    except ShapeError as exc:
+        raise fault(source, "spring", str(exc)) from exc
+    if spring is not None:
+        robot = robot.with_spring(spring)
+    identified = feasible_linear_friction(d, source)
+    return robot if identified is None else robot.with_friction(identified)
+
+
 def _check_link(where: str, mass: float, I6: NDArray[np.float64]) -> None:
     """Warn, as the URDF reader does, on parameters that are not physically consistent, a
     negative mass included (kept: those of an infeasible result are not consistent)."""
@@ -507,11 +532,19 @@ def _check_link(where: str, mass: float, I6: NDArray[np.float64]) -> None:
 
 
 def load_feasible_json(path: str | Path, robot: Robot | None = None) -> Robot:
-    """Read ``feasible.json``: a Robot with the feasible link parameters.
+    """Read ``feasible.json``: a Robot with the feasible link parameters and the model
+    terms identified with them, which :func:`dynid.model_torques` (with the file's drive,
+    :func:`load_feasible_drive`, for its rotor inertias) predicts the fit's torques with.
 
-    With ``robot`` None the kinematics and friction stored in the file are used;
-    otherwise the parameters are put on ``robot`` (link names must match). This is what
-    ``dynid validate --params feasible.json`` loads.
+    Its friction is the one identified with the links (:func:`load_feasible_linear_friction`:
+    ``linear_friction``, per motor through the file's drive where it acts at the motors,
+    plus ``joint_friction`` as a :class:`~dynid.friction.model.FrictionSum`), else the
+    sigmoid ``friction`` the file holds; its springs the file's ``spring``. With ``robot``
+    None the kinematics stored in the file are used; otherwise the parameters are put on
+    ``robot`` (link names must match) with the friction and springs identified with them,
+    ``robot``'s own kept where the file holds none identified
+    (:func:`robot_from_feasible_dict`). This is what ``dynid validate --params
+    feasible.json`` loads.
 
     Raises
     ------
@@ -613,30 +646,45 @@ def load_fit_rejection(path: str | Path) -> str | None:
     return fit_rejection(load_document(path, FEASIBLE))
 
 
-def load_feasible_linear_friction(path: str | Path) -> Friction | FrictionSum | None:
-    """The friction identified with the links held by ``feasible.json`` (the classical
-    ``fv, fc, fo`` per joint of a consistent identification), or None.
+def feasible_linear_friction(
+    d: Mapping[str, Any], source: str = "feasible parameters"
+) -> Friction | FrictionSum | None:
+    """The friction identified with the links held by a checked ``feasible.json`` document
+    ``d`` (the law's coefficients per joint, or per motor, of a consistent
+    identification), or None; ``source`` names the file in errors.
 
-    ``dynid validate --params`` uses it unless another friction is given. With a drive whose
-    friction acts at the motors, the law per motor mapped through the transmission (a
-    :class:`~dynid.friction.model.Friction` with the drive); with ``joint_friction`` too,
-    the sum of both (:class:`~dynid.friction.model.FrictionSum`).
+    With a drive whose friction acts at the motors, the law per motor mapped through the
+    transmission (a :class:`~dynid.friction.model.Friction` with the drive,
+    ``tau_f = K^T f(K dq)``); with ``joint_friction`` too, the sum of both
+    (:class:`~dynid.friction.model.FrictionSum`).
+
+    Raises
+    ------
+    DataError
+        A law's parameter missing or not one per joint; a malformed drive.
+    """
+    if d.get("linear_friction") is None:
+        return None
+    drive = feasible_drive(d, source)
+    at = drive if drive is not None and drive.friction_place == "motor" else None
+    n = len(d["links"])
+    parts = [law_friction(d["linear_friction"], at, n, source, "linear_friction")]
+    if d.get("joint_friction") is not None:
+        parts.append(law_friction(d["joint_friction"], None, n, source, "joint_friction"))
+    return parts[0] if len(parts) == 1 else FrictionSum(tuple(parts))
+
+
+def load_feasible_linear_friction(path: str | Path) -> Friction | FrictionSum | None:
+    """The friction identified with the links held by ``feasible.json``
+    (:func:`feasible_linear_friction`), or None: the friction of the robot
+    :func:`load_feasible_json` returns, alone.
 
     Raises
     ------
     DataError
         A law's parameter missing or not one per joint.
     """
-    d = load_document(path, FEASIBLE)
-    if d.get("linear_friction") is None:
-        return None
-    drive = load_feasible_drive(path)
-    at = drive if drive is not None and drive.friction_place == "motor" else None
-    n, name = len(d["links"]), Path(path).name
-    parts = [law_friction(d["linear_friction"], at, n, name, "linear_friction")]
-    if d.get("joint_friction") is not None:
-        parts.append(law_friction(d["joint_friction"], None, n, name, "joint_friction"))
-    return parts[0] if len(parts) == 1 else FrictionSum(tuple(parts))
+    return feasible_linear_friction(load_document(path, FEASIBLE), Path(path).name)
 
 
 def load_feasible_spring(path: str | Path) -> JointStiffness | None:
@@ -644,10 +692,15 @@ def load_feasible_spring(path: str | Path) -> JointStiffness | None:
     return spring_from_record(load_document(path, FEASIBLE).get("spring"))
 
 
+def feasible_drive(d: Mapping[str, Any], source: str = "feasible parameters") -> Drive | None:
+    """The drive train held by a checked ``feasible.json`` document ``d`` (its rotor
+    inertias the identified ones), or None; ``source`` names the file in errors."""
+    if d.get("drive") is None:
+        return None
+    return drive_from_record(d["drive"], len(d["links"]), source=source, at="drive")
+
+
 def load_feasible_drive(path: str | Path) -> Drive | None:
     """The drive train held by ``feasible.json`` (its rotor inertias the identified ones), or
     None."""
-    d = load_document(path, FEASIBLE)
-    if d.get("drive") is None:
-        return None
-    return drive_from_record(d["drive"], len(d["links"]), source=Path(path).name, at="drive")
+    return feasible_drive(load_document(path, FEASIBLE), Path(path).name)

@@ -84,14 +84,9 @@ def load_robot(
         from .robot.mjcf_read import load_mjcf
 
         return load_mjcf(path)
-    from .feasible import load_feasible_json, load_feasible_linear_friction
+    from .feasible import load_feasible_json
 
-    robot = load_feasible_json(path)
-    identified = load_feasible_linear_friction(path)
-    if identified is None:
-        return robot
-    # the friction identified with the links (at the motors and the joints: their sum)
-    return robot.with_friction(identified)
+    return load_feasible_json(path)  # the friction identified with the links on it
 
 
 def _names() -> str:
