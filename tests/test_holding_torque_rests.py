@@ -12,6 +12,7 @@ same recordings' Fourier motions with a true spring on joint 2 (the positive con
 from __future__ import annotations
 
 import dataclasses
+import re
 import warnings
 
 import numpy as np
@@ -19,7 +20,8 @@ import pytest
 
 from dynid.exceptions import DynidWarning
 from dynid.friction.model import ClassicalFriction
-from dynid.identification.residual_dependence import at_standstill
+from dynid.identification.residual_dependence import at_standstill, dependence_hint
+from dynid.identification.rests import lasting_rests
 from dynid.io.torque_log import save_torque_log
 from dynid.simulation.measurement import SensorNoise, simulate_measurement
 from dynid.simulation.trajectories import Trajectory
@@ -116,3 +118,67 @@ def test_a_holding_torque_at_rest_is_not_called_a_spring(panda, files):
     reason = held.verdict.reason
     assert "holding torque at rest" in reason, reason
     assert "try adding spring" not in reason, reason
+
+
+def _swing(t, fc, band, rng):
+    """One joint swinging ``0.3 sin(0.4 pi t)`` [rad] (reversals every 2.5 s, 4 ms inside a
+    1e-3 rad/s band at 1 kHz, no rest), and the residual of a model whose Coulomb term
+    ``fc`` [N m] is off inside ``band`` [rad/s] where the torques step at the reversal
+    itself, plus 5 mN m of noise."""
+    w = 0.4 * np.pi
+    q, dq = 0.3 * np.sin(w * t), 0.3 * w * np.cos(w * t)
+    e = fc * np.sign(dq) * (np.abs(dq) <= band) + rng.normal(0.0, 0.005, t.size)
+    return q[:, None], dq[:, None], e[:, None]
+
+
+def test_reversals_are_no_rest_and_their_share_is_not_said_as_zero():
+    """Trial regression (a UR5 validated on motion without rests): a residual at the
+    reversals' brief passes through the standstill band had been said to be the holding
+    torque at rest over "the 0 %" of samples; now it is friction's step at the reversals,
+    its share to 2 significant digits."""
+    rng = np.random.default_rng(8)
+    t = np.arange(0.0, 20.0, 1e-3)
+    q, dq, e = _swing(t, 1.0, 1e-3, rng)
+    inside = np.abs(dq) <= 1e-3  # the truth's passes through the band
+    assert 0 < inside.mean() < 0.005
+    said = dependence_hint([q], [dq], [e], np.array([0.005]), ["elbow"], t=[t])
+    assert said is not None and "at rest" not in said and "holding" not in said, said
+    share = re.search(r"over the ([0-9.]+) % of samples at its velocity reversals", said)
+    assert share is not None, said
+    assert float(share.group(1)) == pytest.approx(100 * inside.mean(), rel=0.3)
+    assert float(share.group(1)) > 0.0
+
+
+def test_a_holding_torque_at_real_rests_is_still_said():
+    """Rests of 1 s between moves, whose torques hold 0.3 to 1 N m the model does not: the
+    residual is the holding torque at rest, over the rests' share of the samples."""
+    rng = np.random.default_rng(9)
+    t = np.arange(0.0, 20.0, 1e-3)
+    phase = t % 2.0  # 1 s quintic move of 0.5 rad, then 1 s at rest
+    s = np.clip(phase, 0.0, 1.0)
+    step = np.floor(t / 2.0)
+    q = 0.5 * (step + 10 * s**3 - 15 * s**4 + 6 * s**5)
+    dq = np.where(phase < 1.0, 0.5 * (30 * s**2 - 60 * s**3 + 30 * s**4), 0.0)
+    dq = dq + rng.normal(0.0, 1e-4, t.size)
+    rest = phase >= 1.0
+    hold = rng.uniform(0.3, 1.0, int(step[-1]) + 1)[step.astype(int)]
+    e = np.where(rest, hold, 0.0) + rng.normal(0.0, 0.005, t.size)
+    said = dependence_hint(
+        [q[:, None]], [dq[:, None]], [e[:, None]], np.array([0.005]), ["j"], t=[t]
+    )
+    assert said is not None and "holding torque at rest" in said, said
+    share = re.search(r"over the ([0-9.]+) % of samples at rest", said)
+    assert share is not None and 40 <= float(share.group(1)) <= 52, said
+
+
+def test_a_rest_lasts_min_rest_s():
+    """A run inside the band is a rest from MIN_REST_S on, within one piece."""
+    t = np.arange(0.0, 2.0, 0.01)
+    inside = np.zeros((t.size, 2), dtype=bool)
+    inside[10:60, 0] = True  # 0.49 s from its first sample to its last
+    inside[100:151, 0] = True  # 0.50 s
+    inside[:, 1] = True  # the whole log, but cut into two pieces of 0.99 s
+    got = lasting_rests(inside, [t[:100], t[100:]])
+    assert not got[10:60, 0].any() and got[100:151, 0].all() and got[:, 0].sum() == 51
+    assert got[:, 1].all()
+    assert not lasting_rests(inside[:, 1:], [t[i : i + 40] for i in range(0, 200, 40)]).any()

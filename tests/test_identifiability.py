@@ -15,8 +15,16 @@ from dynid.identification.classical import identify_from_log
 from dynid.identification.least_squares import fit_least_squares
 from dynid.identification.log import TorqueLog
 from dynid.io.robot.urdf import robot_from_urdf_string
-from dynid.regressors.base import base_parameters, identifiability, rank_from_gap
+from dynid.model.drive import Drive
+from dynid.regressors.base import (
+    base_parameters,
+    base_parameters_from_regressor,
+    identifiability,
+    link_families,
+    rank_from_gap,
+)
 from dynid.regressors.static import static_regressor
+from dynid.regressors.terms import RotorInertia
 from dynid.simulation.controller import SimulatedController, acquire_static, acquire_static_at
 
 from conftest import planar_2r, robot_data_urdf
@@ -92,6 +100,65 @@ def test_identifiability_of_the_planar_2r_matches_the_closed_form():
     assert {k for k, v in status.items() if v == "combination"} == combined
     assert all(v == "unidentifiable" for k, v in status.items() if k not in alone | combined)
     assert "mc1x + 0.7*m2" in bp.expressions and "J1zz + 0.49*m2" in bp.expressions
+
+
+def _ur5_rows_with_rotors(gear: float, seed: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    """Pinocchio's torque regressor of the UR5 (dynid's column order) beside the rotor
+    columns ``K^T diag(K ddq)`` of a drive with ``gear`` at every joint and a coupled
+    wrist (``qm6 = gear (q6 + 0.5 q5)``), on random states; and ``K``."""
+    pin = pytest.importorskip("pinocchio")
+    m = pin.buildModelFromUrdf(robot_data_urdf("ur_description/urdf/ur5_robot.urdf"))
+    m.gravity.linear[:] = [0.0, 0.0, -9.80665]
+    d = m.createData()
+    K = np.diag(np.full(6, gear))
+    K[5, 4] = 0.5 * gear
+    rng = np.random.default_rng(seed)
+    rows = []
+    for _ in range(40):
+        q, dq, ddq = rng.uniform(-3, 3, 6), rng.normal(size=6), rng.normal(size=6)
+        Y = pin.computeJointTorqueRegressor(m, d, q, dq, ddq).reshape(6, 6, 10)
+        rows.append(
+            np.hstack([Y[:, :, [0, 1, 2, 3, 4, 5, 7, 6, 8, 9]].reshape(6, 60), K.T * (K @ ddq)])
+        )
+    return np.vstack(rows), K
+
+
+def _identifiable_by_svd(W: np.ndarray) -> tuple[set[int], set[int]]:
+    """Columns whose parameter is identifiable alone (its unit vector in the row space of
+    ``W``: no component in the null space of the column-normalised ``W``) and the columns
+    that act on nothing."""
+    norms = np.linalg.norm(W, axis=0)
+    zero = norms <= 1e-10 * np.median(norms)
+    Ws = W[:, ~zero] / norms[~zero]
+    _, s, Vt = np.linalg.svd(Ws, full_matrices=True)
+    null = Vt[int(np.sum(s > 1e-8 * s[0])) :]
+    alone = np.flatnonzero(~zero)[np.einsum("kj,kj->j", null, null) < 1e-10]
+    return set(alone.tolist()), set(np.flatnonzero(zero).tolist())
+
+
+@pytest.mark.parametrize("gear", [1.0, 50.0, 200.0])
+def test_rotor_identifiability_does_not_depend_on_the_gear_ratio_or_units(gear):
+    """Trial of a geared UR5: at a gear ratio of 200 the rotors of joints 1 and 2 (in a sum
+    with link inertias, ``J1zz + ... + 40000*Ia1``) were called identifiable alone, at 1 and
+    100 not; every ratio and unit (m or mm, kg m^2 or kg mm^2) gives the SVD's sets."""
+    W, K = _ur5_rows_with_rotors(gear)
+    alone, zero = _identifiable_by_svd(W)
+    robot = dynid.Robot.from_urdf(
+        robot_data_urdf("ur_description/urdf/ur5_robot.urdf"), tip_link="tool0"
+    )
+    drive = Drive.from_gears(np.full(6, gear), [(6, 5, K[5, 4])], side="motor")
+    via_robot = base_parameters(robot, kind="torque", terms=[RotorInertia(drive)])
+    # the same rows in mm: first moments in kg mm, inertias (links' and rotors') in kg mm^2
+    mm = np.concatenate([np.tile([1, 1e3, 1e3, 1e3] + [1e6] * 6, 6), np.full(6, 1e6)])
+    families = link_families(6, 6)
+    in_mm = base_parameters_from_regressor(W / mm, via_robot.std_labels, families=families)
+    for bp in (via_robot, in_mm):
+        status = identifiability(bp)
+        assert {j for j, v in enumerate(status) if v == "identifiable"} == alone
+        assert {j for j, v in enumerate(status) if v == "unidentifiable"} == zero
+    labels = via_robot.std_labels
+    assert {labels[j] for j in alone if labels[j].startswith("Ia")} == {"Ia3", "Ia4", "Ia5", "Ia6"}
+    assert len(alone) == 22 and len(zero) == 9
 
 
 def test_rounded_urdf_angles_give_the_rank_of_the_exact_kinematics(rounded_arm):

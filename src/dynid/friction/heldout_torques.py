@@ -287,6 +287,7 @@ class HeldOutTorques:
                 self.left_out,
                 prismatic=None if self.robot is None else tuple(map(bool, self.robot.prismatic)),
                 levels=None if own is None else {j: own.of(j) or () for j in own.joints},
+                t=[v.log.t],
             )
         )
         if said is not None and verdict.level == "good":  # at the floor, the factors said
@@ -357,7 +358,9 @@ class HeldOutTorques:
             return ()
         fl = self._judged()[1]
         error = [v.log.tau - v.tau_hat]
-        return residual_dependence([v.log.q], [v.log.dq], error, fl.total_rms, fl.joint_ratios)
+        return residual_dependence(
+            [v.log.q], [v.log.dq], error, fl.total_rms, fl.joint_ratios, t=[v.log.t]
+        )
 
     @property
     def round_off(self) -> float | None:

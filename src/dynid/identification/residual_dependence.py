@@ -41,6 +41,7 @@ from ..regressors.terms import PART_LABELS, LinearFriction
 from .gravity_tilt import GravityTilt
 from .recording_level import level_clause
 from .residual_spring import ResidualSpring
+from .rests import MIN_REST_S, lasting_rests
 from .velocity_noise import MIN_MOTION, noise_band, velocity_noise_std
 from .verdict import ROUND_OFF_PERCENT, SYSTEMATIC_RATIO, Verdict, with_hint
 
@@ -50,6 +51,7 @@ if TYPE_CHECKING:
 __all__ = [
     "BINS",
     "acceleration_led",
+    "at_rests",
     "at_standstill",
     "cannot_hold_note",
     "Dependence",
@@ -64,6 +66,7 @@ __all__ = [
     "residual_dependence",
     "round_off",
     "round_off_note",
+    "reversal_led",
     "still_led",
     "with_dependence_hint",
 ]
@@ -84,9 +87,9 @@ FOLLOWS = 0.5
 #: round-off (:data:`~dynid.identification.verdict.ROUND_OFF_PERCENT`): its error over a
 #: noise floor itself at the file's rounding says nothing of the model.
 ROUND_OFF = ROUND_OFF_PERCENT / 100.0
-#: A joint's residual is the holding torque at rest when its RMS over the samples at
-#: standstill is at least this many times that over the moving samples, the standstill
-#: samples carrying at least :data:`FOLLOWS` of its mean square above the noise
+#: A joint's residual is the holding torque at rest when its RMS over the samples of its
+#: rests (:func:`at_rests`) is at least this many times that over the other samples, the
+#: rests carrying at least :data:`FOLLOWS` of its mean square above the noise
 #: (:func:`still_led`).
 STILL_RATIO = 2.0
 
@@ -104,6 +107,18 @@ def at_standstill(dq: NDArray[np.float64]) -> NDArray[np.bool_]:
     band = np.maximum(noise_band(velocity_noise_std(V)), MIN_MOTION)
     out: NDArray[np.bool_] = np.abs(V) <= band
     return out
+
+
+def at_rests(dq: NDArray[np.float64], t: Sequence[NDArray[np.float64]] | None) -> NDArray[np.bool_]:
+    """Which samples (N, n) of each joint are at a rest: inside the standstill band
+    (:func:`at_standstill`) for at least :data:`~dynid.identification.rests.MIN_REST_S`
+    (:func:`~dynid.identification.rests.lasting_rests`, ``t`` each piece's times [s]). A
+    reversal passes through the band in a few samples and is no rest: its friction steps,
+    it holds nothing. Without times none is (a rest cannot be told from a reversal)."""
+    V = np.asarray(dq, dtype=np.float64)
+    if t is None:
+        return np.zeros(V.shape, dtype=bool)
+    return lasting_rests(at_standstill(V), t)
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,10 +145,16 @@ class Dependence:
         The RMS [N m] of the residual's binned means over the joint's acceleration, as
         ``position`` (0 where the accelerations were not given).
     still_share : float
-        The share of the samples at which the joint stands still (:func:`at_standstill`).
+        The share of the samples at which the joint rests (:func:`at_rests`).
     still, moving : float
-        The residual's RMS [N m] over the samples at standstill and over the moving ones
-        (0 where there are none).
+        The residual's RMS [N m] over the samples at rest and over the others (0 where
+        there are none).
+    reversal_share : float
+        The share of the samples at which the joint passes through its standstill band
+        without resting (:func:`at_standstill`, not :func:`at_rests`): its reversals.
+    reversal, off_reversal : float
+        The residual's RMS [N m] over those samples and over the others (0 where there are
+        none).
     """
 
     joint: int
@@ -147,6 +168,9 @@ class Dependence:
     still_share: float = 0.0
     still: float = 0.0
     moving: float = 0.0
+    reversal_share: float = 0.0
+    reversal: float = 0.0
+    off_reversal: float = 0.0
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.ratio):
@@ -176,21 +200,35 @@ def _parts(
 
 
 def still_led(d: Dependence) -> bool:
-    """Whether joint ``d``'s residual concentrates at standstill: its RMS there at least
-    :data:`STILL_RATIO` times that while moving, the standstill samples carrying at least
+    """Whether joint ``d``'s residual concentrates at its rests: its RMS there at least
+    :data:`STILL_RATIO` times that elsewhere, the samples at rest carrying at least
     :data:`FOLLOWS` of its mean square above the noise. The holding torque at rest (static
     friction, anything within its limits): no spring's, whatever follows the position
     (a 7-DoF arm resting 51 % of a point-to-point log had been told of a spring on
-    joint 2 whose term made the held-out error worse, 7.79 to 8.75 %)."""
+    joint 2 whose term made the held-out error worse, 7.79 to 8.75 %). Reversals are no
+    rests (:func:`at_rests`): a UR5 validated on motion without rests had been told of the
+    holding torque at rest over the 0.14 % of samples its elbow spent in its band there."""
     if d.still_share <= 0.0 or d.still < STILL_RATIO * d.moving:
         return False
     above = d.rms**2 - d.noise**2
     return above > 0 and d.still_share * (d.still**2 - d.noise**2) >= FOLLOWS * above
 
 
+def reversal_led(d: Dependence) -> bool:
+    """Whether joint ``d``'s residual concentrates at its reversals, the brief passes
+    through its standstill band (:attr:`Dependence.reversal_share`), by the test of
+    :func:`still_led`: friction's step there, which the model places where its own
+    velocity leaves its Coulomb term's band (or smooths it) while the torques step at the
+    true reversal (:mod:`~dynid.identification.friction_steps`); no holding torque."""
+    if d.reversal_share <= 0.0 or d.reversal < STILL_RATIO * d.off_reversal:
+        return False
+    above = d.rms**2 - d.noise**2
+    return above > 0 and d.reversal_share * (d.reversal**2 - d.noise**2) >= FOLLOWS * above
+
+
 def _still(R: NDArray[np.bool_], E: NDArray[np.float64], j: int) -> tuple[float, float, float]:
-    """Joint ``j``'s share of samples at standstill (``R``, :func:`at_standstill`) and the
-    residual's RMS [N m] there and while moving."""
+    """Joint ``j``'s share of samples at rest (``R``, :func:`at_rests`) and the residual's
+    RMS [N m] there and elsewhere."""
     rest = R[:, j]
     if not rest.any() or rest.all():
         return 0.0, 0.0, 0.0
@@ -225,6 +263,7 @@ def residual_dependence(
     noise_rms: NDArray[np.float64],
     ratios: NDArray[np.float64] | None = None,
     ddq: Sequence[NDArray[np.float64]] | None = None,
+    t: Sequence[NDArray[np.float64]] | None = None,
 ) -> tuple[Dependence, ...]:
     """Each joint above :data:`~dynid.identification.verdict.SYSTEMATIC_RATIO` x its noise,
     its residual's dependence on its own position and velocity, and acceleration when
@@ -246,6 +285,9 @@ def residual_dependence(
     ddq : sequence of ndarray, each (N_k, n), optional
         The accelerations [rad/s^2] at the same samples: the part that follows them
         (:attr:`Dependence.acceleration`).
+    t : sequence of ndarray, each (N_k,), optional
+        The samples' times [s], per piece: the rests (:func:`at_rests`), over which a
+        residual is told as the holding torque; without them no sample is at rest.
 
     Returns
     -------
@@ -262,10 +304,12 @@ def residual_dependence(
         return ()
     rms = np.sqrt(np.mean(E**2, axis=0))
     judged = rms / s if ratios is None else np.asarray(ratios, dtype=np.float64)
-    out, R = [], at_standstill(V)
+    out, R = [], at_rests(V, t)
+    passes = at_standstill(V) & ~R  # inside the band without resting: the reversals
     for j in np.flatnonzero((judged > SYSTEMATIC_RATIO) & (rms > s)):  # a part to diagnose
         position, velocity = _parts(Q, V, E, int(j), float(s[j]) ** 2)
         share, still, moving = _still(R, E, int(j))
+        through = _still(passes, E, int(j))
         out.append(
             Dependence(
                 joint=int(j),
@@ -279,6 +323,9 @@ def residual_dependence(
                 still_share=share,
                 still=still,
                 moving=moving,
+                reversal_share=through[0],
+                reversal=through[1],
+                off_reversal=through[2],
             )
         )
     return tuple(out)
@@ -383,6 +430,13 @@ def _constant(
     )
 
 
+def _share_percent(share: float) -> str:
+    """``share`` (0..1) in percent to 2 significant digits (``"0.43"``, ``"51"``), 3 near
+    all (``"99.7"``): a share above 0 is never said as ``"0"``, below 1 never as ``"100"``."""
+    p = 100.0 * share
+    return f"{p:.2g}" if p < 99.5 else f"{p:.3g}"
+
+
 def _sentence(
     d: Dependence,
     name: str,
@@ -395,9 +449,11 @@ def _sentence(
     lacks: str | None = None,
     levels: Mapping[int, Sequence[float]] | None = None,
 ) -> str:
-    """One joint's diagnosis in words (a residual that concentrates at standstill first:
-    the holding torque at rest, its why said once, ``still_as`` the joint it was said
-    at; then a residual that follows the acceleration:
+    """One joint's diagnosis in words (a residual that concentrates at the joint's rests
+    first (:func:`at_rests`; their share of the samples to 2 significant digits): the
+    holding torque at rest, its why said once, ``still_as`` the joint it was said
+    at; then one that concentrates at its reversals (:func:`reversal_led`): friction's
+    step there; then a residual that follows the acceleration:
     an inertia the model lacks, with ``inertia`` the remedy where the caller knows it,
     else :data:`_INERTIA_REMEDY`; a model that holds the armature, its
     inertia off the model's); ``terms`` the model's term names (:func:`held_terms`),
@@ -418,8 +474,9 @@ def _sentence(
     if still_led(d):
         said = (
             f"{head}{d.rms:.2g} N m RMS residual, {d.still:.2g} over the "
-            f"{100 * d.still_share:.0f} % of samples at standstill against {d.moving:.2g} "
-            "while moving: the holding torque at rest"
+            f"{_share_percent(d.still_share)} % of samples at rest (inside the velocity "
+            f"band for {MIN_REST_S:g} s or more) against {d.moving:.2g} elsewhere: the "
+            "holding torque at rest"
         )
         if still_as is not None:
             return f"{said}, as {still_as}"
@@ -427,6 +484,15 @@ def _sentence(
             f"{said} (static friction, anything within its limits, which no term of the "
             "model holds; no spring or friction term fits it: judge the model on moving "
             "samples, or record without rests)"
+        )
+    if reversal_led(d):
+        return (
+            f"{head}{d.rms:.2g} N m RMS residual, {d.reversal:.2g} over the "
+            f"{_share_percent(d.reversal_share)} % of samples at its velocity reversals "
+            f"(brief passes through the standstill band, no rest) against "
+            f"{d.off_reversal:.2g} elsewhere: friction's step at the reversals, which the "
+            "model places where its velocity leaves its Coulomb term's band (or smooths it) "
+            "while the torques step at the reversal itself"
         )
     if acceleration_led(d):
         said = (
@@ -569,6 +635,7 @@ def dependence_hint(
     lacks: str | None = None,
     prismatic: Sequence[bool] | None = None,
     levels: Mapping[int, Sequence[float]] | None = None,
+    t: Sequence[NDArray[np.float64]] | None = None,
 ) -> str | None:
     """:func:`residual_dependence` in words, one clause per joint above its noise joined by
     ``"; "`` (``"right_s1: 0.41 of 0.59 N m RMS residual follows its position (...)"``),
@@ -595,22 +662,28 @@ def dependence_hint(
     (:func:`cannot_hold_note`); ``prismatic``: the joints' kinds, a prismatic joint's
     clause in its own units (N, N/m: :func:`~dynid.model.units.joint_unit`); ``levels``:
     per joint, each recording's constant where the residual is one steady constant over
-    each (:mod:`~.recording_level`), told as the recording's own offset."""
+    each (:mod:`~.recording_level`), told as the recording's own offset; ``t``: the
+    samples' times [s] (pieces as ``q``), which tell the joints' rests from their
+    reversals (:func:`at_rests`; without them no residual is said to be the holding
+    torque at rest)."""
     if tilt is not None and tilt.named and tilt.rows.size == 0:
         return tilt.sentence()  # judged on other samples (a block's whole log): said alone
     if tilt is not None and tilt.named:
-        rows = tilt.rows
+        rows = np.asarray(tilt.rows)
+        ends = np.cumsum([len(p) for p in q])
+        cut = np.searchsorted(rows, ends[:-1])  # the rows kept, piece by piece
 
         def kept(x: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
-            return [np.concatenate([np.asarray(p, dtype=np.float64) for p in x])[rows]]
+            return np.split(np.concatenate([np.asarray(p, dtype=np.float64) for p in x])[rows], cut)
 
         rest = dependence_hint(
-            kept(q), kept(dq), [tilt.rest], noise_rms, joint_names, terms, offsets=offsets,
-            left_out=left_out, ddq=None if ddq is None else kept(ddq), inertia=inertia,
-            lacks=lacks, prismatic=prismatic, levels=levels,
+            kept(q), kept(dq), np.split(tilt.rest, cut), noise_rms, joint_names, terms,
+            offsets=offsets, left_out=left_out, ddq=None if ddq is None else kept(ddq),
+            inertia=inertia, lacks=lacks, prismatic=prismatic, levels=levels,
+            t=None if t is None else kept(t),
         )  # fmt: skip
         return tilt.sentence() + ("" if rest is None else f"; what it leaves: {rest}")
-    found = residual_dependence(q, dq, error, noise_rms, ratios, ddq)
+    found = residual_dependence(q, dq, error, noise_rms, ratios, ddq, t)
     if not found:
         return None
     worst = sorted(found, key=lambda d: d.ratio, reverse=True)
@@ -695,6 +768,7 @@ def with_dependence_hint(
     lacks: str | None = None,
     prismatic: Sequence[bool] | None = None,
     levels: Mapping[int, Sequence[float]] | None = None,
+    t: Sequence[NDArray[np.float64]] | None = None,
 ) -> Verdict:
     """``verdict`` with :func:`dependence_hint` appended when it is above the noise floor
     (not ``"good"``) and a joint is above its noise; else ``verdict`` itself; with the
@@ -709,14 +783,15 @@ def with_dependence_hint(
     ``inertia``: the accelerations and the remedy of a residual that follows them;
     ``lacks``: the robot file the model was read from; ``prismatic``: the joints' kinds
     (:func:`dependence_hint`); ``levels``: each recording's constant per joint where it is
-    one (:mod:`~.recording_level`)."""
+    one (:mod:`~.recording_level`); ``t``: the samples' times [s], which tell rests from
+    reversals (:func:`at_rests`)."""
     if verdict.level == "good":
         return verdict
     if (exact := round_off(error, torques)) is not None:
         return with_hint(verdict, round_off_note(exact))
     said = dependence_hint(
         q, dq, error, noise_rms, joint_names, terms, tilt, ratios, springs, offsets, left_out,
-        ddq, inertia, lacks, prismatic, levels,
+        ddq, inertia, lacks, prismatic, levels, t,
     )  # fmt: skip
     return with_hint(verdict, said)
 

@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..friction.model import FrictionModel, FrictionSum, friction_parts
+from ..identification.rests import MIN_REST_S
 from ..model.units import JointKinds, joint_unit
 from .friction import canonical_friction
 from .thresholds import RestMargin
@@ -57,8 +58,6 @@ __all__ = [
 
 #: Separate settled rests per joint a calibration needs to calibrate its rest level.
 MIN_RESTS = 10
-#: Seconds a rest must stay settled to count (:data:`MIN_RESTS`).
-MIN_REST_S = 0.5
 #: Time constants ``1 / K_O`` of the observer's lag after a joint enters its standstill
 #: band before its rest is settled: the last of a motion creeps inside the band for up to
 #: half of it (a quintic stop of 0.8 s moving a joint 0.01 rad: 0.13 s at 0.01 rad/s), its

@@ -30,7 +30,9 @@ returned (``gap``, the two singular values relative to ``s[0]``) and ``rtol`` is
 level, their geometric mean. An explicit ``rtol`` instead cuts at ``rtol s[0]``.
 
 :func:`identifiability` classifies every standard parameter: identifiable alone,
-unidentifiable (it acts on nothing) or identifiable only in combination.
+unidentifiable (it acts on nothing) or identifiable only in combination, from the zeros of
+``K_d`` the scaled problem set, so that it too holds at any unit and gear ratio (a rotor of
+gear ratio 200 enters ``beta1`` as ``40000*Ia1`` and is still only in combination).
 
 Which standard parameters are independent is decided by the pivot order. After scaling
 every column has norm 1, so pivoting on the largest norm (LAPACK's ``geqp3``) would choose
@@ -530,7 +532,7 @@ def _random_rows(
 IDENTIFIABLE, UNIDENTIFIABLE, IN_COMBINATION = "identifiable", "unidentifiable", "combination"
 
 
-def identifiability(base: BaseParameters, *, tol: float = 1e-8) -> tuple[str, ...]:
+def identifiability(base: BaseParameters) -> tuple[str, ...]:
     """Whether each standard parameter can be identified, alone or only in combination.
 
     With ``P`` the base projection (``beta = P phi``), a standard parameter ``phi_j`` is
@@ -541,11 +543,19 @@ def identifiability(base: BaseParameters, *, tol: float = 1e-8) -> tuple[str, ..
     * ``"combination"`` otherwise: it is known only through the base parameters whose
       expressions contain it.
 
+    ``P`` is ``[I | K_d]`` up to the order of its columns, so ``e_j`` lies in its row space
+    exactly when ``phi_j`` is independent and its row of ``K_d`` is zero (its base
+    parameter is ``phi_j`` alone), and column ``j`` is zero exactly when ``phi_j`` is
+    dependent with a zero column of ``K_d``. The test reads those zeros, which the base
+    set its coefficients to on the column-scaled regressor (a coefficient below the rank
+    cut, :func:`base_parameters_from_regressor`). A distance from the row space of the
+    unscaled ``P`` would instead depend on units and gear ratios: a rotor's coefficient
+    grows with the square of its gear ratio (``beta1 = J1zz + ... + 40000*Ia1`` at a ratio
+    of 200 puts ``e_Ia1`` within 1e-9 of the row space), and the decision must not.
+
     Parameters
     ----------
     base : BaseParameters
-    tol : float
-        Tolerance on the distance of ``e_j`` from the row space (``e_j`` has norm 1).
 
     Returns
     -------
@@ -553,18 +563,12 @@ def identifiability(base: BaseParameters, *, tol: float = 1e-8) -> tuple[str, ..
         In the order of ``base.std_labels``.
     """
     _checks.of_type("base", base, BaseParameters, "a BaseParameters (dynid.base_parameters(robot))")
-    P = base.projection
-    if base.rank == 0:
-        return (UNIDENTIFIABLE,) * base.n_std
-    U = np.linalg.svd(P, full_matrices=False)[2]  # (r, p), orthonormal rows span row(P)
-    inside = np.einsum("kj,kj->j", U, U)  # squared norm of the projection of each e_j
-    col = np.linalg.norm(P, axis=0)
-    out = []
-    for j in range(base.n_std):
-        if col[j] <= tol * max(float(col.max()), 1.0):
-            out.append(UNIDENTIFIABLE)
-        elif inside[j] >= 1.0 - tol:
-            out.append(IDENTIFIABLE)
-        else:
-            out.append(IN_COMBINATION)
+    K_d = np.asarray(base.K_d)
+    out = [UNIDENTIFIABLE] * base.n_std
+    for k, j in enumerate(np.asarray(base.independent)):
+        alone = K_d.shape[1] == 0 or not np.any(K_d[k] != 0.0)
+        out[int(j)] = IDENTIFIABLE if alone else IN_COMBINATION
+    for d, j in enumerate(np.asarray(base.dependent)):
+        if K_d.shape[0] and np.any(K_d[:, d] != 0.0):
+            out[int(j)] = IN_COMBINATION
     return tuple(out)

@@ -186,6 +186,7 @@ def _dependence_said(
     kinds = tuple(bool(p) for p in (model if isinstance(model, Robot) else model.robot).prismatic)
     q = [v.log.q for v in val.parts]
     dq = [v.log.dq for v in val.parts]
+    t = [v.log.t for v in val.parts]  # the joints' rests told from their reversals
     error = [v.log.tau - v.tau_hat for v in val.parts]
     springs = None if whole is None else residual_springs(model, whole, noise.total)
     tilt = None if whole is None else residual_tilt(model, whole, noise.total, springs)
@@ -197,7 +198,7 @@ def _dependence_said(
         verdict = with_hint(verdict, load_hint(load, payload))
         rest = dependence_hint(
             q, dq, load.residual, noise.total, names, terms, offsets=offsets,
-            left_out=left_out, ddq=ddq, inertia=inertia, lacks=lacks, prismatic=kinds,
+            left_out=left_out, ddq=ddq, inertia=inertia, lacks=lacks, prismatic=kinds, t=t,
         )  # fmt: skip
         verdict = with_hint(verdict, None if rest is None else f"what it leaves: {rest}")
         return ResidualHints(verdict, None, None, tilt, load)  # the load, not a spring
@@ -207,7 +208,7 @@ def _dependence_said(
     levels = None if own is None else {j: own.of(j) or () for j in own.joints}
     verdict = with_dependence_hint(
         verdict, q, dq, error, noise.total, names, terms, tilt, noise.ratios, springs,
-        tau, offsets, left_out, ddq, inertia, lacks, kinds, levels,
+        tau, offsets, left_out, ddq, inertia, lacks, kinds, levels, t,
     )  # fmt: skip
     return ResidualHints(verdict, springs, None, tilt, load, own)
 
