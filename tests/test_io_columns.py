@@ -445,6 +445,15 @@ def test_the_recorded_sign_flips_reused_are_a_note(caplog):
         (record,) = caplog.records
         assert record.levelno == level and f"(--units {units})" in record.getMessage(), units
     caplog.clear()
+    with caplog.at_level(NOTE):  # a column map alone (a libfranka log's names): a note
+        libfranka = "t=time,q=q_{i0},dq=dq_{i0},tau=tau_J_{i0}"
+        assert recorded_columns({"columns": libfranka, "units": None}, None, None) == (
+            libfranka,
+            None,
+        )
+    (record,) = caplog.records
+    assert record.levelno == NOTE and f"--columns {libfranka}" in record.getMessage()
+    caplog.clear()
     with caplog.at_level(NOTE):
         recorded_columns({"columns": None, "units": "tau2=-1"}, None, "tau2=-1,tau3=-1")
     (record,) = caplog.records

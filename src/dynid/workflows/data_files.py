@@ -585,7 +585,10 @@ def _checked_units(units: str) -> bool:
     """True when a ``--units`` text holds only sign flips (``tau2=-1,rec2.csv:tau=-1``) and
     named units of :data:`_CHECKED_QUANTITIES` (``t=us,q=deg,dq=deg/s``): a new file they
     do not fit is refused with its own hint, so reusing them is a note (a column map of
-    other names fails on the first missing column just as plainly)."""
+    other names fails on the first missing column just as plainly); none (a column map
+    alone, a libfranka log's ``t=time,q=q_{i0},...``) is a note too."""
+    if not units.strip():
+        return True
     try:
         parsed = parse_column_map(None, units)
     except DataError:
