@@ -70,3 +70,24 @@ def test_the_friction_figure_is_drawn_at_the_motors_it_was_fitted_at():
         assert ax.get_ylabel() == "motor torque [N m]"
         assert ax.get_title().startswith(f"motor {j + 1} ({'ab'[j]})")
     fig.clf()
+
+
+def test_the_table_says_the_laws_were_fitted_at_the_motors_of_a_geared_drive():
+    """Through a drive whose friction acts at its motors (gear ratios 50 and 30; the
+    residual the classical law's in closed form at ``K dq``, mapped by ``K^T``) the table
+    and the record say the laws were fitted there; without a drive they say nothing of
+    motors."""
+    rng = np.random.default_rng(22)
+    drive = Drive.from_gears([50.0, 30.0])
+    fv, fc = np.array([2e-4, 1e-4]), np.array([0.02, 0.01])
+
+    def motors(dq):
+        v = dq @ drive.transmission.T
+        return (fv * v + fc * np.sign(v)) @ drive.transmission
+
+    sel = select_friction(_residual(rng, motors), drive)
+    assert sel.at_motors and "fitted at the drive's motors" in sel.table()
+    assert sel.as_dict()["laws_at"] == "motors"
+    plain = select_friction(_residual(rng, ClassicalFriction([0.5], [1.0], [0.0]).torques, n=1))
+    assert not plain.at_motors and "motors" not in plain.table()
+    assert plain.as_dict()["laws_at"] == "joints"

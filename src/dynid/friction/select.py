@@ -175,6 +175,9 @@ class FrictionSelection:
         The law of the model's own friction (``"classical"``), when it is a candidate:
         the ``own`` candidate is shown by it (:meth:`label`), as validate and the
         figure name it.
+    at_motors : bool
+        The registry's laws were fitted at the motors of a drive (its friction acts
+        there: :func:`~dynid.friction.fit.fit_friction_through`), not at the joints.
     """
 
     fit: FrictionFit
@@ -184,6 +187,7 @@ class FrictionSelection:
     method: str = "contiguous-block cross-validation"
     rule: str = RULE
     own_kind: str | None = None
+    at_motors: bool = False
 
     def label(self, name: str) -> str:
         """A candidate's name as shown: ``own (classical)`` for the model's own friction
@@ -216,11 +220,13 @@ class FrictionSelection:
                 }
                 for s in self.scores
             ],
+            "laws_at": "motors" if self.at_motors else "joints",
         }
 
     def table(self) -> str:
         """The candidates as a text table, the kept one marked with ``*``, those set aside
-        (not dissipative) with ``x`` and a line each saying where, and the rule."""
+        (not dissipative) with ``x`` and a line each saying where, and the rule (with where
+        the laws act, where that is a drive's motors)."""
         w = max([12, *(len(self.label(s.name)) for s in self.scores)])
         p = max([10, *(len(", ".join(s.params)) for s in self.scores)])
         rows = [
@@ -237,6 +243,11 @@ class FrictionSelection:
         rows.append(
             f"kept (*): {self.rule} (by noise); {self.method}, the rigid-body model as "
             "given (not refitted per fold)"
+            + (
+                "; the laws fitted at the drive's motors (where its friction acts)"
+                if self.at_motors
+                else ""
+            )
         )
         for s in self.scores:
             if s.unphysical:
@@ -382,8 +393,15 @@ def select_friction(
         scores.append(own_score)
     kept = simplest_within(_dissipative(scores), prefer=OWN if own is not None else None)
     own_kind = fits[OWN].kind if OWN in fits else None
+    at_motors = drive is not None and drive.friction_place == "motor"
     return FrictionSelection(
-        fits[kept.name], kept.name, tuple(scores), folds, method, own_kind=own_kind
+        fits[kept.name],
+        kept.name,
+        tuple(scores),
+        folds,
+        method,
+        own_kind=own_kind,
+        at_motors=at_motors,
     )
 
 
