@@ -280,6 +280,24 @@ def _output_set(args: argparse.Namespace, argv: Sequence[str]) -> Iterator[RunOu
         yield run
 
 
+#: The BLAS libraries' thread counts a command sets when neither the environment nor an
+#: earlier import of numpy did: one thread. The fits are tall products and QR factors of
+#: a hundred columns, where a second BLAS thread gains little and, on a machine whose cores
+#: are busy, spins against the other work (an exact 186,000-row log of a UR5: 31 s with one
+#: thread, 64 s to 217 s with two on two shared cores; a 10 s Panda log 4 s against 33 s).
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def _one_blas_thread() -> None:
+    """One BLAS thread (:data:`BLAS_THREAD_VARIABLES`) unless set in the environment; only
+    before numpy is loaded, which reads them once (a command called in a process that
+    loaded it keeps that process's threads)."""
+    if "numpy" in sys.modules:
+        return
+    for name in BLAS_THREAD_VARIABLES:
+        os.environ.setdefault(name, "1")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dynid`` console script; returns the exit code.
 
@@ -290,6 +308,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     Called in a process (``argv`` given), the root logger's level and handlers are left
     as they were: a ``-q`` run does not silence the next.
     """
+    _one_blas_thread()
     root = logging.getLogger()
     level, handlers = root.level, list(root.handlers)
     try:
