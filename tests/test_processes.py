@@ -340,3 +340,22 @@ def test_ctrl_c_during_the_clarabel_solve_ends_it_and_the_run(tmp_path):
     assert "solver status CallbackTerminated" in err
     assert "interrupted; no partial output left" in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("given", [None, "3"])
+def test_a_command_runs_blas_on_one_thread_unless_told(given):
+    """A command's process sets OPENBLAS_NUM_THREADS and MKL_NUM_THREADS to 1 before numpy
+    loads (which reads them once), and leaves a value the environment gives as it is."""
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+    }
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    code = (
+        "import os, sys; from dynid.cli.__main__ import _one_blas_thread; "
+        "assert 'numpy' not in sys.modules; _one_blas_thread(); "
+        "print(os.environ['OPENBLAS_NUM_THREADS'], os.environ['MKL_NUM_THREADS'])"
+    )
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == [given or "1", "1"]
