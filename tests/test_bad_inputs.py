@@ -1031,7 +1031,7 @@ CASES = [
     C("feasible-limit-string", feasible_edited, "export --params {d}/limit.json --out {d}/out.urdf", 2, "limit.json: key 'kinematics.limits.q_max[0]': expected a number; got '2.8'"),
     C("feasible-negative-mass", feasible_edited, "export --params {d}/negative.json --out {d}/out.urdf", 0, "negative.json: links[0] is physically inconsistent: negative mass -1.0; kept as given"),
     C("model-unknown-key", model_unknown_keys, "predict --model {d}/top.json --q " + NEUTRAL, 2, "top.json: key 'note': unknown key; allowed: base, coefficients,"),
-    C("model-coefficient-unknown-key", model_unknown_keys, "predict --model {d}/coef.json --q " + NEUTRAL, 2, "coef.json: key 'coefficients[0].note': unknown key; allowed: expression, kept, name, std, std_percent, value"),
+    C("model-coefficient-unknown-key", model_unknown_keys, "predict --model {d}/coef.json --q " + NEUTRAL, 2, "coef.json: key 'coefficients[0].note': unknown key; allowed: description, expression, kept, name, std, std_percent, value, z"),
     C("model-kept-string", model_unknown_keys, "predict --model {d}/kept.json --q " + NEUTRAL, 2, "kept.json: key 'coefficients[0].kept': expected true or false; got 'yes'"),
     C("friction-unknown-key", friction_edited, f"validate --robot panda --friction {{d}}/top.json --data {{d}}/log.csv --out {OUT}", 2, "top.json: key 'note': unknown key; allowed: convention, drive"),
     C("friction-joint-unknown-key", friction_edited, f"validate --robot panda --friction {{d}}/joint.json --data {{d}}/log.csv --out {OUT}", 2, "joint.json: key 'joints[0].note': unknown key; allowed: fc, fo, fv"),

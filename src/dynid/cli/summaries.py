@@ -27,6 +27,7 @@ from ..identification.outlying_spans import cut_text
 from ..identification.pieces import gaps_text
 from ..identification.structural import mixed_sign
 from ..identification.structure import JOINT_PREFIX, MIN_WIDTH, joint_side_joints, own_rotors
+from ..identification.vs_description import description_comparison
 from ..io.observer_files import log_labels
 from ..model.robot import Robot
 from ..model.units import JointKinds, joint_unit, unit_said, values_said
@@ -138,19 +139,36 @@ def format_identification(
     head += [f"note: {offsets['note']}"] if isinstance(offsets, dict) and "note" in offsets else []
     head += selection_lines(info.selection)
     head += estimator_lines(info.estimator_choice)
-    lw = text_width("name", model.base.labels[: model.base.rank], 7)
-    head.append(f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}  kept  expression")
-    rows = []
-    for k in range(model.base.rank):
-        e = model.base.expressions[k]
+    return "\n".join(head + _base_table(model, width) + term_lines(model))
+
+
+def _base_table(model: IdentifiedModel, width: int) -> list[str]:
+    """The base parameters' table: value, std %, kept and expression (cut at ``width``);
+    where the description holds inertials, its value of each and ``z`` (the difference in
+    standard deviations, :mod:`~dynid.identification.vs_description`), with the one line
+    that sums them up below the table."""
+    fit, base = model.fit, model.base
+    vs = description_comparison(model)
+    lw = text_width("name", base.labels[: base.rank], 7)
+    described = f" {'description':>13} {'z':>7}" if vs is not None else ""
+    rows = [f"{'#':>3}  {'name':<{lw}} {'value':>13} {'std %':>9}{described}  kept  expression"]
+    for k in range(base.rank):
+        e = base.expressions[k]
         e = e if len(e) <= width else e[: width - 3] + "..."
         pct = fit.std_percent[k]
+        cells = ""
+        if vs is not None:
+            d, z = float(vs.values[k]), float(vs.z[k])
+            cells = (
+                f" {'-' if not np.isfinite(d) else f'{d:+.6g}':>13}"
+                f" {'-' if not np.isfinite(z) else f'{z:+.1f}':>7}"
+            )
         rows.append(
-            f"{k + 1:>3}  {model.base.labels[k]:<{lw}} {fit.beta[k]:>+13.6g} "
-            f"{'-' if not np.isfinite(pct) else f'{pct:.3g}':>9}  "
+            f"{k + 1:>3}  {base.labels[k]:<{lw}} {fit.beta[k]:>+13.6g} "
+            f"{'-' if not np.isfinite(pct) else f'{pct:.3g}':>9}{cells}  "
             f"{'yes' if fit.kept[k] else 'no':<4}  {e}"
         )
-    return "\n".join(head + rows + term_lines(model))
+    return rows + ([] if vs is None else [vs.sentence()])
 
 
 def term_lines(model: IdentifiedModel) -> list[str]:

@@ -5,7 +5,8 @@ Layout of the file (top-level keys)::
     schema, dynid_version, route, seed,
     rank, condition_number, relative_error_percent, residual_rms, sigma, n_rows, rtol,
     scaled_condition_number, dropped_rows, pruned, std_estimator,
-    coefficients: [{"name", "expression", "value", "std", "std_percent", "kept"}, ...],
+    coefficients: [{"name", "expression", "value", "std", "std_percent", "kept",
+        ["description", "z"]}, ...],
     covariance: (r x r) covariance of the values, or null,
     base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol", "gap"},
     terms: the model terms beside the links, in the order stacked (:mod:`dynid.regressors.
@@ -20,6 +21,10 @@ Layout of the file (top-level keys)::
         torque_constant, rotor_inertia "identify" or values, friction_at); with identified
         rotor inertias base.std_labels continue with Ia1 .. Ia_n after the links' 10 n,
     robot: the kinematics (:mod:`dynid.io.robot_json`),
+    vs_description: where the description holds link inertials, the identified base
+        parameters against its own (:mod:`dynid.identification.vs_description`): source,
+        rms_z, n_compared, threshold, beyond [{"name", "z"}], said; each coefficient
+        then holds its ``description`` value and ``z`` (null where not compared),
     metadata: the identification's record (IdentificationInfo, flat): route, reference,
         n_rows, dropped_rows, pruned, max_std_percent, std_estimator, estimator, rtol,
         rank_gap, identifiability, [seed], static: n_configurations,
@@ -62,6 +67,7 @@ from ..friction.laws import LAWS
 from ..identification.info import IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
 from ..identification.model import IdentifiedModel
+from ..identification.vs_description import description_comparison
 from ..model.drive import Drive
 from ..model.units import units_said
 from ..regressors.base import BaseParameters
@@ -140,6 +146,10 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
         }
         for k in range(base.rank)
     ]
+    vs = description_comparison(model)
+    if vs is not None:  # the description's own base parameters, and the distance in stds
+        for c, d, z in zip(coefficients, vs.values, vs.z, strict=True):
+            c["description"], c["z"] = finite_or_none(d), finite_or_none(z)
     out: dict[str, Any] = {
         "schema": MODEL_SCHEMA,
         "dynid_version": __version__,
@@ -166,12 +176,16 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     out["friction"] = frictions[0].params.tolist() if len(frictions) == 1 else None
     out["drive"] = None if model.drive is None else model.drive.as_dict()
     out["robot"] = robot_to_dict(model.description, inertials=True)
+    if vs is not None:
+        out["vs_description"] = _jsonable(vs.as_dict())
     out["metadata"] = info_to_dict(info, model.drive) | friction_metadata(model)
     law = LAWS[frictions[0].law if len(frictions) == 1 else "classical"]
     units = {
         "value": "SI of each expression: m kg, mc kg m, J kg m^2",
         "std": "as value",
         "std_percent": "%",
+        "description": "as value",
+        "z": "standard deviations (std)",
         "relative_error_percent": "%",
         "residual_rms": "N m, kg m^2 for M rows" if info.route == "static" else "N m",
         "sigma": "as residual_rms",
@@ -348,6 +362,23 @@ _COEFFICIENT = Record(
         "std": Field("number", required=True, low=0.0),
         "std_percent": Field("number", required=True, nullable=True, unit="%"),
         "kept": Field("bool", required=True),
+        "description": Field("number", nullable=True),
+        "z": Field("number", nullable=True, unit="std"),
+    }
+)
+#: ``vs_description``: the identified base parameters against the description's
+_VS_DESCRIPTION = Record(
+    {
+        "source": Field("string", required=True),
+        "rms_z": Field("number", required=True, nullable=True, low=0.0),
+        "n_compared": Field("integer", required=True, low=0),
+        "threshold": Field("number", required=True, low=0.0),
+        "beyond": Field(
+            "objects",
+            required=True,
+            record=Record({"name": Field("string", required=True), "z": _NUMBER}),
+        ),
+        "said": Field("string", required=True),
     }
 )
 _BASE = Record(
@@ -404,6 +435,7 @@ MODEL = Format(
             "friction": Field("numbers", nullable=True, shape=("n", None)),
             "drive": Field("object", nullable=True),
             "metadata": Field("object", nullable=True, record=_META),
+            "vs_description": Field("object", nullable=True, record=_VS_DESCRIPTION),
             "units": Field("any"),
             "conventions": Field("any"),
         }

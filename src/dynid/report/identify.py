@@ -990,10 +990,15 @@ def _per_recording_table(doc: dict, record: dict, what: str, judged: bool = Fals
 
 
 def _coefficients_section(doc: dict) -> str:
+    """The base parameters as ``coefficients[]`` holds them, each with its std as a bar;
+    where the file compares them with the description's (``vs_description``), its value
+    of each and ``z``, with the summary's line above the table."""
     coefs = doc.get("coefficients") or []
     if not coefs:
         return ""
     top = max([c.get("std_percent", 0) for c in coefs if is_number(c.get("std_percent"))] + [100])
+    vs = doc.get("vs_description")
+    described = isinstance(vs, dict)
     rows = []
     for k, c in enumerate(coefs):
         s = c.get("std_percent")
@@ -1007,6 +1012,7 @@ def _coefficients_section(doc: dict) -> str:
                 esc(coefficient_unit(c.get("expression", ""))),
                 cell(s),
                 bar(s, top, log=True, bad=UNCERTAIN_PERCENT) if is_number(s) else "",
+                *([cell(c.get("description")), cell(c.get("z"))] if described else []),
                 cell(c.get("kept")),
             ]
         )
@@ -1019,10 +1025,18 @@ def _coefficients_section(doc: dict) -> str:
         "unit",
         "std [%]",
         f"std [%], log scale (red above {UNCERTAIN_PERCENT:g} %)",
+        *(["description's value", "z [std]"] if described else []),
         "kept",
     ]
+    said = ""
+    if isinstance(vs, dict) and isinstance(vs.get("said"), str):
+        said = (
+            f"<p>The identified values {esc(vs['said'])}; z = (value - description's "
+            "value) / std.</p>"
+        )
     return section(
         "coefficients",
         "Coefficients and their standard deviations",
+        said,
         table(headers, rows, cls="coefficients"),
     )
