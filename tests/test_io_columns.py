@@ -504,8 +504,11 @@ def test_a_files_own_sign_negates_every_joint_of_that_file_alone(tmp_path):
     b = load_mapped_torque_log(tmp_path / "b.csv", scaled)
     np.testing.assert_allclose(b.log.tau, -1e-3 * logs["b.csv"].tau, rtol=1e-15)
     assert "(--units b.csv:tau=-1,tau=mNm)" in b.conversions[0], b.conversions
-    with pytest.raises(DataError, match=r"b.csv:tau=mNm: a file's own entry flips the sign"):
-        parse_column_map(None, "b.csv:tau=mNm")
+    milli = parse_column_map(None, "b.csv:tau=mNm")  # a file's own unit (once refused)
+    b = load_mapped_torque_log(tmp_path / "b.csv", milli)
+    np.testing.assert_allclose(b.log.tau, 1e-3 * logs["b.csv"].tau, rtol=1e-15)
+    a = load_mapped_torque_log(tmp_path / "a.csv", milli)
+    np.testing.assert_array_equal(a.log.tau, logs["a.csv"].tau)
 
 
 def test_a_files_own_flip_reads_that_file_alone_and_is_said_with_its_name(tmp_path):

@@ -61,7 +61,9 @@ def test_the_recording_in_degrees_is_named_with_the_columns_to_convert(panda, lo
     with pytest.raises(DataError, match=r"r1.csv: its positions and velocities look like") as e:
         check_degrees(_rec(logs[0], _deg(logs[1]), logs[2]), panda)
     assert "convert its q and dq to radians" in str(e.value)
-    assert "--units applies to every file" in str(e.value)
+    assert "hint: --units r1.csv:q=deg,r1.csv:dq=deg/s reads it in degrees" in str(e.value)
+    with pytest.raises(DataError, match=r"hint: --units tau=-1,r1.csv:q=deg,r1.csv:dq=deg/s "):
+        check_degrees(_rec(logs[0], _deg(logs[1]), logs[2]), panda, "tau=-1")
     with pytest.raises(DataError, match=r"r0.csv: its positions look like degrees") as e:
         check_degrees(_rec(_deg(logs[0], velocities=False), logs[1]), panda)
     assert "convert its q to radians" in str(e.value)

@@ -669,7 +669,9 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="MAP|FILE.toml",
         help="column names of --data: 'q=position_{i0},tau=effort_{i0}' ({i} from 1, {i0} "
-        "from 0) or a TOML file with [columns] and [units]; positions only: velocities "
+        "from 0) or a TOML file with [columns] and [units]; observe also reads label=NAME "
+        "(contact labels) and tau_ext=NAME{i0} (external torques, taken as the truth it is "
+        "scored against); positions only: velocities "
         "from the zero-phase filtered derivative; dq=none reads the log without its velocity "
         "(and acceleration) columns, derived from the positions instead; ddq=none without "
         "its acceleration columns",
@@ -683,5 +685,6 @@ def add_column_options(p: argparse.ArgumentParser) -> None:
         "prismatic joints, an angle unit the revolute ones, both given for both kinds: "
         "q=mm,q=deg,dq=mm/s,dq=deg/s; tau=mA or A: motor "
         "currents, with a --drive of effort = current; tau=-1 flips every joint's sign, "
-        "tau2=-1 joint 2's alone, rec2.csv:tau2=-1 or rec2.csv:tau=-1 in that file alone)",
+        "tau2=-1 joint 2's alone, rec2.csv:tau2=-1 or rec2.csv:tau=-1 in that file alone; "
+        "a file's own unit, rec4.csv:t=ms, in place of every file's for that file)",
     )

@@ -72,51 +72,50 @@ A long event (1 s or more) that a weight at the flange explains is read as a loa
 (or a steady push along gravity: the joint torques cannot tell them apart): its event
 keeps the level load and is scored as any event, and detection runs again without its
 torque for the contacts on top; --no-loads reads no event as a load.
-A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN none)
-named collision, contact or label (the first the log has), or mapped with --columns
-label=NAME, else the true tau_ext that `dynid simulate --contact` writes beside a log (in
-contact where some joint's |tau_ext| exceeds 0.1 N m). A contact is detected when an
-event starts from --label-tolerance (0.1 s) before a label column's contact (labels made
-by hand are late or early by tens of ms; from tau_ext, the true start: 0.02 s or 3
-samples) to --label-tolerance (0.1 s, the observer's lag) after its end (an event still
-open over a later contact detects only the one it started in); an event that detects no
-contact is a false alarm (one starting long before any contact, such as a whole-log
-event: the contacts it covers are missed), marked so in events.json (false_alarm) and the
-report's events table; several false alarms that each start shortly before a missed
-contact and run into it get a note: the labels look shifted by about that much. The
-summary prints per log
-and in total the contacts labelled, detected and missed (each missed one with its times
-and, from tau_ext, its peak true torque, and why where it can be read: the joint stood
-still and its torque is below its at-rest threshold, or below its moving one), the false
-alarms and their rate per minute of
-contact-free time, and the delays (event start less contact start, median and max;
-with velocities derived from the positions, the zero-phase low-pass sees ahead, and the
-delays, shorter than an online observer's, say so); events.json holds them under score;
-residuals.png hatches the labelled contacts. A log without labels is not scored.
-One contact is one event: runs over the threshold closer than --merge (0.2 s) are joined
-(a push near the threshold on a joint at rest crosses it again and again as the
-standstill margin follows the velocity noise), and an event shorter than --min-duration
-(0.01 s) that stays at the contact level is dropped (the velocity noise crosses for a
-few samples). A crossing shorter than --min-duration with no other within half of
---merge is dropped before runs are joined: it neither starts nor extends an event.
---merge 0 --min-duration 0: every run over the threshold. The crossings dropped are
-not contacts but are said: the summary counts them and names those furthest over the
-threshold (time, joint, peak, |r|/contact, duration against --min-duration, the rule),
-and events.json holds them under dropped.
-A torque sample off both neighbours by more than 20 times the noise while the joint moves
-(a one-sample spike, a sensor or logging fault, as identify finds them) is replaced by the
+A log with labelled contacts is scored: a 0/1 column (nonzero in contact; NaN none) named
+collision, contact or label (the first the log has), or mapped with --columns label=NAME,
+else the true tau_ext that `dynid simulate --contact` writes beside a log, or the columns
+--columns tau_ext=NAME{i0} maps (in contact where some joint's |tau_ext| exceeds 0.1 N m):
+whatever is mapped is taken as the truth, so a robot's own estimate (libfranka's
+tau_ext_hat_filtered) scores the observer against that estimate's errors. A contact is
+detected when an event starts from --label-tolerance (0.1 s) before a label column's
+contact (labels made by hand are late or early by tens of ms; from tau_ext, the true
+start: 0.02 s or 3 samples) to --label-tolerance (0.1 s, the observer's lag) after its end
+(an event still open over a later contact detects only the one it started in); an event
+that detects no contact is a false alarm (one starting long before any contact, such as a
+whole-log event: the contacts it covers are missed), marked so in events.json
+(false_alarm) and the report's events table; several false alarms that each start shortly
+before a missed contact and run into it get a note: the labels look shifted by about that
+much. The summary prints per log and in total the contacts labelled, detected and missed
+(each missed one with its times and, from tau_ext, its peak true torque, and why where it
+can be read: the joint stood still and its torque is below its at-rest threshold, or below
+its moving one), the false alarms and their rate per minute of contact-free time, and the
+delays (event start less contact start, median and max; with velocities derived from the
+positions, the zero-phase low-pass sees ahead, and the delays, shorter than an online
+observer's, say so); events.json holds them under score; residuals.png hatches the
+labelled contacts. A log without labels is not scored. One contact is one event: runs over
+the threshold closer than --merge (0.2 s) are joined (a push near the threshold on a joint
+at rest crosses it again and again as the standstill margin follows the velocity noise),
+and an event shorter than --min-duration (0.01 s) that stays at the contact level is
+dropped (the velocity noise crosses for a few samples). A crossing shorter than
+--min-duration with no other within half of --merge is dropped before runs are joined: it
+neither starts nor extends an event. --merge 0 --min-duration 0: every run over the
+threshold. The crossings dropped are not contacts but are said: the summary counts them
+and names those furthest over the threshold (time, joint, peak, |r|/contact, duration
+against --min-duration, the rule), and events.json holds them under dropped. A torque
+sample off both neighbours by more than 20 times the noise while the joint moves (a
+one-sample spike, a sensor or logging fault, as identify finds them) is replaced by the
 line between its neighbours before the observer runs, calibrating or detecting, with a
-warning naming the file, the joints, the counts and the times: never an event.
-Several logs (or a folder of them): residuals_<name>.csv and .png each, one events.json;
-logs of one name in different folders are named by their folder. With --thresholds the
+warning naming the file, the joints, the counts and the times: never an event. Several
+logs (or a folder of them): residuals_<name>.csv and .png each, one events.json; logs of
+one name in different folders are named by their folder. With --thresholds the
 calibration's options (--gain, --discretisation, --rule, --margin, --quantile,
---collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused:
-the file fixes them; --frame, --wrench, --merge, --min-duration and --label-tolerance
-apply to detection only.
-A model identified with --torque-delay prepares the logs with that delay (their states
-read that much earlier): the summary, thresholds.json's calibration and events.json
-("torque_delay_used") and the report's options say the delay and whether it was given or
-the model's; --torque-delay 0 observes without it.
+--collision-factor, --k-sigma, --no-uncertainty, --no-standstill-margin) are refused: the
+file fixes them; --frame, --wrench, --merge, --min-duration and --label-tolerance apply to
+detection only. A model identified with --torque-delay prepares the logs with that delay
+(their states read that much earlier): the summary, thresholds.json's calibration and
+events.json ("torque_delay_used") and the report's options say the delay and whether it
+was given or the model's; --torque-delay 0 observes without it.
 
 Examples:
   dynid observe --model id/identification.json --data free.csv --calibrate --out cal

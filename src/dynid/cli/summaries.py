@@ -1111,7 +1111,8 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     if truth:
         rows.append(
             f"r - tau_ext: the residual against the true external torques of {len(truth)} "
-            "log(s) (columns tau_ext, a simulation's ground truth), the observer's lag included"
+            "log(s) (columns tau_ext, a simulation's ground truth, or those --columns "
+            "tau_ext= maps, taken as the reference), the observer's lag included"
         )
     if calibrating:
         what = "largest" if th.quantile == 1.0 else f"{th.quantile:g} quantile of the"

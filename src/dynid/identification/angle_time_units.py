@@ -88,11 +88,19 @@ class GivenUnits:
     lengths : mapping of str to float
         Quantity -> the factor to SI the prismatic joints' ``q``, ``dq``, ``ddq`` were
         read with (``{"dq": 1e-3}`` for ``dq=mm/s``); missing: 1.
+    files : mapping of str to GivenUnits
+        A file's name -> the units it was read with where they are its own (``--units
+        rec4.csv:t=ms``), the same ``text``; the other files read with these.
     """
 
     text: str | None = None
     factors: Mapping[str, float] = field(default_factory=dict)
     lengths: Mapping[str, float] = field(default_factory=dict)
+    files: Mapping[str, GivenUnits] = field(default_factory=dict)
+
+    def of(self, name: str) -> GivenUnits:
+        """The units the file ``name`` was read with (:attr:`files`, else these)."""
+        return self.files.get(name, self)
 
     def factor(self, quantity: str) -> float:
         """The factor [1] ``quantity`` was read with, its sign left out (a sign flip is no

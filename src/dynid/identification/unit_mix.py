@@ -57,6 +57,7 @@ from .angle_time_units import (
     rate_verdict,
     time_unit,
     time_unit_said,
+    unit_name,
 )
 from .log import TorqueLog, joint_side_log
 from .velocity_scale import prismatic_scale_finding, velocity_scale_finding
@@ -67,6 +68,7 @@ __all__ = [
     "LIMIT_MARGIN",
     "degrees_among_radians",
     "joints_in_degrees",
+    "time_unit_read",
     "unit_findings",
 ]
 
@@ -140,14 +142,15 @@ def degrees_among_radians(
         said = ", ".join(who) if len(who) <= 3 else "the other recordings"
         what = "positions and velocities" if both else "positions"
         cols = "q and dq" if both else "q"
+        own = f"{names[r]}:q=deg" + (f",{names[r]}:dq=deg/s" if both else "")
         return r, (
             f"its {what} look like degrees among recordings in radians: positions "
             f"{k:.3g} times those of {said}"
             + (f" (velocities {kv:.3g} times)" if both else "")
             + f", and joint {robot.joint_names[j]} spans [{lo[j]:.4g}, {hi[j]:.4g}], outside "
             f"its limits [{robot.q_min[j]:.4g}, {robot.q_max[j]:.4g}] unless read in "
-            f"degrees; hint: convert its {cols} to radians (x pi/180) or leave it out "
-            "(--units applies to every file)"
+            f"degrees; hint: --units {own} reads it in degrees (a file's own entry), or "
+            f"convert its {cols} to radians (x pi/180)"
         )
     return None
 
@@ -339,3 +342,14 @@ def unit_findings(
     if (scaled := velocity_scale_finding(robot, side, given, [*joints, *skip])) is not None:
         found.append(scaled)
     return joined_unit_findings(found, given.text) if found else None
+
+
+def time_unit_read(robot: Robot, log: TorqueLog, given: GivenUnits | None = None) -> str:
+    """The ``--units t=`` spelling of the unit ``log``'s time column is in: the one its
+    velocities tell (:func:`~dynid.identification.angle_time_units.time_unit`, judged as
+    :func:`unit_findings` judges it, a prismatic joint's velocities in mm/s left out),
+    else the one it was read in (``given``)."""
+    given = given or GivenUnits()
+    rail = prismatic_scale_finding(robot, log, given)
+    found = time_unit(log, given.factor("t"), () if rail is None else rail[1])
+    return found[0] if found is not None else unit_name("t", given.factor("t"))

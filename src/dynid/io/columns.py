@@ -92,6 +92,7 @@ __all__ = [
     "load_mapped_static_data",
     "load_mapped_torque_log",
     "load_joint_columns",
+    "load_external_torques",
     "load_label_column",
     "load_time_column",
     "unread_columns",
@@ -107,6 +108,7 @@ _DEFAULT = {
     "M": "M{i}_{j}",
     "g": "g{i}",
     "label": "label",
+    "tau_ext": "tau_ext{i}",
 }
 #: The template that reads a log without a quantity's columns (``--columns dq=none``).
 IGNORED = "none"
@@ -131,6 +133,7 @@ _UNITS: dict[str, dict[str, float]] = {
     "tau": {**_TORQUE, **CURRENT_UNITS},
     "g": _TORQUE,
     "M": {"kg m^2": 1.0, "g m^2": 1e-3},
+    "tau_ext": _TORQUE,
 }
 
 
@@ -189,6 +192,11 @@ class ColumnMap:
         ``{"q": "mm"}``, ``names`` holding ``{"q": "deg"}``): the prismatic joints' columns
         read in it, the revolute joints' in the angle unit (the robot's kinds needed,
         :meth:`for_robot`).
+    file_units : mapping of str to mapping of str to str or tuple of str
+        A file's name -> its own units, quantity -> the unit as given (or a joint
+        quantity's length and angle units, ``("mm", "deg")``), in place of every file's
+        for that file alone (``--units rec4.csv:t=ms``: ``{"rec4.csv": {"t": "ms"}}``,
+        :meth:`for_file`): recordings logged in different units read in one run.
     """
 
     columns: Mapping[str, str] = field(default_factory=dict)
@@ -200,6 +208,7 @@ class ColumnMap:
     file_signs: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
     prismatic: tuple[bool, ...] | None = None
     lengths: Mapping[str, str] = field(default_factory=dict)
+    file_units: Mapping[str, Mapping[str, str | tuple[str, ...]]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for key in list(self.columns) + list(self.factors):
@@ -225,6 +234,15 @@ class ColumnMap:
                 {k: _checks.frozen_mapping(dict(v)) for k, v in self.file_flips.items()}
             ),
         )
+        for units in self.file_units.values():
+            _own_factors(units)  # each unit checked as every file's is
+        object.__setattr__(
+            self,
+            "file_units",
+            _checks.frozen_mapping(
+                {k: _checks.frozen_mapping(dict(v)) for k, v in self.file_units.items()}
+            ),
+        )
         object.__setattr__(self, "flips", _checks.frozen_mapping(dict(self.flips)))
         signs = {k: tuple(v) for k, v in self.file_signs.items()}
         object.__setattr__(self, "file_signs", _checks.frozen_mapping(signs))
@@ -238,38 +256,40 @@ class ColumnMap:
         cls, columns: Mapping[str, str], units: Mapping[str, Any], **kw: Any
     ) -> ColumnMap:
         """Map from templates and unit names (``{"q": "deg", "tau": "mNm"}``; one length
-        and one angle unit of ``q``, ``dq`` or ``ddq`` as a pair, ``{"q": ["mm", "deg"]}``)
-        and single joints' sign flips (``{"tau2": -1}``)."""
-        units, lengths = _split_kinds(units)
+        and one angle unit of ``q``, ``dq`` or ``ddq`` as a pair, ``{"q": ["mm", "deg"]}``),
+        single joints' sign flips (``{"tau2": -1}``) and a file's own entries, prefixed by
+        its name: sign flips (``{"rec2.csv:tau4": -1}``, ``{"rec2.csv:tau": -1}``) or units
+        (``{"rec4.csv:t": "ms"}``)."""
+        own = {k: u for k, u in units.items() if ":" in k}
+        units, lengths = _split_kinds({k: u for k, u in units.items() if ":" not in k})
         flips: dict[str, set[int]] = {}
         files: dict[str, dict[str, set[int]]] = {}
         whole: dict[str, set[str]] = {}  # a file's quantities negated on every joint
+        file_units: dict[str, dict[str, str | tuple[str, ...]]] = {}
+        for key, u in own.items():
+            name, _, quantity = (x.strip() for x in key.rpartition(":"))
+            if not name:
+                raise DataError(f"{key}={u}: a file's own entry starts with its name (FILE:t=ms)")
+            if quantity in _FLIPPABLE and _is_sign(u):
+                if _sign_flip(key, u):  # (FILE:tau=1: read as it is)
+                    whole.setdefault(name, set()).add(quantity)
+            elif (joint := _joint_key(quantity)) is not None:
+                if _sign_flip(quantity, u):
+                    files.setdefault(name, {}).setdefault(joint[0], set()).add(joint[1])
+            else:
+                said = tuple(str(v) for v in u) if isinstance(u, list | tuple) else str(u)
+                try:
+                    _own_factors({quantity: said})
+                except DataError as exc:
+                    raise DataError(f"--units {key}: {exc}") from None
+                file_units.setdefault(name, {})[quantity] = said
         for key, u in units.items():
-            if ":" in key:
-                name, _, own = key.rpartition(":")
-                if own.strip() in _FLIPPABLE and name.strip() and _is_sign(u):
-                    if _sign_flip(key, u):  # (FILE:tau=1: read as it is)
-                        whole.setdefault(name.strip(), set()).add(own.strip())
-                    continue
-                if (joint := _joint_key(own)) is None or not name.strip():
-                    raise DataError(
-                        f"{key}={u}: a file's own entry flips the sign of single joints "
-                        f"(FILE:tau4=-1) or of all (FILE:tau=-1); units other than a sign "
-                        "are every file's"
-                    )
-                if _sign_flip(own, u):
-                    files.setdefault(name.strip(), {}).setdefault(joint[0], set()).add(joint[1])
-            elif (joint := _joint_key(key)) is not None:
+            if (joint := _joint_key(key)) is not None:
                 if _sign_flip(key, u):
                     flips.setdefault(joint[0], set()).add(joint[1])
-            elif key not in _DEFAULT:
-                raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
-            elif key == "label":
-                raise DataError(
-                    f"label={u}: a label column has no unit (nonzero is in contact); give "
-                    "its name with --columns label=NAME"
-                )
-        given = {k: u for k, u in units.items() if _joint_key(k) is None and ":" not in k}
+            else:
+                _check_quantity(key, u)
+        given = {k: u for k, u in units.items() if _joint_key(k) is None}
         factors = {k: _to_factor(k, u) for k, u in given.items()}
         names = {k: str(u) for k, u in given.items()}
         signs = {k: tuple(sorted(v)) for k, v in flips.items()}
@@ -282,31 +302,38 @@ class ColumnMap:
             file_flips=per_file,
             file_signs={f: tuple(sorted(q)) for f, q in whole.items()},
             lengths=lengths,
+            file_units=file_units,
             **kw,
         )
 
     def for_file(self, name: str) -> ColumnMap:
         """The map the file ``name`` is read with: the flips of every file and its own
-        (:attr:`file_flips`, kept as its only entry for the notes), without the other
-        files' own."""
-        if not self.file_flips and not self.file_signs:
+        (:attr:`file_flips`, kept as its only entry for the notes), its own units in place
+        of every file's (:attr:`file_units`), without the other files' own entries."""
+        if not self.file_flips and not self.file_signs and not self.file_units:
             return self
         own = self.file_flips.get(name, {})
         flips = {
             k: tuple(sorted({*self.flips.get(k, ()), *own.get(k, ())})) for k in {*self.flips, *own}
         }
+        units = self.file_units.get(name, {})
+        factors, names, lengths = _own_factors(units)
+        factors = {**self.factors, **factors}
+        names = {**self.names, **names}
+        lengths = {**{k: v for k, v in self.lengths.items() if k not in units}, **lengths}
         negated = self.file_signs.get(name, ())
-        factors = {**self.factors, **{k: -self.factor(k) for k in negated}}
+        factors = {**factors, **{k: -float(factors.get(k, 1.0)) for k in negated}}
         return ColumnMap(
             self.columns,
             factors,
             self.velocity_cutoff_hz,
-            names=self.names,
+            names=names,
             flips=flips,
             file_flips={name: own} if own else {},
             file_signs={name: negated} if negated else {},
             prismatic=self.prismatic,
-            lengths=self.lengths,
+            lengths=lengths,
+            file_units={name: units} if units else {},
         )
 
     def unknown_files(self, names: Sequence[str]) -> tuple[str, ...]:
@@ -316,8 +343,8 @@ class ColumnMap:
     @property
     def own_files(self) -> tuple[str, ...]:
         """The files named by a file's own entry (``rec2.csv:tau4=-1``,
-        ``rec2.csv:tau=-1``), in the order given."""
-        return tuple(dict.fromkeys([*self.file_flips, *self.file_signs]))
+        ``rec2.csv:tau=-1``, ``rec4.csv:t=ms``), in the order given."""
+        return tuple(dict.fromkeys([*self.file_flips, *self.file_signs, *self.file_units]))
 
     @property
     def tau_is_current(self) -> bool:
@@ -341,7 +368,15 @@ class ColumnMap:
             parts.append(f"{k} in {given} (x {f:.17g} to {to})")
         for k, length in self.lengths.items():
             parts.append(f"{k} in {length} (x {_UNITS[k][length]:.17g} to SI)")
-        return None if not parts else "data read with --units " + ", ".join(parts)
+        own = []
+        for name, units in self.file_units.items():
+            factors, names, lengths = _own_factors(units)
+            said = [f"{k} in {names[k]} (x {f:.17g} to SI)" for k, f in factors.items()]
+            said += [f"{k} in {u} (x {_UNITS[k][u]:.17g} to SI)" for k, u in lengths.items()]
+            own.append(f"{name} alone: " + ", ".join(said))
+        if not parts and not own:
+            return None
+        return "data read with --units " + "; ".join([", ".join(parts)] * bool(parts) + own)
 
     def template(self, quantity: str) -> str:
         """The column template of a quantity."""
@@ -468,6 +503,46 @@ class ColumnMap:
 
 #: The quantities whose single joints' columns ``--units`` can flip (``tau2=-1``).
 _FLIPPABLE = ("q", "dq", "ddq", "tau")
+
+
+def _check_quantity(key: str, unit: Any) -> None:
+    """Refuse a ``--units`` entry of an unknown quantity or of ``label`` (no unit).
+
+    Raises
+    ------
+    DataError
+        Naming the entry and the quantities.
+    """
+    if key not in _DEFAULT:
+        raise DataError(f"unknown quantity {key!r}; expected one of {list(_DEFAULT)}")
+    if key == "label":
+        raise DataError(
+            f"label={unit}: a label column has no unit (nonzero is in contact); give "
+            "its name with --columns label=NAME"
+        )
+
+
+def _own_factors(
+    units: Mapping[str, Any],
+) -> tuple[dict[str, float], dict[str, str], dict[str, str]]:
+    """A file's own units (quantity -> unit, or a joint quantity's pair of a length and
+    an angle unit) as :meth:`ColumnMap.from_units` reads every file's: the factors to SI,
+    the units as given and the length units given beside an angle unit.
+
+    Raises
+    ------
+    DataError
+        An unknown quantity or unit, two units that are not one length and one angle unit.
+    """
+    kept, lengths = _split_kinds(
+        {k: list(u) if isinstance(u, tuple) else u for k, u in units.items()}
+    )
+    for k, u in kept.items():
+        _check_quantity(k, u)
+    factors = {k: _to_factor(k, u) for k, u in kept.items()}
+    return factors, {k: str(u) for k, u in kept.items()}, lengths
+
+
 #: The index fields of a template of ``M``: row, column, flat (column-major).
 _ROW, _COL, _FLAT = ("i", "i0"), ("j", "j0"), ("k", "k0")
 
@@ -567,7 +642,7 @@ def _pairs(text: str, what: str) -> dict[str, str | list[str]]:
             raise DataError(f"{what} must read 'quantity=value,...'; got {part!r} in {text!r}")
         if key in out:
             held = out[key]
-            if what == "--units" and key in _JOINT_QUANTITIES:
+            if what == "--units" and key.rpartition(":")[2].strip() in _JOINT_QUANTITIES:
                 out[key] = [held, value] if isinstance(held, str) else [*held, value]
                 continue
             raise DataError(f"{what}: {key!r} is given twice in {_checks.short(text)}")
@@ -936,7 +1011,8 @@ def _guessed_hint(header: Sequence[str], name: str, cmap: ColumnMap) -> str:
     """``; hint: --columns '...' --units '...' reads the file``: the map guessed from a
     CSV's header (:func:`~dynid.io.column_hint.guessed_map`, the templates given kept) with
     the ``--units`` given kept and the units the names say added for the quantities
-    without one given; empty when nothing is guessed."""
+    without one given; empty when nothing is guessed. A header of dynid's own names
+    (``t, q1.., dq1.., tau1..``: the empty map, ``--columns ''``) is said to be one."""
     guess = guessed_map(header, cmap.columns) if name.lower().endswith(".csv") else ""
     if not guess:
         return ""
@@ -944,7 +1020,13 @@ def _guessed_hint(header: Sequence[str], name: str, cmap: ColumnMap) -> str:
     units = dict(e.split("=", 1) for e in said.strip("'").split(",") if "=" in e)
     units.update(_given_units(cmap))
     text = ",".join(f"{k}={v}" for k, v in [*units.items(), *cmap.lengths.items()])
-    return f"; hint: {spec}" + (f" --units '{text}'" if text else "") + " reads the file"
+    with_units = f" --units '{text}'" if text else ""
+    if spec == "--columns ''":
+        return (
+            "; hint: the file has dynid's own column names (t, q1.., dq1.., tau1..), not "
+            f"those of the map: --columns ''{with_units} (an empty map) reads them as they are"
+        )
+    return f"; hint: {spec}{with_units} reads the file"
 
 
 def _given_units(cmap: ColumnMap) -> dict[str, str]:
@@ -957,6 +1039,10 @@ def _given_units(cmap: ColumnMap) -> dict[str, str]:
     for f, own in cmap.file_flips.items():
         out |= {f"{f}:{k}{j + 1}": "-1" for k, joints in own.items() for j in joints}
     out |= {f"{f}:{k}": "-1" for f, signs in cmap.file_signs.items() for k in signs}
+    for f, units in cmap.file_units.items():
+        out |= {  # a pair typed as two entries (rec4.csv:q=mm,rec4.csv:q=deg)
+            f"{f}:{k}": u if isinstance(u, str) else f",{f}:{k}=".join(u) for k, u in units.items()
+        }
     return out
 
 
@@ -991,23 +1077,38 @@ def unread_columns(header: Sequence[str], columns: ColumnMap) -> tuple[str, ...]
     """The columns of a file of header ``header`` that a torque log read through
     ``columns`` leaves unread: named by none of its quantities' templates (``t, q, dq, tau,
     ddq``; a quantity left out, ``dq=none``, names none), and neither contact labels nor
-    true external torques, which ``dynid observe`` reads."""
-    quantities = ("t", "q", "dq", "tau", "ddq")
+    external torques (``tau_ext``'s template, mapped or dynid's ``tau_ext1..n``), which
+    ``dynid observe`` reads."""
+    quantities = ("t", "q", "dq", "tau", "ddq", "tau_ext")
     read = _referenced(list(header), columns, quantities)
     label = {columns.template("label")} if columns.mapped("label") else set(LABEL_COLUMNS)
-    return tuple(
-        c for c in header if c not in read and c not in label and not re.fullmatch(r"tau_ext\d*", c)
-    )
+    return tuple(c for c in header if c not in read and c not in label)
+
+
+#: A column whose name says external joint torques (libfranka's ``tau_ext_hat_filtered_0``,
+#: ``external_torque_1``, ``ext_tau3``).
+_EXTERNAL = re.compile(r"(?i).*(tau_?ext|ext(ernal)?_?(tau|torque|effort)).*")
 
 
 def unread_note(unread: Sequence[str], n: int) -> str:
     """One line naming the columns ``unread`` (a family of ``n`` joints' columns as
-    ``first..last``) of a file read through ``--columns``."""
+    ``first..last``) of a file read through ``--columns``, and of a family whose name says
+    external joint torques (``tau_ext_hat_filtered_0..6``) the ``--columns tau_ext=``
+    entry that has ``observe`` read it as its reference."""
     families = joint_families(list(unread), n)
     grouped = {c for cols in families.values() for c in cols}
     shown = [f"{cols[0]}..{cols[-1]}" for cols in families.values()]
     shown += [c for c in unread if c not in grouped]
-    return f"column(s) {', '.join(shown)} named by no --columns entry: not read"
+    said = f"column(s) {', '.join(shown)} named by no --columns entry: not read"
+    external = [tpl for tpl, cols in families.items() if _EXTERNAL.fullmatch(cols[0])]
+    if external:
+        said += (
+            f"; {families[external[0]][0]}..{families[external[0]][-1]} look like external "
+            f"joint torques: --columns tau_ext={external[0]} has observe compare its residual "
+            "with them, taken as the reference (an estimate of the robot's own, such as "
+            "libfranka's tau_ext_hat_filtered, is scored as if it were the truth)"
+        )
+    return said
 
 
 def load_mapped_torque_log(
@@ -1129,6 +1230,67 @@ def load_joint_columns(path: str | Path, name: str, n: int) -> NDArray[np.float6
     return _vector(table, cmap, "tau", n)
 
 
+def load_external_torques(
+    path: str | Path, columns: ColumnMap | None, n: int
+) -> tuple[str, NDArray[np.float64] | None, NDArray[np.float64]] | None:
+    """The external joint torques stored beside a log and the times of its rows: the
+    columns ``columns`` maps ``tau_ext`` to (``--columns tau_ext=tau_ext_hat_filtered_{i0}``,
+    in the unit of ``--units tau_ext=``), else dynid's ``tau_ext1 .. tau_extn`` (CSV) or
+    array ``tau_ext`` (NPZ) that ``dynid simulate --contact`` writes. Rows as stored (NaN
+    kept): the caller aligns them with the cleaned log by their times.
+
+    Parameters
+    ----------
+    path : str or Path
+    columns : ColumnMap, optional
+        The map the log is read with (its ``t`` template and unit too:
+        :meth:`ColumnMap.for_file` of the file's name).
+    n : int
+        The joint count.
+
+    Returns
+    -------
+    (str, ndarray (N,) or None, ndarray (N, n)) or None
+        Where they were read (``columns tau_ext1..tau_ext7``), ``t`` [s] (None: no time
+        column) and the torques [N m]; None when the file has none.
+
+    Raises
+    ------
+    DataError
+        A ``tau_ext`` mapped that the file lacks, some but not all of its columns, a
+        malformed file.
+    """
+    path = Path(path)
+    cmap = (columns or ColumnMap()).for_file(path.name)
+    mapped = cmap.mapped("tau_ext")
+    tpl = cmap.template("tau_ext")
+    if not mapped and path.suffix.lower() == ".npz":
+        tpl = "tau_ext"
+    own = ColumnMap(
+        {"t": cmap.template("t"), "tau_ext": tpl},
+        {k: cmap.factor(k) for k in ("t", "tau_ext")},
+    )
+    try:
+        table = _read_table(path, own, ("t", "tau_ext"))
+    except DataError as exc:
+        if mapped or "no column the map names" not in str(exc):
+            raise
+        return None
+    ext = _vector(table, own, "tau_ext", n)
+    if ext is None:
+        if not mapped:
+            return None
+        first = _fill(tpl, 0) if "{" in tpl else tpl
+        raise DataError(
+            f"no column {first!r} for 'tau_ext' (--columns tau_ext={tpl}); {table.has()}",
+            file=path.name,
+        )
+    t = table.columns.get(own.template("t"))
+    t = None if t is None else np.asarray(t, dtype=np.float64).reshape(-1) * own.factor("t")
+    said = [_fill(tpl, 0), _fill(tpl, n - 1)] if "{" in tpl else [tpl]
+    return f"columns {'..'.join(said)}" if len(said) > 1 else f"array {tpl!r}", t, ext
+
+
 def load_time_column(path: str | Path) -> NDArray[np.float64] | None:
     """The times ``t`` [s] (N,) of a log's rows as stored (NaN kept, no row dropped), the
     column (CSV) or array (NPZ) ``t``, or None when the file has none: what aligns a signal
@@ -1176,7 +1338,7 @@ def load_label_column(
         A column of a default name that is not numbers (read as no labels).
     """
     path = Path(path)
-    cmap = columns if columns is not None else ColumnMap()
+    cmap = (columns if columns is not None else ColumnMap()).for_file(path.name)
     present = _header(path)
     if cmap.mapped("label"):
         name = cmap.template("label")

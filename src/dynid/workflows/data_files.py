@@ -147,6 +147,7 @@ def column_map(
                 flips={**cmap.flips, **extra.flips},
                 file_flips={**cmap.file_flips, **extra.file_flips},
                 file_signs={**cmap.file_signs, **extra.file_signs},
+                file_units={**cmap.file_units, **extra.file_units},
             )
     else:
         cmap = parse_column_map(columns, units, **kw)

@@ -557,6 +557,8 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
     wants_margin = opts.standstill if given is None else given.standstill
     files = data_files(opts.data)
     columns, cmap = _model_columns(model, recorded, opts.columns, files)  # said once
+    if cmap is not None and cmap.mapped("tau_ext"):
+        _log.log(NOTE, "%s", _reference_note(cmap))
     read = _read_logs(
         files, model, cmap, _Reading(opts.drop_invalid, opts.q_start, opts.max_gap),
         among=opts.calibrate, recorded=recorded, units=(columns[1], opts.columns[1]),
@@ -565,9 +567,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
         read, model.robot.joint_names, SPIKES_BEFORE_OBSERVER, min_rate_hz=SPIKE_RATE_HZ
     )
     if given is None:
-        cal = _calibrated(
-            read, model, columns[0] is not None, opts, options, wants_std, wants_margin
-        )
+        cal = _calibrated(read, model, cmap, opts, options, wants_std, wants_margin)
         th = _recorded_calibration(cal.thresholds, read.logs, fingerprint)
         return dataclasses.replace(cal, thresholds=th, fingerprint=fingerprint, friction_source=own)
     paths = tuple(map(Path, read.paths))
@@ -599,7 +599,7 @@ def observe_files(opts: ObserveOptions, sink: ResidualSink | None = None) -> Obs
             detected_log(
                 prep,
                 model,
-                columns[0] is not None,
+                cmap,
                 given,
                 options,
                 wants=(wants_std, wants_margin),
@@ -757,6 +757,18 @@ def friction_source(opts: ObserveOptions) -> str | None:
     return None if spec.lower().endswith(".json") else Path(spec).name
 
 
+def _reference_note(cmap: ColumnMap) -> str:
+    """What a ``tau_ext`` mapped (``--columns tau_ext=NAME``) is taken for: the truth the
+    residual is scored and its RMS error measured against, whatever the columns hold."""
+    tpl = cmap.template("tau_ext")
+    return (
+        f"tau_ext read from {tpl} (--columns tau_ext={tpl}): taken as the true external "
+        "torques, the score and RMS r - tau_ext are against them; a robot's own estimate "
+        "(libfranka's tau_ext_hat_filtered) carries its own model's errors, which count "
+        "here as the observer's"
+    )
+
+
 def read_log_as_identified(
     path: str | Path, model: IdentifiedModel, *, drop_invalid: bool = False
 ) -> TorqueLog:
@@ -903,7 +915,7 @@ def _judge_sign(name: str, sign: TorqueSign, noise: GainNoiseTally, names: Seque
 def _calibrated(
     read: Recorded,
     model: ObserverModel,
-    mapped: bool,
+    cmap: ColumnMap | None,
     opts: ObserveOptions,
     options: ObserverOptions,
     wants_std: bool,
@@ -967,7 +979,7 @@ def _calibrated(
                 yield blk
             _judge_sign(Path(path).name, sign, mine, names)
             tally.merge(mine)
-            logs.append(_observation(prep, model, mapped, opts, keep, peak, seen))
+            logs.append(_observation(prep, model, cmap, opts, keep, peak, seen))
 
     # calibrate reads a block's residual, then its margin and std: these two come from the
     # block the residual was last read from (one block held; itertools.tee would keep up
@@ -1113,7 +1125,7 @@ def _settled(x: ObservedBlock, n: int) -> NDArray[np.float64]:
 def _observation(
     prep: PreparedLog,
     model: ObserverModel,
-    mapped: bool,
+    cmap: ColumnMap | None,
     opts: ObserveOptions,
     keep: Series | None,
     peak: NDArray[np.float64],
@@ -1124,7 +1136,7 @@ def _observation(
     path, log = prep.path, prep.log
 
     def run() -> LogObservation:
-        ext = None if keep is None else true_torques(prep, model, mapped)
+        ext = None if keep is None else true_torques(prep, model, cmap)
         return LogObservation(
             path,
             log.t,

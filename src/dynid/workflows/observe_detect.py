@@ -29,7 +29,7 @@ from .. import _checks
 from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
-from ..io.columns import ColumnMap, load_joint_columns, load_label_column, load_time_column
+from ..io.columns import ColumnMap, load_external_torques, load_label_column
 from ..observer.calibration_check import detectable
 from ..observer.carried_load import (
     MIN_LOAD_S,
@@ -118,11 +118,20 @@ class ResidualSink(Protocol):
         ...
 
 
-def true_torques(prep: PreparedLog, model: ObserverModel, mapped: bool) -> NDArray | None:
-    """The true external torques ``tau_ext`` (N, n) [N m] stored beside a log of dynid's
-    (``dynid simulate --contact``), one per row of the cleaned log: rows dropped while
-    reading (``--drop-invalid``) are matched by their times, as the labels are
-    (:func:`contact_labels`); or None (none, a log read through a column map).
+def true_torques(
+    prep: PreparedLog, model: ObserverModel, columns: ColumnMap | None
+) -> NDArray | None:
+    """The external torques ``tau_ext`` (N, n) [N m] stored beside a log, one per row of
+    the cleaned log: the columns ``columns`` maps ``tau_ext`` to, else dynid's
+    ``tau_ext1..n`` (``dynid simulate --contact``) (:func:`~dynid.io.columns.
+    load_external_torques`), taken as the truth the residual is scored against; rows
+    dropped while reading (``--drop-invalid``) are matched by their times, as the labels
+    are (:func:`contact_labels`); or None (none stored).
+
+    Raises
+    ------
+    DataError
+        A ``tau_ext`` mapped that the log lacks.
 
     Warns
     -----
@@ -130,12 +139,14 @@ def true_torques(prep: PreparedLog, model: ObserverModel, mapped: bool) -> NDArr
         True torques whose times are not the log's: no score and no error against them.
     """
     path, log_t = prep.path, prep.log.t
-    if mapped or path.suffix.lower() not in (".csv", ".npz"):
+    if path.suffix.lower() not in (".csv", ".npz"):
         return None
-    ext = load_joint_columns(path, "tau_ext", model.n)
-    if ext is None or ext.shape[0] == log_t.shape[0]:
+    found = load_external_torques(path, columns, model.n)
+    if found is None:
+        return None
+    _, t, ext = found
+    if ext.shape[0] == log_t.shape[0]:
         return ext
-    t = load_time_column(path)
     rows = None if t is None or t.shape[0] != ext.shape[0] else _stored_rows(t, log_t)
     if rows is None:
         warnings.warn(
@@ -191,7 +202,7 @@ def contact_labels(prep: PreparedLog, columns: ColumnMap | None) -> Labels | Non
 def _detected_once(
     prep: PreparedLog,
     model: ObserverModel,
-    mapped: bool,
+    columns: ColumnMap | None,
     thresholds: Thresholds,
     options: ObserverOptions,
     *,
@@ -238,7 +249,7 @@ def _detected_once(
         sample_period_s=period,
     )
     keep = Series.new(prep, n, *wants) if keep_series else None
-    ext = in_file(prep.path, lambda: true_torques(prep, model, mapped))
+    ext = in_file(prep.path, lambda: true_torques(prep, model, columns))
     stats = _Running(n)
     sign = TorqueSign(n)
     strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
@@ -312,7 +323,7 @@ def _detected_once(
 def detected_log(
     prep: PreparedLog,
     model: ObserverModel,
-    mapped: bool,
+    columns: ColumnMap | None,
     thresholds: Thresholds,
     options: ObserverOptions,
     *,
@@ -339,7 +350,7 @@ def detected_log(
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         first = _detected_once(
-            prep, model, mapped, thresholds, options, table=table, samples=samples, **kw
+            prep, model, columns, thresholds, options, table=table, samples=samples, **kw
         )
     if not log.t.shape[0]:
         _said_again(said)
@@ -356,7 +367,7 @@ def detected_log(
     kw["picks"] = load_events(found, first.events)
     again = None if retable is None else retable(loads=found)  # its header names them
     return _detected_once(
-        prep, model, mapped, thresholds, options, table=again, carried=found, **kw
+        prep, model, columns, thresholds, options, table=again, carried=found, **kw
     )
 
 

@@ -65,7 +65,7 @@ from numpy.typing import NDArray
 
 from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning, OptionError
-from ..identification.angle_time_units import GivenUnits
+from ..identification.angle_time_units import GivenUnits, units_with
 from ..identification.derivative_columns import (
     DDQ_NOISE_RATIO,
     SCALE_OFF,
@@ -86,10 +86,12 @@ from ..identification.recorded_signs import SignFinding, recording_sign_findings
 from ..identification.reversed_among import reversed_among
 from ..identification.sanity import too_few_samples, torque_unit_finding
 from ..identification.spikes import despiked, spike_finding
+from ..identification.time_units_among import time_units_hint, time_units_said
 from ..identification.unit_mix import (
     LIMIT_MARGIN,
     degrees_among_radians,
     joints_in_degrees,
+    time_unit_read,
     unit_findings,
 )
 from ..identification.velocity_noise import moving_joints
@@ -580,10 +582,17 @@ def note_unread_columns(rec: Recorded, cmap: ColumnMap | None) -> None:
 def given_units(cmap: ColumnMap | None, text: str | None) -> GivenUnits:
     """The units the logs were read with (``cmap``'s factors: of ``q``, ``dq``, ``ddq``
     the revolute joints' and the prismatic joints', each kind read in its own unit or in
-    SI, :meth:`~dynid.io.columns.ColumnMap.joint_factors`) and the ``--units`` text given,
-    for the unit findings' hint."""
+    SI, :meth:`~dynid.io.columns.ColumnMap.joint_factors`; a file's own units, ``--units
+    rec4.csv:t=ms``, its own: :meth:`GivenUnits.of`) and the ``--units`` text given, for
+    the unit findings' hint."""
     if cmap is None:
         return GivenUnits(text)
+    own = {f: _given_units(cmap.for_file(f), text) for f in cmap.file_units}
+    return dataclasses.replace(_given_units(cmap, text), files=own)
+
+
+def _given_units(cmap: ColumnMap, text: str | None) -> GivenUnits:
+    """:func:`given_units` of the files ``cmap`` reads alike."""
     factors = {k: cmap.factor(k) for k in ("t", "q", "dq", "ddq")}
     lengths = dict(factors)
     kinds = cmap.prismatic
@@ -600,36 +609,77 @@ def given_units(cmap: ColumnMap | None, text: str | None) -> GivenUnits:
 def check_unit_findings(rec: Recorded, robot: Robot, given: GivenUnits | None = None) -> None:
     """Refuse a recording whose time column (ms, us, ns), positions (degrees) or velocity
     columns (another angle unit than the positions) are in other units than read with
-    (``given``), every unit found said at once with one ``--units`` hint, the whole
-    option to run again (:func:`~dynid.identification.unit_mix.unit_findings`): a log in
-    ms and degrees was told ``--units t=ms`` and, run again, ``--units q=deg``.
+    (``given``, each file's own: :meth:`~dynid.identification.angle_time_units.GivenUnits.of`),
+    every unit found said at once with one ``--units`` hint, the whole option to run again
+    (:func:`~dynid.identification.unit_mix.unit_findings`): a log in ms and degrees was
+    told ``--units t=ms`` and, run again, ``--units q=deg``. Of several recordings whose
+    time columns are in different units, the hint reads each in its own (``--units
+    rec4.csv:t=ms``, :func:`~dynid.identification.time_units_among.time_units_hint`).
 
     A recording in degrees among recordings in radians is said first
-    (:func:`check_degrees`): the file to convert, as ``--units`` applies to every file.
+    (:func:`check_degrees`): the file and the ``--units`` entry of its own that reads it.
 
     Raises
     ------
     DataError
         Naming the recording, what each unit finding rests on and the ``--units`` hint.
     """
-    check_degrees(rec, robot)
+    given = given or GivenUnits()
+    check_degrees(rec, robot, given.text)
     for name, log, side in zip(rec.names, rec.logs, rec.joint_side, strict=True):
-        if (found := unit_findings(robot, log, rec.drive, side=side, given=given)) is not None:
-            raise DataError(found, file=name)
+        own = given.of(name)
+        if (found := unit_findings(robot, log, rec.drive, side=side, given=own)) is None:
+            continue
+        if len(rec.logs) > 1:
+            pairs = zip(rec.names, rec.logs, strict=True)
+            units = [time_unit_read(robot, x, given.of(n)) for n, x in pairs]
+            if (text := time_units_hint(rec.names, units, given.text)) is not None:
+                bare = unit_findings(
+                    robot, log, rec.drive, side=side, given=dataclasses.replace(own, text=None)
+                )
+                found = _with_time_units(found, bare or "", text, time_units_said(rec.names, units))
+        raise DataError(found, file=name)
 
 
-def check_degrees(rec: Recorded, robot: Robot) -> None:
+def _with_time_units(found: str, bare: str, text: str, said: str) -> str:
+    """The finding ``found`` with its hint the ``--units`` ``text`` that reads each
+    recording's time column in its own unit, the file's other entries (of ``bare``, its
+    finding's hint without the ``--units`` given) written into it, and ``said``, the
+    recordings' time units."""
+    hint = bare.partition("; hint: ")[2]
+    first, _, rest = hint.partition("; ")
+    if first.startswith("--units "):
+        pairs = (e.partition("=") for e in first.removeprefix("--units ").split(","))
+        text = units_with(text, [(k, v) for k, _, v in pairs if k.strip() != "t"])
+    else:
+        rest = hint
+    return (
+        f"{found.partition('; hint: ')[0]}; hint: --units {text} (the recordings' time "
+        f"columns differ: {said})" + (f"; {rest}" if rest else "")
+    )
+
+
+def check_degrees(rec: Recorded, robot: Robot, units: str | None = None) -> None:
     """Refuse a recording in degrees among recordings in radians
-    (:func:`~dynid.identification.unit_mix.degrees_among_radians`), naming it.
+    (:func:`~dynid.identification.unit_mix.degrees_among_radians`), naming it and the
+    file's own ``--units`` entries that read it (``rec2.csv:q=deg``), written into the
+    ``--units`` given, ``units``.
 
     Raises
     ------
     DataError
-        Naming the recording, the scales and the columns to convert.
+        Naming the recording, the scales, the ``--units`` hint and the columns to convert.
     """
     found = degrees_among_radians(robot, list(rec.joint_side), rec.names, LIMIT_MARGIN)
-    if found is not None:
-        raise DataError(found[1], file=rec.names[found[0]])
+    if found is None:
+        return
+    said = found[1]
+    if units:
+        what, _, hint = said.partition("; hint: --units ")
+        entries, _, rest = hint.partition(" ")
+        pairs = [e.partition("=") for e in entries.split(",")]
+        said = f"{what}; hint: --units {units_with(units, [(k, v) for k, _, v in pairs])} {rest}"
+    raise DataError(said, file=rec.names[found[0]])
 
 
 def sign_findings(
