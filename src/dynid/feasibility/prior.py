@@ -24,6 +24,12 @@ it (:func:`~dynid.feasibility.lmi.repair_pseudo_inertia`), and a total mass outs
 band is reported. A link that violates a physical condition (``lambda_min(J) < 0``: a CAD
 inertia breaking the triangle inequality, a negative principal moment; a mass at or below
 zero, which gets the generic cylinder) is *repaired* (:attr:`Prior.repaired`); a
+link whose mass is a description's placeholder (:mod:`dynid.model.placeholders`: above
+zero, under 1 % of the median link mass) gets the generic cylinder too, one note naming
+them all (:attr:`Prior.placeholders`); the links given the cylinder
+(:attr:`Prior.guessed`) have their masses bounded as the generic prior's are, by the
+bounds alone, not by a factor of the guess
+(:func:`~dynid.feasibility.convex.problem.mass_bounds`); a
 physically valid link only within the margin is *held at the margin*
 (:attr:`Prior.held`: a Unitree Z1's link05 at ``0.000199 tr(J)`` against ``0.0002``).
 Nothing is changed silently: :attr:`Prior.notes` says what was done, one line each.
@@ -31,6 +37,7 @@ Nothing is changed silently: :attr:`Prior.notes` says what was done, one line ea
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +45,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import ModelError
 from ..model.inertia import phi_from_inertial
+from ..model.placeholders import placeholder_links, placeholder_words
 from ..model.robot import Robot
 from .bounds import segment_points
 from .lmi import pseudo_inertia, pseudo_inertia_margin, repair_pseudo_inertia
@@ -87,6 +95,12 @@ class Prior:
     held : tuple of int
         Links (1-based) physically valid (``lambda_min(J) >= 0``) but within the margin,
         their eigenvalues floored to ``margin tr(J)``: held at the margin, not repaired.
+    placeholders : tuple of int
+        Links (1-based) whose mass was a description's placeholder
+        (:mod:`dynid.model.placeholders`), given the generic cylinder.
+    guessed : tuple of int
+        Links (1-based) given the generic cylinder in place of the description's (massless
+        or a placeholder): a guess, which bounds no mass.
     """
 
     phi: NDArray[np.float64]
@@ -94,6 +108,8 @@ class Prior:
     repaired: tuple[int, ...] = ()
     notes: tuple[str, ...] = ()
     held: tuple[int, ...] = ()
+    placeholders: tuple[int, ...] = ()
+    guessed: tuple[int, ...] = ()
 
     @property
     def n(self) -> int:
@@ -226,19 +242,27 @@ def prior_from_robot(
     notes: list[str] = []
     repaired: list[int] = []
     massless = phi[:, 0] <= 0
-    if np.any(massless):
+    stand_in = placeholder_links(phi[:, 0])
+    if np.any(massless | stand_in):
         cyl = generic_prior(robot).phi
         for i in np.flatnonzero(massless):
             notes.append(
                 f"prior {name}: link {i + 1} ({robot.link_names[i + 1]}) has mass "
                 f"{phi[i, 0]:g} kg; replaced by the generic cylinder of {cyl[i, 0]:.3g} kg"
             )
-            phi[i] = cyl[i]
             repaired.append(int(i) + 1)
+        if np.any(stand_in):
+            cyls = ", ".join(f"{cyl[i, 0]:.3g}" for i in np.flatnonzero(stand_in))
+            notes.append(
+                f"prior {name}: {placeholder_words(robot)}; replaced by the generic cylinder "
+                f"({cyls} kg), their masses bounded by the links' lengths alone, not by a "
+                "factor of the stand-in's (as a link without a description is)"
+            )
+        phi[massless | stand_in] = cyl[massless | stand_in]
     before = pseudo_inertia_margin(phi)
     phi, changed = repair_pseudo_inertia(phi, margin)
-    violated = changed & (before < 0) & ~massless
-    held = changed & ~violated & ~massless
+    violated = changed & (before < 0) & ~massless & ~stand_in
+    held = changed & ~violated & ~massless & ~stand_in
     notes += _margin_notes(robot, name, margin, before, violated, held)
     repaired += [int(i) + 1 for i in np.flatnonzero(violated)]
     if total_mass is not None:
@@ -260,6 +284,8 @@ def prior_from_robot(
         repaired=tuple(sorted(set(repaired))),
         notes=tuple(notes),
         held=tuple(int(i) + 1 for i in np.flatnonzero(held)),
+        placeholders=tuple(int(i) + 1 for i in np.flatnonzero(stand_in)),
+        guessed=tuple(int(i) + 1 for i in np.flatnonzero(massless | stand_in)),
     )
 
 
@@ -322,6 +348,12 @@ def default_prior(robot: Robot, total_mass: tuple[float, float] | None = None) -
         f"{float(pr.phi[:, 0].sum()):.4g} kg"
         + (f"; link(s) {', '.join(map(str, pr.repaired))} repaired" if pr.repaired else "")
         + (f"; link(s) {', '.join(map(str, pr.held))} held at the margin" if pr.held else "")
+        + (
+            f"; link(s) {', '.join(map(str, pr.placeholders))} placeholders, the generic "
+            "cylinder in their place"
+            if pr.placeholders
+            else ""
+        )
         + " (--prior names another)"
     )
-    return Prior(pr.phi, pr.source, pr.repaired, (note, *pr.notes), pr.held)
+    return dataclasses.replace(pr, notes=(note, *pr.notes))

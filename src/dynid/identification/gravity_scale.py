@@ -47,6 +47,7 @@ from numpy.typing import NDArray
 
 from ..dynamics.terms import gravity_torques
 from ..model.drive import Drive
+from ..model.placeholders import placeholder_words
 from ..model.robot import Robot
 from ..regressors.torque import torque_regressor
 from .drive_gains import AGREE, MASSES, corrected_constants
@@ -463,15 +464,23 @@ def gravity_masses_words(robot: Robot, found: GravityRatios) -> str:
 
 def _at_the_flange(robot: Robot, found: GravityRatios) -> str:
     """A clause naming the mass at the flange that makes up the difference
-    (:func:`flange_mass`), or nothing."""
+    (:func:`flange_mass`), or nothing; where the description has placeholder links
+    (:mod:`dynid.model.placeholders`), they are named first: their missing masses look
+    like a load at the flange."""
     if found.flange is None:
         return ""
     m, c = found.flange
     at = ", ".join(f"{v:+.3f}" for v in c)
+    stand_in = placeholder_words(robot)
+    first = (
+        ""
+        if stand_in is None
+        else f"first the description's {stand_in}, whose real masses it lacks; else "
+    )
     return (
         f"; a mass of about {m:.3g} kg at ({at}) m in {robot.link_names[-1]}'s frame makes up the "
-        "difference: a hand or a tool the description lacks (the built-in panda and fr3 "
-        "hold none), or its last links heavier than described (gravity alone cannot tell "
+        f"difference: {first}a hand or a tool the description lacks (the built-in panda and "
+        "fr3 hold none), or its last links heavier than described (gravity alone cannot tell "
         "them apart), which the fit carries in its parameters"
     )
 

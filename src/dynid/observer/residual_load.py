@@ -116,11 +116,23 @@ class ResidualLoad:
         clear = self.mass > max(MASS_STDS * self.mass_std, self.mass_misfit)
         return bool(self.mass > 0 and clear and self.explained >= EXPLAINED)
 
-    def sentence(self, command: str) -> str:
-        """The load in words, with the ``command`` that measures it."""
+    def sentence(self, command: str, stand_in: str | None = None) -> str:
+        """The load in words, with the ``command`` that measures it; ``stand_in``, the
+        model's placeholder links in words (:func:`~dynid.model.placeholders.placeholder_words`),
+        named first as the likelier cause: their missing masses weigh as a load would."""
         c = ", ".join(f"{x:+.3f}" for x in self.com)
+        first = (
+            ""
+            if stand_in is None
+            else (
+                f"first the description's {stand_in}: their real masses, which the model "
+                "lacks, weigh on the joints as a load at the flange does (give the links "
+                "their masses, or identify the arm: a consistent fit's prior puts the generic "
+                "cylinder in their place); else "
+            )
+        )
         return (
-            f"a load at the flange the model lacks: a rigid body of {self.mass:.2f} kg "
+            f"{first}a load at the flange the model lacks: a rigid body of {self.mass:.2f} kg "
             f"(std {self.mass_std:.2g} kg; CoM ({c}) m in the flange's axes) explains "
             f"{100 * self.explained:.0f} % of the residual above the noise; measure it with "
             f"{command}"
@@ -224,6 +236,7 @@ def residual_load(
     )
 
 
-def load_hint(load: ResidualLoad | None, command: str) -> str | None:
-    """:meth:`ResidualLoad.sentence` when the load is named, else None."""
-    return None if load is None or not load.named else load.sentence(command)
+def load_hint(load: ResidualLoad | None, command: str, stand_in: str | None = None) -> str | None:
+    """:meth:`ResidualLoad.sentence` when the load is named (``stand_in``, the model's
+    placeholder links in words, named first), else None."""
+    return None if load is None or not load.named else load.sentence(command, stand_in)

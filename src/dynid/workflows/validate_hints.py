@@ -40,6 +40,7 @@ from ..identification.residual_dependence import (
 from ..identification.residual_spring import ResidualSpring
 from ..identification.verdict import Verdict, with_hint
 from ..model.drive import Drive
+from ..model.placeholders import placeholder_words
 from ..model.robot import Robot
 from ..observer.residual_load import ResidualLoad, load_hint, residual_load
 
@@ -195,7 +196,8 @@ def _dependence_said(
     tilted = tilt is not None and tilt.named  # a tilt named is said first, as before
     load = None if whole is None or tilted else _fitted_load(model, val, ddq, noise)
     if load is not None and load.named:  # the joints diagnosed on what it leaves
-        verdict = with_hint(verdict, load_hint(load, payload))
+        stand_in = placeholder_words(model) if isinstance(model, Robot) else None
+        verdict = with_hint(verdict, load_hint(load, payload, stand_in))
         rest = dependence_hint(
             q, dq, load.residual, noise.total, names, terms, offsets=offsets,
             left_out=left_out, ddq=ddq, inertia=inertia, lacks=lacks, prismatic=kinds, t=t,

@@ -63,6 +63,11 @@ for _k, (_i, _j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
 def mass_bounds(
     prior: Prior, bounds: Bounds, factor: float | None
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], list[str]]:
+    """Link mass bounds [kg] (n,) each: ``bounds``' narrowed to ``prior.mass / factor ..
+    prior.mass * factor``, except for a generic prior and the links a prior guessed
+    (:attr:`~dynid.feasibility.prior.Prior.guessed`: the generic cylinder in place of a
+    massless or placeholder link), which keep ``bounds``' alone; and a note per link
+    whose ranges had to be reconciled."""
     lo = np.array(bounds.mass_min, dtype=float)
     hi = np.array(bounds.mass_max, dtype=float)
     notes: list[str] = []
@@ -70,8 +75,10 @@ def mass_bounds(
         return lo, hi, notes
     m0 = prior.mass
     plo, phi_ = m0 / factor, m0 * factor
+    free = np.zeros(len(m0), dtype=bool)
+    free[np.asarray(prior.guessed, dtype=int) - 1] = True  # a guess bounds no mass
     guessed = np.asarray(bounds.mass_guessed or (False,) * len(m0), dtype=bool)
-    above = guessed & (m0 > hi)  # a description's mass against a guess from a length
+    above = guessed & (m0 > hi) & ~free  # a description's mass against a guess from a length
     for i in np.flatnonzero(above):
         notes.append(
             f"link {i + 1}: the prior's mass {m0[i]:.4g} kg lies above the generic bound "
@@ -80,6 +87,7 @@ def mass_bounds(
         )
     hi = np.where(above, np.minimum(phi_, MAX_LINK_MASS), hi)
     nlo, nhi = np.maximum(lo, plo), np.minimum(hi, phi_)
+    nlo, nhi = np.where(free, lo, nlo), np.where(free, hi, nhi)
     empty = nlo > nhi
     for i in np.flatnonzero(empty):
         notes.append(

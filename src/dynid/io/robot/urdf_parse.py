@@ -71,6 +71,7 @@ from ..._checks import caller_level
 from ...exceptions import DynidWarning, ModelError, UnknownNameError
 from ...friction.model import ClassicalFriction, Friction
 from ...model.inertia import READ_AS_GIVEN, inertial_problems, phi_from_inertial
+from ...model.placeholders import placeholder_words
 from ...model.robot import MAX_LINK_MASS, MAX_LINK_OFFSET, Frame, Robot
 from ...progress import NOTE
 from ..input_files import file_bytes
@@ -132,6 +133,14 @@ def _inertial(
     _warn_if_inconsistent(link, mass, I_o)
     R = T_link_o[:3, :3]
     return mass, T_link_o[:3, 3].copy(), R @ I_o @ R.T
+
+
+#: What a placeholder inertial becomes when read (:mod:`dynid.model.placeholders`).
+PLACEHOLDER_READ = (
+    "read as given (a model taken from the description lacks their weight; identification "
+    "fits the links anew, and a consistent fit's prior puts the generic cylinder in their "
+    "place, their masses not bounded by the stand-in's)"
+)
 
 
 def _warn_if_inconsistent(link: str, mass: float, I: NDArray[np.float64]) -> None:
@@ -264,7 +273,9 @@ def robot_from_urdf_string(
     DynidWarning
         The inertial of a link that enters the model is physically inconsistent
         (negative mass, inertia not positive semi-definite, triangle inequality violated):
-        it is kept as given. A velocity or
+        it is kept as given. A link's mass is a placeholder (above zero and under 1 % of
+        the median link mass, :mod:`dynid.model.placeholders`): one warning names them all,
+        kept as given. A velocity or
         effort limit is not positive: it is treated as unbounded. Joint-origin
         angles are rounded near multiples of pi/2 (``rpy="1.5708"``) in a way that
         matters and ``snap_angles`` is False: the joints and the unscaled condition
@@ -541,6 +552,10 @@ def _robot_from_text(
             warnings.warn(msg, DynidWarning, stacklevel=caller_level())
         elif note_angles:
             _log.log(NOTE, "%s", msg)
+    if (stand_in := placeholder_words(robot)) is not None:
+        warnings.warn(
+            f"{source}: {stand_in}; {PLACEHOLDER_READ}", DynidWarning, stacklevel=caller_level()
+        )
     fr = robot.friction
     if isinstance(fr, Friction):
         held = [
