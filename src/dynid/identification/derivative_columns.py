@@ -53,6 +53,7 @@ from numpy.typing import NDArray
 from .. import signals
 from .input_noise import derived_noise_gains, quantized_noise_std
 from .log import TorqueLog
+from .position_jumps import jump_steps, log_jitter
 from .rate import cutoff_from_motion
 from .velocity_noise import at_round_off, moving_joints, velocity_noise_std
 from .velocity_scale import joint_rate_factors
@@ -88,9 +89,6 @@ STILL_SHARE = 0.05
 #: Acceleration columns whose noise at the cut-off exceeds the velocities' derivative's
 #: by this factor (std; 9 times the variance) are left out.
 DDQ_NOISE_RATIO = 3.0
-#: A step of the positions this many robust standard deviations (of the steps' second
-#: differences) off its neighbours and the recorded velocity is a jump (samples lost).
-JUMP_SPREAD = 20.0
 #: Velocity columns this many times larger or smaller than the positions' derivative on a
 #: joint are off by a scale (a unit), not read for a lag.
 SCALE_OFF = 1.5
@@ -128,22 +126,17 @@ class VelocityCheck:
 
 def _position_derivative(log: TorqueLog, m: int) -> tuple[NDArray[np.float64], float]:
     """Central differences of the first ``m`` positions [rad/s] (m, n), the rows at a gap,
-    a jump of half a turn or more, or a jump the recorded velocities do not explain (a
-    stretch of samples lost under even stamps: a step of the positions more than
-    :data:`JUMP_SPREAD` robust standard deviations of the steps' differences from its
-    neighbours' and from the mean recorded velocity) set to the recorded velocity (not
-    motion), and the median step [s]."""
+    a jump of half a turn or more, or a jump the recorded velocities and the stamps'
+    jitter do not explain (a stretch of samples lost under even stamps, a glitch: the rule
+    of :func:`~dynid.identification.position_jumps.jump_steps`) set to the recorded
+    velocity (not motion), and the median step [s]."""
     t, q, dq = log.t[:m], log.q[:m], log.dq[:m]
     dt = float(np.median(np.diff(t)))
     v = np.gradient(q, t, axis=0)
-    steps = np.diff(t)
-    dqdt = np.diff(q, axis=0) / steps[:, None]
-    r = dqdt - 0.5 * (dq[1:] + dq[:-1])
-    e = np.zeros_like(dqdt)  # a step against its neighbours: a spike, not the motion
-    e[1:-1] = dqdt[1:-1] - 0.5 * (dqdt[:-2] + dqdt[2:])
-    spread = 1.4826 * np.median(np.abs(e), axis=0)
-    jump = (spread > 0) & (np.abs(e) > JUMP_SPREAD * spread) & (np.abs(r) > JUMP_SPREAD * spread)
-    bad_step = (steps > 1.5 * dt)[:, None] | (np.abs(np.diff(q, axis=0)) >= np.pi) | jump
+    gap = np.diff(t) > 1.5 * dt
+    starts = np.concatenate([[0], np.flatnonzero(gap) + 1])
+    jump = jump_steps(t, q, dq, starts, log_jitter(log.cleaning))
+    bad_step = gap[:, None] | (np.abs(np.diff(q, axis=0)) >= np.pi) | jump
     bad = np.zeros(q.shape, dtype=bool)
     bad[1:] |= bad_step
     bad[:-1] |= bad_step

@@ -9,8 +9,9 @@ A shorter step (a sample or two lost, a row dropped for NaN or inf) is bridged a
 ``identify`` bridges it: the observer's update takes any step ``T``
 (:mod:`~dynid.observer.residual`), exact for an external torque constant over it, so it
 carries on across the step with its actual length. Inside a piece, a
-position that moves more than its recorded velocity allows over one step (an encoder
-glitch, a re-homing) changes ``M(q)`` and ``g(q)`` at once: :func:`position_jumps` finds it
+position that moves more than its recorded velocity allows over one step, beyond what the
+noise and the stamps' jitter explain (samples lost under even stamps, an encoder glitch, a
+re-homing), changes ``M(q)`` and ``g(q)`` at once: :func:`position_jumps` finds it
 for a warning.
 """
 
@@ -22,14 +23,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
+from ..identification.position_jumps import jump_steps, velocity_departure
 
-__all__ = ["JUMP_FACTOR", "JUMP_FLOOR", "PositionJump", "pieces", "position_jumps"]
-
-#: A position step is a jump when it departs from the step of the recorded velocity by more
-#: than this many robust standard deviations of that departure ...
-JUMP_FACTOR = 20.0
-#: ... and by more than this [rad or m] (encoder quantisation is far below).
-JUMP_FLOOR = 1e-3
+__all__ = ["PositionJump", "pieces", "position_jumps"]
 
 
 def pieces(t: ArrayLike, max_gap_s: float) -> NDArray[np.int64]:
@@ -62,31 +58,35 @@ class PositionJump:
 
 
 def position_jumps(
-    t: ArrayLike, q: ArrayLike, dq: ArrayLike, starts: ArrayLike = (0,)
+    t: ArrayLike,
+    q: ArrayLike,
+    dq: ArrayLike,
+    starts: ArrayLike = (0,),
+    jitter_s: float | None = None,
 ) -> list[PositionJump]:
     """Steps of ``q`` (N, n) that the velocity ``dq`` (N, n) does not explain, inside the
-    pieces beginning at ``starts``: ``d = q_k - q_{k-1} - T_k (dq_k + dq_{k-1}) / 2``
-    (trapezoid) beyond :data:`JUMP_FACTOR` times its robust standard deviation (1.4826 the
-    median absolute deviation) and :data:`JUMP_FLOOR`; the first per joint and piece (of
-    a glitch, the jump rather than the jump back)."""
+    pieces beginning at ``starts``: the rule of
+    :func:`~dynid.identification.position_jumps.jump_steps` (a step departing from the
+    recorded velocity's, ``d = q_k - q_{k-1} - T_k (dq_k + dq_{k-1}) / 2``, and from its
+    neighbours', by more than
+    :data:`~dynid.identification.position_jumps.JUMP_FACTOR` times the spread the noise and
+    the stamps' jitter ``jitter_s`` [s] give it, and by more than
+    :data:`~dynid.identification.position_jumps.JUMP_FLOOR`; None
+    reads the jitter of ``t``); the first per joint and piece (of a glitch, the jump
+    rather than the jump back), its size ``d``."""
     ta = _checks.as_array("t", t)
     N = ta.shape[0]
     qa, dqa = _checks.as_array("q", q), _checks.as_array("dq", dq)
     if N < 3:
         return []
-    half = 0.5 * np.diff(ta)
-    across = np.asarray(starts, dtype=np.int64) - 1
-    across = across[across >= 0]
+    jumps = jump_steps(ta, qa, dqa, starts, jitter_s)
     bounds = np.concatenate([np.asarray(starts, dtype=np.int64), [N]])
     out = []
-    for j in range(qa.shape[1]):  # one joint at a time: a few (N,) arrays on long logs
-        d = np.diff(qa[:, j]) - half * (dqa[1:, j] + dqa[:-1, j])
-        d[across] = 0.0  # no step across a cut
-        mad = np.median(np.abs(d - np.median(d)))
-        limit = max(JUMP_FACTOR * 1.4826 * float(mad), JUMP_FLOOR)
-        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
-            over = np.flatnonzero(np.abs(d[a : b - 1]) > limit)
+    for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        for j in range(qa.shape[1]):
+            over = np.flatnonzero(jumps[a : b - 1, j])
             if over.size:  # the first: a glitch's jump, not its jump back
-                k = int(over[0])
-                out.append(PositionJump(float(ta[a + k + 1]), j, float(d[a + k])))
+                k = a + int(over[0])
+                d = velocity_departure(ta[k : k + 2], qa[k : k + 2, j], dqa[k : k + 2, j])
+                out.append(PositionJump(float(ta[k + 1]), j, float(d[0])))
     return sorted(out, key=lambda x: (x.t, x.joint))
