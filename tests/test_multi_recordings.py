@@ -275,7 +275,9 @@ def test_a_recording_in_other_units_is_named(panda, files, tmp_path, capsys):
     save_torque_log(tmp_path / "ms.csv", type(log)(1000 * log.t, log.q, log.dq, log.tau))
     with pytest.raises(DataError, match=r"mnm.csv: its torques \(RMS\) are 1\.\d+e\+03 times tho"):
         validate_files(panda, [files / "rec1.csv", tmp_path / "mnm.csv"])
-    with pytest.raises(DataError, match=r"ms\.csv: .*time column looks like ms.*--units t=ms"):
+    with pytest.raises(
+        DataError, match=r"ms\.csv: .*time column looks like ms.*--units ms\.csv:t=ms"
+    ):
         fit_friction_files(panda, [files / "rec1.csv", tmp_path / "ms.csv"])
     code = main(["identify", "--robot", "panda", "--data", str(tmp_path / "ms.csv"), "--out",
                  str(tmp_path / "i"), "--no-figures"])  # fmt: skip

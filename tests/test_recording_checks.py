@@ -355,7 +355,9 @@ def test_a_time_column_in_ms_among_good_recordings_is_named_for_its_time(panda, 
 
     save_torque_log(tmp_path / "good.csv", log)
     save_torque_log(tmp_path / "ms.csv", TorqueLog(1e3 * log.t, log.q, log.dq, log.tau))
-    with pytest.raises(DataError, match=r"ms\.csv: .*time column looks like ms.*--units t=ms"):
+    with pytest.raises(
+        DataError, match=r"ms\.csv: .*time column looks like ms.*--units ms\.csv:t=ms"
+    ):
         validate_files(_continuous(panda, [0, 6]), [tmp_path / "good.csv", tmp_path / "ms.csv"])
 
 
