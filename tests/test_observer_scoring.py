@@ -17,6 +17,7 @@ from dynid.observer.scoring import (
     combined,
     interval_peaks,
     label_intervals,
+    labels_lead,
     lead_for,
     match_events,
     score_events,
@@ -485,3 +486,30 @@ def test_a_label_columns_lead_is_its_tolerance_and_late_labels_are_said():
     wide = score_events(ev, lab, (0.0, 5.0), lead_s=0.1)
     assert (wide.detected, wide.false_events, wide.early) == (2, (2,), ())
     assert shifted_labels_note(wide) is None
+
+
+def test_detections_that_lead_late_labels_get_the_note_with_the_median_lead():
+    """Regression (a UR5's labels 21-58 ms late: every event started before its label,
+    delay median -16 ms, said without a word): contacts at 1, 3, 5 and 7 s detected 10,
+    20, 30 ms after their true onsets, labelled 40, 50, 60 ms late (leads 30 ms each)
+    and a fourth 10 ms after its label: the note gives the median lead, 30 ms."""
+    onsets = np.array([1.0, 3.0, 5.0, 7.0])
+    late = np.array([0.04, 0.05, 0.06, 0.0])
+    starts = onsets + np.array([0.01, 0.02, 0.03, 0.01])
+    labels = np.column_stack([onsets + late, onsets + late + 0.3])
+    sc = score_events(np.column_stack([starts, starts + 0.2]), labels, (0.0, 9.0), lead_s=0.1)
+    np.testing.assert_allclose(sorted(sc.delays), [-0.03, -0.03, -0.03, 0.01], atol=1e-12)
+    count, lead = labels_lead(sc)
+    assert count == 3 and lead == pytest.approx(0.03)
+    note = shifted_labels_note(sc)
+    assert note is not None and "3 of 4 detected contacts' events start before" in note
+    assert "labels look late by about 30 ms" in note
+
+
+def test_a_few_events_before_their_labels_are_no_sign_of_late_labels():
+    """Two of four events starting before their labels (exact labels, velocities that
+    see ahead) are no majority: no note."""
+    labels = np.array([[1.0, 1.3], [3.0, 3.3], [5.0, 5.3], [7.0, 7.3]])
+    starts = np.array([0.99, 2.99, 5.02, 7.03])
+    sc = score_events(np.column_stack([starts, starts + 0.2]), labels, (0.0, 9.0), lead_s=0.1)
+    assert labels_lead(sc) is None and shifted_labels_note(sc) is None

@@ -91,7 +91,7 @@ from ..observer.carried_load import CarriedLoad, load_words
 from ..observer.detection import ContactEvent, Thresholds, undetected_at_rest
 from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
-from ..observer.scoring import ContactScore, MissedContact
+from ..observer.scoring import ContactScore, MissedContact, labels_lead
 from ..observer.thresholds import ModelFingerprint, RestMargin
 from ..observer.unmodelled_load import LOAD_FRAME
 from ..observer.wrench import FULL, WrenchKind, wrench_rank
@@ -227,6 +227,7 @@ _SCORE_FIELDS = {
     "delay_max_ms": Field("number", nullable=True, unit="ms"),
     "delays_look_ahead": Field("bool"),
     "early_ms": Field("numbers", shape=(None,), low=0.0, unit="ms"),
+    "labels_lead_ms": Field("number", nullable=True, low=0.0, unit="ms"),
     "missed_contacts": Field(
         "objects",
         required=True,
@@ -235,11 +236,15 @@ _SCORE_FIELDS = {
                 "start": Field("number", required=True, unit="s"),
                 "end": Field("number", required=True, unit="s"),
                 "peak": Field("number", nullable=True, low=0.0, unit=_NM),
-                "reason": Field("string", choices=("below_at_rest", "below_moving", "unexplained")),
+                "reason": Field(
+                    "string",
+                    choices=("below_at_rest", "below_moving", "dropped_crossing", "unexplained"),
+                ),
                 "joint": Field("integer", low=1),
                 "joint_name": Field("string", nullable=True),
                 "torque": Field("number", low=0.0, unit=_NM),
                 "threshold": Field("number", low=0.0, unit=_NM),
+                "at": Field("number", unit="s"),
                 "torque_source": Field("string", choices=("true", "residual")),
             }
         ),
@@ -917,6 +922,7 @@ def _score_record(sc: ContactScore, names: Sequence[str]) -> dict[str, Any]:
         "delay_max_ms": None if sc.delay_max is None else 1e3 * sc.delay_max,
         "delays_look_ahead": sc.look_ahead,
         "early_ms": [1e3 * d for d in sc.early],
+        "labels_lead_ms": None if (lead := labels_lead(sc)) is None else 1e3 * lead[1],
         "missed_contacts": [_missed_record(m, names) for m in sc.missed],
     }
 
@@ -925,8 +931,8 @@ def _missed_record(m: MissedContact, names: Sequence[str]) -> dict[str, Any]:
     """One missed contact as ``events.json`` writes it: its times [s], its largest true
     torque ``peak`` [N m], and where read (:mod:`~dynid.observer.missed_reason`) the
     ``reason``, the ``joint`` (1-based) and ``joint_name``, its ``torque`` and the
-    ``threshold`` it was compared with [N m], and ``torque_source`` (``true`` or
-    ``residual``)."""
+    ``threshold`` in force it was compared with [N m] at the time ``at`` [s], and
+    ``torque_source`` (``true`` or ``residual``)."""
     out: dict[str, Any] = {"start": m.start, "end": m.end, "peak": m.peak}
     if m.reason is not None and m.joint is not None:
         out.update(
@@ -935,6 +941,7 @@ def _missed_record(m: MissedContact, names: Sequence[str]) -> dict[str, Any]:
             joint_name=names[m.joint] if m.joint < len(names) else None,
             torque=m.torque,
             threshold=m.threshold,
+            **({} if m.at is None else {"at": m.at}),
             torque_source="true" if m.true_torque else "residual",
         )
     return out

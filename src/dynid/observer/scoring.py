@@ -56,6 +56,8 @@ __all__ = [
     "EARLY_CONCENTRATION",
     "EARLY_ELSEWHERE_MIN",
     "LEAD_SAMPLES",
+    "LEADING_MIN",
+    "LEADING_SHARE",
     "LOOK_AHEAD_WORDS",
     "TRUTH_LEVEL",
     "ContactScore",
@@ -65,6 +67,7 @@ __all__ = [
     "early_by_chance",
     "interval_peaks",
     "label_intervals",
+    "labels_lead",
     "lead_for",
     "match_events",
     "score_events",
@@ -94,6 +97,11 @@ EARLY_CONCENTRATION = 3.0
 #: Fewest other false alarms that make a rate to compare with (:func:`early_by_chance`):
 #: one or two strays beside labels that look late leave the hint.
 EARLY_ELSEWHERE_MIN = 3
+#: Detections lead their labels (:func:`labels_lead`) when more than this share of the
+#: detected contacts' events start before their labels' starts ...
+LEADING_SHARE = 0.5
+#: ... and at least this many do (:func:`labels_lead`).
+LEADING_MIN = 3
 #: A simulated log is in contact where some joint's true external torque exceeds this
 #: [N m] (``tau_ext`` of ``dynid simulate --contact``, zero outside its windows).
 TRUTH_LEVEL = 0.1
@@ -235,8 +243,9 @@ class MissedContact:
     """A labelled contact no event overlaps: ``start``, ``end`` [s] and ``peak``, its
     largest true external torque [N m] (None: not known, a label column); where read
     (:mod:`~dynid.observer.missed_reason`), the ``reason`` it was missed, the ``joint``
-    (0-based) whose ``torque`` came closest to its ``threshold`` [N m], and whether that
-    torque is the true one (``true_torque``) or the residual's peak."""
+    (0-based) whose ``torque`` came closest to its ``threshold`` [N m], the one in force at
+    the time ``at`` [s] of that sample, and whether that torque is the true one
+    (``true_torque``) or the residual."""
 
     start: float
     end: float
@@ -246,6 +255,7 @@ class MissedContact:
     torque: float | None = None
     threshold: float | None = None
     true_torque: bool = False
+    at: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -453,22 +463,45 @@ def early_by_chance(sc: ContactScore) -> bool:
     return EARLY_CONCENTRATION * far >= near
 
 
-def shifted_labels_note(sc: ContactScore) -> str | None:
-    """One line when two or more false alarms each start shortly before a missed contact
-    and run into it (:attr:`ContactScore.early`): the labels look late by about the median
-    of those leads, and a ``--label-tolerance`` covering the longest would count them;
-    None otherwise, and where the log's other false alarms come at a similar rate
-    (:func:`early_by_chance`: the model's error, not the labels)."""
-    if len(sc.early) < 2 or early_by_chance(sc):
+def labels_lead(sc: ContactScore) -> tuple[int, float] | None:
+    """How many detected contacts' events start before their labels' starts, and their
+    median lead [s] (> 0), when more than :data:`LEADING_SHARE` of the delays and at
+    least :data:`LEADING_MIN` of them do: labels late by about that much, the delays
+    measured from them short by as much; None otherwise. (A UR5 whose labels were set
+    21-58 ms late: all 7 events started 5-32 ms before their labels, delay median -16 ms,
+    +13 to +57 ms from the true onsets.)"""
+    lead = [-d for d in sc.delays if d < 0.0]
+    if len(lead) < LEADING_MIN or len(lead) <= LEADING_SHARE * len(sc.delays):
         return None
-    med, top = 1e3 * float(np.median(sc.early)), max(sc.early)
-    return (
-        f"{len(sc.early)} false alarm(s) each start shortly before a missed labelled contact "
-        f"and run into it ({1e3 * min(sc.early):.0f} to {1e3 * top:.0f} ms before its "
-        f"start): the labels look shifted late by ~{med:.0f} ms (labels made by hand?); "
-        f"--label-tolerance {np.ceil(top * 20.0) / 20.0:g} (s, applied before a label's "
-        "start too) would count those events as detections"
-    )
+    return len(lead), float(np.median(lead))
+
+
+def shifted_labels_note(sc: ContactScore) -> str | None:
+    """One line when the labels look shifted late: two or more false alarms each start
+    shortly before a missed contact and run into it (:attr:`ContactScore.early`; the
+    median of those leads, and a ``--label-tolerance`` covering the longest would count
+    them), left out where the log's other false alarms come at a similar rate
+    (:func:`early_by_chance`: the model's error, not the labels); or most detections
+    start before their labels (:func:`labels_lead`: the median lead, by which the delays
+    measured from the labels are short); None with neither."""
+    said = []
+    if len(sc.early) >= 2 and not early_by_chance(sc):
+        med, top = 1e3 * float(np.median(sc.early)), max(sc.early)
+        said.append(
+            f"{len(sc.early)} false alarm(s) each start shortly before a missed labelled "
+            f"contact and run into it ({1e3 * min(sc.early):.0f} to {1e3 * top:.0f} ms "
+            f"before its start): the labels look shifted late by ~{med:.0f} ms (labels made "
+            f"by hand?); --label-tolerance {np.ceil(top * 20.0) / 20.0:g} (s, applied before "
+            "a label's start too) would count those events as detections"
+        )
+    if (leading := labels_lead(sc)) is not None:
+        k, lead = leading
+        said.append(
+            f"{k} of {len(sc.delays)} detected contacts' events start before their labels, "
+            f"by a median lead of {1e3 * lead:.0f} ms: the labels look late by about "
+            f"{1e3 * lead:.0f} ms, and the delays measured from them are short by as much"
+        )
+    return "; ".join(said) if said else None
 
 
 def _union_length(iv: NDArray[np.float64]) -> float:

@@ -267,19 +267,25 @@ def _missed_said(sc: dict) -> str:
 
 
 def _why(m: dict) -> str:
-    """`` (joint4 stood still: true torque 0.5 N m below its at-rest threshold 0.84 N m)``:
-    a missed contact's reason in ``events.json``, empty without one."""
+    """`` (joint4 stood still: true torque 0.5 N m against the threshold in force at 1.2
+    s, 0.84 N m)``: a missed contact's reason in ``events.json``, empty without one."""
     reason, name = m.get("reason"), m.get("joint_name") or f"joint {m.get('joint')}"
     torque, level = m.get("torque"), m.get("threshold")
     if not (isinstance(reason, str) and is_number(torque) and is_number(level)):
         return ""
-    what = "true torque" if m.get("torque_source") == "true" else "residual's peak"
-    size = f"{what} {torque:.3g} N m"
+    at = f" at {m['at']:.3f} s" if is_number(m.get("at")) else ""
+    if reason == "dropped_crossing":
+        return (
+            f" (a crossing dropped as shorter than the minimum duration: {name}{at}, "
+            f"residual's peak {torque:.3g} N m)"
+        )
+    what = "true torque" if m.get("torque_source") == "true" else "residual"
+    size = f"{what} {torque:.3g} N m against the threshold in force{at}, {level:.3g} N m"
     if reason == "below_at_rest":
-        return f" ({name} stood still: {size} below its at-rest threshold {level:.3g} N m)"
+        return f" ({name} stood still: {size}, its standstill margin included)"
     if reason == "below_moving":
-        return f" ({name}: {size} below its moving threshold {level:.3g} N m)"
-    return f" (unexplained: {name}'s {size} reached its threshold {level:.3g} N m)"
+        return f" ({name}: {size})"
+    return f" (unexplained: {name}'s {size}, over it)"
 
 
 #: Dropped crossings a report names at most (events.json holds more).

@@ -30,7 +30,6 @@ from .._checks import caller_level
 from ..exceptions import DataError, DynidWarning
 from ..exceptions import in_file as about_file
 from ..io.columns import ColumnMap, load_external_torques, load_label_column
-from ..observer.calibration_check import detectable
 from ..observer.carried_load import (
     MIN_LOAD_S,
     CarriedLoad,
@@ -40,10 +39,9 @@ from ..observer.carried_load import (
     carried_loads,
     load_events,
 )
-from ..observer.detection import undetected_at_rest
-from ..observer.events import ContactEvent, EventDetector, time_slack
+from ..observer.events import ContactEvent, DroppedCrossing, EventDetector, time_slack
 from ..observer.friction import velocity_bands
-from ..observer.missed_reason import LabelledResidual, explained, interval_rows
+from ..observer.missed_reason import LabelledSamples, explained, interval_rows
 from ..observer.model import ObserverModel
 from ..observer.residual import ObserverOptions
 from ..observer.rest_margin import at_rest
@@ -250,8 +248,7 @@ def _detected_once(
     )
     keep = Series.new(prep, n, *wants) if keep_series else None
     ext = in_file(prep.path, lambda: true_torques(prep, model, columns))
-    stats = _Running(n)
-    sign = TorqueSign(n)
+    stats, sign = _Running(n), TorqueSign(n)
     strided = None if not figure_points else _Strided(log.t.shape[0], figure_points, thresholds)
     events: list[ContactEvent] = []
     wrenches: list[WrenchEstimate] = []
@@ -259,7 +256,7 @@ def _detected_once(
     seen = model.friction
     if unmodelled is not None:
         unmodelled.new_log()
-    labelled = None if labels is None or ext is not None else LabelledResidual(labels.flags, n)
+    labelled = _labelled_samples(labels, ext, n)
     less = LoadTorque(model.robot, carried, options.gains(n)) if carried else None
     with about_file(prep.path.name), table or nullcontext(None) as put:
         for blk in _less_load(
@@ -310,7 +307,9 @@ def _detected_once(
         figure=None if strided is None else strided.series(),
         peak_ratio=det.largest_ratio,
         friction=None if seen is model.friction else seen,
-        score=_log_score(prep, model, thresholds, events, labels, ext, tolerance_s, labelled),
+        score=_log_score(
+            prep, model, thresholds, events, labels, ext, tolerance_s, labelled, det.dropped
+        ),  # fmt: skip
         dropped=det.dropped,
         dropped_count=det.dropped_count,
         damped=None if fits is None else damped_shares(log.t, events, fits.damped),
@@ -436,15 +435,16 @@ def _tallied(
     unmodelled: FrictionTally | None,
     load: LoadTally | None,
     samples: LoadSamples | None,
-    labelled: LabelledResidual | None = None,
+    labelled: LabelledSamples | None = None,
 ) -> None:
     """One block fed to the tallies off contacts (``unmodelled``: the friction the model
     misses; ``load``: a load at the flange it misses) and its samples over the threshold
     to ``samples`` (a carried load's fit); ``contact`` (m, n) [N m] the block's contact
     threshold (:func:`~dynid.observer.thresholds.threshold_series`, NaN where not
-    observed); its residual over labelled contacts to ``labelled`` (why one was missed)."""
+    observed); its residual and that threshold over labelled contacts to ``labelled``
+    (why one was missed)."""
     if labelled is not None:
-        labelled.add(blk.a, blk.r)
+        labelled.add(blk.a, blk.r, contact)
     if unmodelled is None and load is None and samples is None:
         return
     log = prep.log
@@ -589,6 +589,15 @@ def scored(
     )
 
 
+def _labelled_samples(labels: Labels | None, ext: NDArray | None, n: int) -> LabelledSamples | None:
+    """The store of the samples of a log's labelled contacts (its ``labels``, else the
+    true torques ``ext`` over :data:`~dynid.observer.scoring.TRUTH_LEVEL`: the contacts
+    :func:`scored` reads) for the reasons of the missed ones; None with neither."""
+    if labels is not None:
+        return LabelledSamples(labels.flags, n)
+    return None if ext is None else LabelledSamples(truth_flags(ext), n)
+
+
 def _log_score(
     prep: PreparedLog,
     model: ObserverModel,
@@ -597,13 +606,14 @@ def _log_score(
     labels: Labels | None,
     ext: NDArray | None,
     tolerance_s: float,
-    labelled: LabelledResidual | None,
+    labelled: LabelledSamples | None,
+    dropped: Sequence[DroppedCrossing] = (),
 ) -> ContactScore | None:
     """The score of one log's ``events`` (:func:`scored`) with the reasons of its missed
     contacts (:func:`with_reasons`)."""
     log = prep.log
     sc = scored(log.t, events, labels, ext, tolerance_s, look_ahead=log.dq_derived)
-    return with_reasons(sc, log.t, prep.dq, model, thresholds, ext, labelled)
+    return with_reasons(sc, log.t, prep.dq, model, thresholds, ext, labelled, dropped)
 
 
 def with_reasons(
@@ -613,39 +623,48 @@ def with_reasons(
     model: ObserverModel,
     thresholds: Thresholds,
     ext: NDArray | None,
-    labelled: LabelledResidual | None,
+    labelled: LabelledSamples | None,
+    dropped: Sequence[DroppedCrossing] = (),
 ) -> ContactScore | None:
     """``score`` with the reason of each missed contact (:mod:`dynid.observer.missed_reason`)
-    of a log at times ``t`` (N,) [s] with velocities ``dq`` (N, n) [rad/s]: its torque the
-    true external torques ``ext`` (N, n) [N m], else the residual's kept over the labels
-    (``labelled``), against each joint's threshold standing still inside its standstill
-    band (:func:`~dynid.observer.detection.undetected_at_rest`; with thresholds that add
-    the standstill margin) or moving (the calibration's ``detectable``, else
-    :func:`~dynid.observer.calibration_check.detectable`): ``thresholds.json``'s numbers;
-    unchanged with no missed contact or neither torque."""
-    if score is None or not score.missed or (ext is None and labelled is None):
+    of a log at times ``t`` (N,) [s] with velocities ``dq`` (N, n) [rad/s]: a crossing
+    the detection ``dropped`` where an event would have detected it, else its torque, the
+    true external torques ``ext`` (N, n) [N m] or the residual, against the contact
+    threshold in force at each of its samples as the detection applied it (kept in
+    ``labelled``), each joint standing still where inside its friction's standstill band
+    (:func:`~dynid.observer.rest_margin.at_rest`; with thresholds that add the standstill
+    margin); unchanged with no missed contact or no samples kept."""
+    if score is None or not score.missed or labelled is None:
         return score
-    moving = thresholds.detectable
-    if moving is None:  # not recorded: the fixed contact level
-        moving = detectable(thresholds, None)
-    rest = undetected_at_rest(model, thresholds, moving)
+    window = (score.lead_s, score.tolerance_s)
+    bands = None
+    if thresholds.standstill and model.friction is not None:
+        bands = velocity_bands(model.friction, dq)
     out = []
     for m in score.missed:
         i, j = interval_rows(t, m.start, m.end)
-        if j <= i:
+        rows = labelled.samples(i, j)
+        if rows.size == 0:
             out.append(m)
             continue
+        size, level = labelled.rows(i, j)
         if ext is not None:
-            with np.errstate(invalid="ignore"):
-                peak = np.nanmax(np.abs(np.where(np.isfinite(ext[i:j]), ext[i:j], np.nan)), 0)
-        else:
-            assert labelled is not None
-            peak = labelled.peak(i, j)
-        still = np.zeros(model.n, dtype=bool)
-        if thresholds.standstill and model.friction is not None:
-            bands = velocity_bands(model.friction, dq)
-            still = np.all(at_rest(model.friction, dq[i:j], bands), axis=0)
-        out.append(explained(m, peak, still, rest, moving, true_torque=ext is not None))
+            size = np.abs(ext[rows])
+        still = np.zeros(level.shape, dtype=bool)
+        if bands is not None and model.friction is not None:
+            still = at_rest(model.friction, dq[rows], bands)
+        out.append(
+            explained(
+                m,
+                t[rows],
+                size,
+                level,
+                still,
+                true_torque=ext is not None,
+                dropped=dropped,
+                window=window,
+            )  # fmt: skip
+        )
     return replace(score, missed=tuple(out))
 
 
