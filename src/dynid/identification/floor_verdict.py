@@ -26,7 +26,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .input_noise import (
-    FITTED_WORDS,
     NoiseFloor,
     Predict,
     StateNoise,
@@ -117,7 +116,6 @@ def judged_prediction(
     *,
     opposite: bool = False,
     fitted: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
-    fitted_words: str = FITTED_WORDS,
 ) -> tuple[Verdict, NoiseFloor]:
     """The verdict of a prediction on pieces and the noise floor it was judged against.
 
@@ -139,10 +137,7 @@ def judged_prediction(
     fitted : sequence of (int, ndarray), optional
         The noise the coefficients of a fit that did not see the pieces put into the
         prediction, per piece as ``inputs``
-        (:mod:`~dynid.identification.fold_spread`), or of the model's own coefficients
-        (:mod:`~dynid.identification.coefficient_noise`); None: not counted.
-    fitted_words : str
-        How the verdict's floor names that part (default: the folds' coefficients).
+        (:mod:`~dynid.identification.fold_spread`); None: not counted.
 
     Returns
     -------
@@ -151,9 +146,7 @@ def judged_prediction(
         against :func:`~dynid.identification.input_noise.noise_floor`, each joint against
         its own noise.
     """
-    fl = noise_floor(
-        tau, error, sensor_var, inputs, rms=errors.rms, fitted=fitted, fitted_words=fitted_words
-    )
+    fl = noise_floor(tau, error, sensor_var, inputs, rms=errors.rms, fitted=fitted)
     verdict = judge_prediction(
         errors.relative_error_percent,
         fl.percent,
