@@ -230,3 +230,16 @@ def test_a_motion_a_decade_below_the_cutoff_within_the_tolerance_trims_half_a_pe
     assert signals.edge_seconds(fc, fc / 10.0 * (1.0 + 2e-6)) == signals.MOTION_EDGE_PERIODS / fc
     assert signals.edge_seconds(fc, fc / 10.0) == signals.MOTION_EDGE_PERIODS / fc
     assert signals.edge_seconds(fc, fc / 10.0 * 1.01) == signals.EDGE_PERIODS / fc
+
+
+def test_robust_std_is_scipys_normal_scaled_mad_and_a_gaussians_sigma() -> None:
+    from scipy.stats import median_abs_deviation
+
+    rng = np.random.default_rng(3)
+    x = 0.7 * rng.standard_normal((4000, 3)) + np.array([1.0, -5.0, 40.0])
+    x[::97, 1] = 1e6  # one sample in a hundred far off: the level barely moves
+    want = median_abs_deviation(x, axis=0, scale="normal")
+    np.testing.assert_allclose(signals.robust_std(x, axis=0), want, rtol=1e-4)
+    np.testing.assert_allclose(signals.robust_std(x[:, 0]), 0.7, rtol=0.05)
+    assert signals.robust_std(x[:, 1]) < 0.75
+    assert float(signals.robust_std(np.zeros(0))) == 0.0

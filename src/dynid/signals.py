@@ -45,6 +45,7 @@ __all__ = [
     "DECADE_TOLERANCE",
     "EDGE_PERIODS",
     "EXACT_DERIVATIVE_ORDER",
+    "MAD_TO_STD",
     "MOTION_EDGE_PERIODS",
     "below_nyquist",
     "derivative",
@@ -57,6 +58,7 @@ __all__ = [
     "lowpass",
     "lowpass_noise_gain",
     "resample_uniform",
+    "robust_std",
     "sample_rate",
     "stamp_resolution",
     "trim_edges",
@@ -100,6 +102,23 @@ def _time(t: ArrayLike, name: str = "t") -> NDArray[np.float64]:
             f"{name}[{k + 1}] = {float(t[k + 1])!r}; hint: clean the log (TorqueLog.from_raw)"
         )
     return t
+
+
+#: A Gaussian's standard deviation over its median absolute deviation: the robust noise
+#: level of the checks and robust estimators (a sample far off moves it by one rank).
+MAD_TO_STD = 1.4826
+
+
+def robust_std(x: ArrayLike, axis: int | None = None) -> NDArray[np.float64]:
+    """Robust standard deviation of ``x`` along ``axis`` (all of it for ``None``), in the
+    unit of ``x``: :data:`MAD_TO_STD` times the median absolute deviation about the median;
+    0 for an empty ``x``. Of differences of consecutive independent samples, divide by
+    ``sqrt(2)`` for the samples' own."""
+    a = np.asarray(x, dtype=np.float64)
+    if a.size == 0:
+        return np.zeros(() if axis is None else np.delete(a.shape, axis))
+    med = np.median(a, axis=axis, keepdims=True)
+    return np.asarray(MAD_TO_STD * np.median(np.abs(a - med), axis=axis), dtype=np.float64)
 
 
 def sample_rate(t: ArrayLike) -> float:
@@ -162,7 +181,7 @@ def _lattice_period(t: NDArray[np.float64], h0: float) -> float:
     (read from the steps' median absolute deviation)."""
     dt = np.diff(t)
     median = float(np.median(dt[(dt > 0.5 * h0) & (dt < 1.5 * h0)]))
-    jitter = 1.4826 * float(np.median(np.abs(dt - h0))) / np.sqrt(2.0)
+    jitter = MAD_TO_STD * float(np.median(np.abs(dt - h0))) / np.sqrt(2.0)
     if jitter > _GRID_JITTER * h0:
         return median
     cuts = np.concatenate([[0], np.flatnonzero(dt > _RUN_GAP * h0) + 1, [t.size]])
@@ -252,10 +271,10 @@ def grid_steps(t: ArrayLike) -> tuple[NDArray[np.int64], float, float]:
         return steps, h, 0.0
     frac = m - np.round(m)
     counted = bool(np.all(np.abs(frac) <= 0.4))
-    jitter = 1.4826 * float(np.median(np.abs(dt - h))) / np.sqrt(2.0)
+    jitter = MAD_TO_STD * float(np.median(np.abs(dt - h))) / np.sqrt(2.0)
     if not counted and jitter <= _GRID_JITTER * h:
         # the steps' distance to whole periods: the jitter without the dropped samples' steps
-        rounded = 1.4826 * float(np.median(np.abs(frac))) / np.sqrt(2.0) <= _ROUND_JITTER
+        rounded = MAD_TO_STD * float(np.median(np.abs(frac))) / np.sqrt(2.0) <= _ROUND_JITTER
         cuts = np.concatenate([[0], np.flatnonzero(m > _RUN_GAP) + 1, [t.size]])
         for a, b in zip(cuts[:-1], cuts[1:], strict=True):
             if b - a >= 3 and rounded:

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._times import offset_text, stamp_text
+from ..signals import MAD_TO_STD
 
 __all__ = [
     "CUT_MAX_TIME_SHARE",
@@ -53,7 +54,6 @@ MIN_SHARE = 0.01
 CUT_REST_RATIO = 1.5
 #: ... and the spans cut, with their margins, hold at most this share of its duration [1].
 CUT_MAX_TIME_SHARE = 0.2
-_MAD_TO_STD = 1.4826  # a Gaussian's standard deviation over its median absolute deviation
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,7 +130,7 @@ def robust_levels(e: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[
     in ``e``'s units. A sample stands off its joint's median by more than
     :data:`OFF_SIGMAS` levels (:func:`outlying_spans`)."""
     dev = e - np.median(e, axis=0)
-    return dev, _MAD_TO_STD * np.median(np.abs(dev), axis=0)
+    return dev, MAD_TO_STD * np.median(np.abs(dev), axis=0)
 
 
 def spans_text(

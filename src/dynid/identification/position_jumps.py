@@ -62,10 +62,6 @@ def log_jitter(cleaning: LogCleaning) -> float | None:
     return float(cleaning.stamp_jitter_s) if cleaning.n_input_rows else None
 
 
-def _robust_std(x: NDArray[np.float64]) -> float:
-    return 1.4826 * float(np.median(np.abs(x - np.median(x)))) if x.size else 0.0
-
-
 def jump_steps(
     t: ArrayLike,
     q: ArrayLike,
@@ -108,7 +104,10 @@ def jump_steps(
         near[:-1] += np.where(right[:-1], rate[1:], 0.0)
         e = np.where(weight > 0, step - T * weight * near, 0.0)
         speed = np.maximum(np.abs(dqa[1:, j]), np.abs(dqa[:-1, j]))
-        s_d, s_e = _robust_std(d[inside]), _robust_std(e[inside & (weight > 0)])
+        s_d, s_e = (
+            float(signals.robust_std(d[inside])),
+            float(signals.robust_std(e[inside & (weight > 0)])),
+        )
         lim_d = JUMP_FACTOR * np.sqrt(s_d**2 + var_t * speed**2)
         lim_e = JUMP_FACTOR * np.sqrt(s_e**2 + 3.0 * var_t * speed**2)
         out[:, j] = (

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import _checks
+from .. import _checks, signals
 from .._times import said_times
 from ..exceptions import ShapeError
 from .log import TorqueLog
@@ -123,7 +123,7 @@ def _column_spikes(
     d = x[1::k][:m] - x[0::k][:m]  # consecutive samples, spread over the log
     ad = np.abs(d)
     step = float(np.min(ad[ad > 0])) if np.any(ad > 0) else 0.0
-    s = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
+    s = float(signals.robust_std(d)) / math.sqrt(2.0)
     lo, hi = np.quantile(x[::k], [0.01, 0.99])
     level = max(s, step, 1e-9 * float(np.max(np.abs(x[::k]))), 1e-300)
     least = max(sigmas * level, 1e-3 * float(hi - lo))

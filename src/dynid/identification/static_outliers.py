@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from ..model.drive import Drive
 from ..model.robot import Robot
+from ..signals import MAD_TO_STD
 from .core import model_columns
 from .data import StaticDataset
 
@@ -156,7 +157,7 @@ def outlying_configurations(
         if z is None or not np.isfinite(z).any():
             break
         med = float(np.nanmedian(z))
-        mad = 1.4826 * float(np.nanmedian(np.abs(z - med)))
+        mad = MAD_TO_STD * float(np.nanmedian(np.abs(z - med)))
         bad = np.isfinite(z) & (z > med + MAD_FACTOR * mad) & (z > MEDIAN_FACTOR * med)
         bad &= z > MIN_RESIDUAL
         if not bad.any():

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .. import _checks
 from ..exceptions import ShapeError
+from ..signals import MAD_TO_STD, robust_std
 
 __all__ = [
     "MAX_DIFFERENCE_ORDER",
@@ -125,7 +126,7 @@ def velocity_noise_std(dq: ArrayLike, t: ArrayLike | None = None) -> NDArray[np.
             d = np.diff(a[:, j : j + w], n=order, axis=0)
             d -= np.median(d, axis=0)
             mad[j : j + w] = np.median(np.abs(d, out=d), axis=0)
-        est.append(1.4826 * mad / np.sqrt(var))
+        est.append(MAD_TO_STD * mad / np.sqrt(var))
     out: NDArray[np.float64] = np.minimum.reduce(est)
     return out
 
@@ -160,8 +161,7 @@ def _differences_noise(a: NDArray[np.float64]) -> NDArray[np.float64]:
         d = np.diff(d, axis=-2)
         if order < 2:
             continue
-        mad = np.median(np.abs(d - np.median(d, axis=-2, keepdims=True)), axis=-2)
-        out = np.minimum(out, 1.4826 * mad / np.sqrt(comb(2 * order, order)))
+        out = np.minimum(out, robust_std(d, axis=-2) / np.sqrt(comb(2 * order, order)))
     return out
 
 
@@ -280,7 +280,7 @@ def _uneven_noise_std(a: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray
             r = r[ok] / scale
             r -= np.median(r)
             mad[j] = np.median(np.abs(r))
-        est.append(1.4826 * mad)
+        est.append(MAD_TO_STD * mad)
     out: NDArray[np.float64] = np.minimum.reduce(est) if est else np.zeros(a.shape[1])
     return out
 

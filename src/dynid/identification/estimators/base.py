@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from ... import _checks
 from ...exceptions import DataError, ShapeError
+from ...signals import MAD_TO_STD
 
 __all__ = [
     "Estimator",
@@ -213,7 +214,7 @@ def huber_weights(
     for g in np.flatnonzero(np.bincount(groups)):  # the groups present
         mad = float(np.median(np.abs(e[groups == g])))
         if mad > 0:
-            s[g] = 1.4826 * mad
+            s[g] = MAD_TO_STD * mad
     u = np.abs(e) / s[groups]
     hub = np.minimum(1.0, c / np.maximum(u, 1e-300))
     return np.asarray(np.sqrt(hub) / s[groups], dtype=np.float64)
