@@ -185,3 +185,21 @@ def test_identify_names_every_combination_a_still_wrist_leaves_unexcited():
     assert "not excited by the data" in msg and "the model's structural rank" in msg
     assert "= Ia5" in msg and "= Ia6" in msg
     assert len(info.value.combinations) == info.value.needed - info.value.rank
+
+
+def test_the_scaled_rank_and_least_squares_ignore_column_units() -> None:
+    import scipy.linalg
+
+    from dynid.identification.solvers import column_scale, pivoted_rank, scaled_lstsq
+
+    rng = np.random.default_rng(5)
+    W = rng.standard_normal((200, 6))
+    W[:, 5] = W[:, 1] - 2.0 * W[:, 3]  # one combination the rows cannot excite
+    units = np.array([1e-6, 1.0, 1e4, 1e-3, 1.0, 1e5])  # mm, gear ratios squared, ...
+    for Wu in (W, W * units):
+        R = scipy.linalg.qr(Wu / column_scale(Wu), mode="r", pivoting=True)[0]
+        assert pivoted_rank(R, 1e-9) == np.linalg.matrix_rank(W) == 5
+    x = rng.standard_normal(5)
+    y = W[:, :5] @ x
+    np.testing.assert_allclose(scaled_lstsq(W[:, :5] * units[:5], y) * units[:5], x, rtol=1e-9)
+    assert np.array_equal(column_scale(np.zeros((3, 2))), np.ones(2))

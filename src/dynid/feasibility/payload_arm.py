@@ -42,6 +42,7 @@ from ..identification.data import StaticDataset
 from ..identification.log import TorqueLog
 from ..identification.model import IdentifiedModel
 from ..identification.selection import identify_recordings
+from ..identification.solvers import scaled_lstsq
 from ..identification.static import identify_static
 from ..identification.structure import Structure
 from ..model.drive import Drive
@@ -339,7 +340,5 @@ def parameter_spread(
         other = dataclasses.replace(arm, model=model.with_coefficients(x))
         Yb[:, i] = np.concatenate([other.torques(*s, with_friction=False).ravel() for s in states])
         Yb[:, i] -= base
-    norms = np.linalg.norm(W, axis=0)
-    s = np.where(norms > 0, norms, 1.0)
-    K = -np.linalg.lstsq(W / s, Yb, rcond=None)[0][:p] / s[:p, None]
+    K = -scaled_lstsq(W, Yb)[:p]
     return np.asarray(K @ C @ K.T, dtype=np.float64)

@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..identification.prepared_log import PreparedLog
+from ..identification.solvers import scaled_lstsq
 
 __all__ = [
     "MATCH_DISTANCE",
@@ -147,10 +148,7 @@ def arm_residual(
     less the classical friction columns of ``W`` (N n, 10 + 3 n; those ``kept``) fitted
     to them, as the load's fit corrects its own (the load's 10 columns left out)."""
     F = W[:, 10:][:, kept[10:]]
-    norms = np.linalg.norm(F, axis=0)
-    s = np.where(norms > 0, norms, 1.0)
-    b = np.linalg.lstsq(F / s, y, rcond=None)[0]
-    return (y - (F / s) @ b).reshape(-1, n)
+    return (y - F @ scaled_lstsq(F, y)).reshape(-1, n)
 
 
 def matched_residual(

@@ -27,7 +27,12 @@ from numpy.typing import NDArray
 from ..exceptions import DataError, RankDeficientError, SolverError
 from ..identification.least_squares import LeastSquaresFit, fit_least_squares
 from ..identification.one_way_friction import offset_instead, one_way_joints
-from ..identification.solvers import unexcited_columns, unexcited_combinations
+from ..identification.solvers import (
+    column_scale,
+    pivoted_rank,
+    unexcited_columns,
+    unexcited_combinations,
+)
 from ..model.inertia import inertia6_from_matrix, inertial_from_phi
 from ..regressors.base import RANK_FLOOR
 from ..regressors.terms import friction_labels
@@ -221,11 +226,9 @@ def _not_told_apart_columns(
 
     if not names or F.shape[0] < F.shape[1]:
         return None
-    norms = np.linalg.norm(F, axis=0)
-    scale = np.where(norms > 0, norms, 1.0)
+    scale = column_scale(F)
     R, piv = scipy.linalg.qr(F / scale, mode="r", pivoting=True)
-    d = np.abs(np.diag(R))
-    rank = int(np.sum(d > rtol * d[0])) if d[0] > 0 else 0
+    rank = pivoted_rank(R, rtol)
     if rank == len(names):
         return None
     R = R[: len(names), np.argsort(piv)]  # the columns back in their order
@@ -275,8 +278,7 @@ def _excited(
     M = np.concatenate([W[:, other], W[:, :p]], axis=1)
     if M.shape[0] < M.shape[1]:
         return p, ()  # fewer rows than columns: the least squares says so
-    norms = np.linalg.norm(M, axis=0)
-    M /= np.where(norms > 0, norms, 1.0)
+    M /= column_scale(M)
     R = scipy.linalg.qr(M, mode="r")[0]
     _, sv, Vt = np.linalg.svd(R[other.size : other.size + p, other.size :])
     r = int(np.sum(sv > RANK_FLOOR))
@@ -420,8 +422,7 @@ def misfit_covariance(
     import scipy.linalg  # as the rest of the module: scipy on first use
 
     m = residual.size if rows is None else rows
-    norms = np.linalg.norm(W, axis=0)
-    s = np.where(norms > 0, norms, 1.0)
+    s = column_scale(W)
     R = scipy.linalg.qr(W / s, mode="r")[0][: W.shape[1]]
     Rinv = scipy.linalg.solve_triangular(R, np.eye(W.shape[1]))[:p]  # rows of R^-1
     G = (Rinv @ Rinv.T) / np.outer(s[:p], s[:p])  # (W^T W)^-1 = R^-1 R^-T, columns unscaled
@@ -472,8 +473,7 @@ def block_jackknife_covariance(
     samples = W.shape[0] // n
     if blocks < 2 or samples < 2 * blocks:
         return None
-    norms = np.linalg.norm(W, axis=0)
-    s = np.where(norms > 0, norms, 1.0)
+    s = column_scale(W)
     edges = np.linspace(0, samples, blocks + 1).astype(int) * n
     G = [(W[a:b] / s).T @ (W[a:b] / s) for a, b in zip(edges[:-1], edges[1:], strict=True)]
     h = [(W[a:b] / s).T @ y[a:b] for a, b in zip(edges[:-1], edges[1:], strict=True)]

@@ -22,6 +22,9 @@ __all__ = [
     "StdMethod",
     "block_grams",
     "checked_std",
+    "column_scale",
+    "pivoted_rank",
+    "scaled_lstsq",
     "tall_pivoted_qr",
     "tall_r",
     "unexcited_columns",
@@ -51,6 +54,32 @@ def checked_std(std: str) -> StdMethod:
         choices = " or ".join(repr(s) for s in STD_METHODS)
         raise OptionError(f"std must be {choices} (--std); got {std!r}")
     return std
+
+
+def column_scale(A: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The Euclidean norm of each column of ``A`` (m, k), 1 for a zero column: the scaling
+    that makes every rank reading of this project the same in any unit or gear ratio
+    (``A / column_scale(A)`` has unit columns; coefficients come back divided by it)."""
+    norms = np.sqrt(np.einsum("ij,ij->j", A, A))
+    return np.where(norms > 0, norms, 1.0)
+
+
+def pivoted_rank(R: NDArray[np.float64], rtol: float) -> int:
+    """The numerical rank of a column-pivoted triangular factor ``R`` (of a column-scaled
+    matrix): its diagonal entries above ``rtol`` times the first (0 when that is 0)."""
+    d = np.abs(np.diag(R))
+    return int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+
+
+def scaled_lstsq(W: NDArray[np.float64], Y: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The minimum-norm least-squares coefficients of ``W X = Y`` (``W`` (m, k), ``Y``
+    (m,) or (m, r)), in the units of ``W``'s columns, fitted with the columns scaled to
+    unit norm (:func:`column_scale`: the minimum norm of the scaled coefficients, so a
+    column's unit does not decide which combination the rank-deficient part takes)."""
+    s = column_scale(W)
+    X = np.linalg.lstsq(W / s, Y, rcond=None)[0]
+    out: NDArray[np.float64] = X / (s if X.ndim == 1 else s[:, None])
+    return out
 
 
 def _column_names(
@@ -438,8 +467,7 @@ def _solve_qr(
     import scipy.linalg  # scipy on first use (start-up time)
 
     m, rk = Wk.shape
-    norms = np.sqrt(np.einsum("ij,ij->j", Wk, Wk))
-    scale = np.where(norms > 0, norms, 1.0)
+    scale = column_scale(Wk)
     if m > 4 * (rk + 1):
         # stage 1: R of [Ws y] (its last column holds Q0^T y)
         R0 = tall_r(Wk, scale, y)
@@ -447,8 +475,7 @@ def _solve_qr(
     else:
         A, b = Wk / scale, y
     Q, R, piv = scipy.linalg.qr(A, mode="economic", pivoting=True)
-    d = np.abs(np.diag(R))
-    rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+    rank = pivoted_rank(R, rtol)
     cond, cond_u, vp = _conditioning(R, scale[piv])  # vp: a null direction when m < rk
     vmin = np.empty(rk)
     vmin[piv] = vp

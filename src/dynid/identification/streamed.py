@@ -21,7 +21,13 @@ from .engine import fit_rows
 from .estimators import Estimator, Weights
 from .least_squares import LeastSquaresFit, StdMethod, assembled, hac_covariance
 from .serial import Serial, SerialMeat
-from .solvers import _conditioning, unexcited_columns, unexcited_combinations
+from .solvers import (
+    _conditioning,
+    column_scale,
+    pivoted_rank,
+    unexcited_columns,
+    unexcited_combinations,
+)
 from .streaming import (
     BlockSource,
     GroupFactors,
@@ -65,11 +71,9 @@ def _solve(
     if rk < c:
         T = _triangular(np.array(T))
     A, b, rres = T[:rk, :rk], T[:rk, rk], float(T[rk, rk])
-    norms = np.sqrt(np.einsum("ij,ij->j", A, A))
-    scale = np.where(norms > 0, norms, 1.0)
+    scale = column_scale(A)
     Q, R, piv = scipy.linalg.qr(A / scale, mode="economic", pivoting=True)
-    d = np.abs(np.diag(R))
-    rank = int(np.sum(d > rtol * d[0])) if d.size and d[0] > 0 else 0
+    rank = pivoted_rank(R, rtol)
     cond, cond_u, vp = _conditioning(R, scale[piv])
     vmin = np.empty(rk)
     vmin[piv] = vp

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from ..model.robot import Robot
 from ..regressors.torque import torque_regressor_prepared
 from .dataset import ModelColumns
-from .solvers import unexcited_columns, unexcited_combinations
+from .solvers import column_scale, unexcited_columns, unexcited_combinations
 
 __all__ = [
     "STRUCTURAL_RTOL",
@@ -104,8 +104,7 @@ def structural_rank(
     if used is not None:
         W = W[:, used]
         labels = tuple(lab for lab, u in zip(labels, used, strict=True) if u)
-    scale = np.linalg.norm(W, axis=0)
-    scale[scale == 0] = 1.0
+    scale = column_scale(W)
     R = scipy.linalg.qr(W / scale, mode="r")[0][: W.shape[1]]
     sv = np.linalg.svd(R, compute_uv=False)
     rank = int(np.sum(sv > STRUCTURAL_RTOL * sv[0])) if sv.size else 0
@@ -162,8 +161,7 @@ def absorbed_by(
     if label not in labels:
         return {}
     W = _random_columns(robot, columns, n_samples, rng)
-    scale = np.linalg.norm(W, axis=0)
-    scale[scale == 0] = 1.0
+    scale = column_scale(W)
     sv, Vt = np.linalg.svd(W / scale, full_matrices=False)[1:]
     null = Vt[sv <= STRUCTURAL_RTOL * sv[0]] / scale  # (d, c), coefficients' units
     k = labels.index(label)
