@@ -181,3 +181,25 @@ def test_the_filter_edge_of_a_smooth_signal_is_as_accurate_as_its_interior():
     inner = int(np.ceil(signals.MOTION_EDGE_PERIODS * fs / fc))
     assert err.max() < 3e-3
     assert err[inner:-inner].max() < 2e-4
+
+
+def test_of_several_recordings_the_jittered_one_is_named():
+    """Regression: identify's samples line said "stamps jittered, std 0.58 ms" pooled over
+    three recordings without naming the one whose stamps jitter; each recording's line
+    says its own now, and the pooled line none."""
+    from dynid.cli.summaries import recordings_lines
+
+    panda = dynid.panda()
+    rng = np.random.default_rng(12)
+    t = sample_times(4.0, 200.0)
+    log = simulate_measurement(
+        panda, random_fourier(panda, rng)(t), rng=rng, noise=SensorNoise.none()
+    )
+    shaken = t + rng.normal(0.0, 0.6e-3, t.size)  # 0.6 ms std at a 5 ms period
+    shaken[0] = t[0]
+    logs = [TorqueLog.from_raw(s, log.q, log.dq, log.tau) for s in (t, shaken)]
+    rec = prepare_recordings(panda, logs, ["even.csv", "shaken.csv"], cutoff_hz=5.0)
+    lines = recordings_lines(rec.summary())
+    assert "jittered" not in lines[0], lines
+    said = lines[1].split("stamps jittered, std ")[1]
+    assert abs(float(said.split(" ms")[0]) - 0.6) < 0.1, said
