@@ -584,3 +584,52 @@ def test_a_wrench_damped_near_a_singular_configuration_is_said_per_event(tmp_pat
     assert "the wrench there is unreliable" in out
     page = html.unescape((tmp_path / "o" / "report.html").read_text())
     assert f"event 1 {100 * first:.3g} %" in page and "the wrench there is unreliable" in page
+
+
+@pytest.mark.filterwarnings("ignore:.*calibrated with:UserWarning")
+def test_the_trust_verdict_tells_a_model_that_fits_from_one_that_misfits(
+    logs, panda_thresholds, tmp_path, capsys
+):
+    """The first line of the summary, events.json's trust and the report's headline say
+    how far to trust the events. The arm's own model on the log with two pushes: good, the
+    residual outside the events near the calibration's level. The same arm with 50 g at
+    the flange that the model holds and the arm does not: poor, the level over the
+    calibration's, and its rate of false alarms the one counted here from the simulated
+    contacts' known times (link6 2-2.5 s, flange 4-4.3 s)."""
+    from dynid import panda
+    from dynid.io.robot.toml import save_toml
+
+    robot = panda()
+    mass = np.array(robot.mass, dtype=float)
+    mass[6] += 0.05
+    save_toml(tmp_path / "misfit.toml", robot.with_inertials(mass, robot.com, robot.inertia))
+    recorded = json.loads(panda_thresholds.read_text())["calibration"]["residual_level"]
+    got = {}
+    for name, params in (("fits", "panda"), ("misfit", str(tmp_path / "misfit.toml"))):
+        capsys.readouterr()
+        cmd = ["observe", "--params", params, "--no-figures", "--data", str(logs / "hit.csv")]
+        out = tmp_path / name
+        assert main([*cmd, "--thresholds", str(panda_thresholds), "--out", str(out)]) == 0
+        first = capsys.readouterr().out.splitlines()[0]
+        doc = json.loads((out / "events.json").read_text())
+        got[name] = (first, doc, (out / "report.html").read_text())
+    for name, level in (("fits", "good"), ("misfit", "poor")):
+        first, doc, page = got[name]
+        trust = doc["trust"]
+        assert trust["level"] == level and first == trust["summary"]
+        assert first.startswith(f"trust: {level} - outside events the residual sits at")
+        assert trust["calibration_level"] == pytest.approx(recorded)
+        assert f'<section class="verdict {level}" id="verdict">' in page
+        assert f"trust {level}</span> Outside events the residual sits at" in _answer(page)
+    fits, misfit = got["fits"][1]["trust"], got["misfit"][1]["trust"]
+    assert fits["quiet_level"] <= 1.2 * recorded and fits["false_alarms"] == 0
+    assert misfit["quiet_level"] > 1.4 * recorded
+    # the false alarms from the known contacts: an event starting outside every
+    # [start - 0.02 s, end + 0.1 s] (the score's lead and tolerance) detects none
+    doc = got["misfit"][1]
+    windows = [(2.0 - 0.02, 2.5 + 0.1), (4.0 - 0.02, 4.3 + 0.1)]
+    false = [e for e in doc["events"] if not any(a <= e["start"] <= b for a, b in windows)]
+    free = doc["duration_s"][0] - sum(b - a for a, b in windows)
+    assert misfit["false_alarms"] == len(false) >= 1
+    assert misfit["false_alarms_per_min"] == pytest.approx(60.0 * len(false) / free, rel=0.02)
+    assert "expect false alarms" in misfit["summary"]

@@ -64,6 +64,13 @@ Two steps:
   against it per joint, and the score below), and prints the largest |r| of each log and
   the events with the time they cover (seconds and % of the logs' duration;
   events.json's flagged_s and duration_s per log): fewer events can cover more time.
+  Its first line says how far to trust them (events.json's trust, the report's
+  headline): good, fair or poor from the residual outside the events and labelled
+  contacts (the 95th percentile of max_j |r_j| / contact_j there) against the
+  calibration's own level and false alarms per minute (thresholds.json's
+  calibration.residual_level, false_alarms), the time the events cover and, with
+  labels, the false alarms counted per minute: a residual well over the calibration's
+  is a model that misfits this log, and its events may be false alarms.
 A residual off contacts that follows the weight of a load at the flange the model lacks
 (a fit of its mass and centre of mass explaining more than a quarter of the residual under
 the threshold and reaching 15 % of some joint's threshold) gets a note with the mass and

@@ -1064,6 +1064,11 @@ def _check_lines(check: CalibrationCheck | None, robot: JointKinds | None = None
             f"{check.false_alarms} false alarm(s) on the calibration logs"
             + ("" if rate is None else f" ({rate:.3g} per minute)")
         )
+    if check.level is not None:  # what a detection's trust verdict compares its own with
+        out.append(
+            f"the residual on them sits at {100.0 * check.level:.0f} % of the contact "
+            "threshold (95 % of the samples under it; thresholds.json's residual_level)"
+        )
     out.append(
         "smallest external torque detected while a joint moves: "
         + values_said(robot, [f"{v:.3g}" for v in check.detectable], "N m")
@@ -1119,7 +1124,9 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
     truth = [err for x in result.logs if (err := x.truth_error()) is not None]
     if truth:
         cols[f"RMS r - tau_ext [{u}]"] = np.sqrt(np.mean(np.square(truth), axis=0))
-    rows = [format_rms_table(names, cols)]
+    trust = None if calibrating else result.trust()
+    rows = [] if trust is None else [trust.words]  # how far to trust the events: first
+    rows.append(format_rms_table(names, cols))
     if truth:
         rows.append(
             f"r - tau_ext: the residual against the true external torques of {len(truth)} "

@@ -21,6 +21,8 @@
                                           # recorded; observe warns at another rate)
                      "velocities": "measured" | "derived" | "mixed",  # the logs'
                      "false_alarms": k,   # events on them (null: not counted)
+                     "residual_level": x, # the 95th percentile of max_j |r_j| / contact_j
+                                          # over them, in shares of the threshold
                      "detectable": [...], # N m per joint, the smallest torque detected
                                           # while the joint moves (the largest contact
                                           # threshold along the motion)
@@ -70,6 +72,14 @@ singular configuration, where the wrench is unreliable) and ``unexplained_share`
 frame's). Events of a log with labelled contacts say whether they were counted as a
 ``false_alarm``; ``score`` lists them per log (``false_alarm_events``, ``{"start",
 "end"}`` [s]) with the leads of those that run into a missed contact (``early_ms``).
+``trust`` (:mod:`dynid.observer.trust`) says how far to trust the events: ``level``
+(good, fair or poor) and its line ``summary``, the residual's level outside the events
+and labelled contacts in shares of the contact threshold (``quiet_level``, its 95th
+percentile; ``above_half``, the share of that time ``quiet_s`` [s] above half of it), the
+calibration's level and false alarms per minute beside it (``calibration_level``,
+``calibration_false_alarms_per_min``; null: not recorded), the false alarms counted
+against labels and per minute of contact-free time (null: no labels) and the
+``reasons`` that lowered it.
 """
 
 from __future__ import annotations
@@ -93,6 +103,7 @@ from ..observer.residual import ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import ContactScore, MissedContact, labels_lead
 from ..observer.thresholds import ModelFingerprint, RestMargin
+from ..observer.trust import CalibratedOn
 from ..observer.unmodelled_load import LOAD_FRAME
 from ..observer.wrench import FULL, WrenchKind, wrench_rank
 from .atomic import open_atomic
@@ -276,6 +287,22 @@ SCORE = Record(
         ),
     }
 )
+_SHARE = Field("number", nullable=True, low=0.0)
+#: ``events.json``'s ``trust``: how far to trust the events (:mod:`dynid.observer.trust`).
+TRUST = Record(
+    {
+        "level": Field("string", required=True, choices=("good", "fair", "poor")),
+        "summary": Field("string", required=True),
+        "quiet_level": _SHARE,
+        "above_half": Field("number", nullable=True, low=0.0, high=1.0),
+        "quiet_s": _S,
+        "calibration_level": _SHARE,
+        "calibration_false_alarms_per_min": Field("number", nullable=True, low=0.0, unit="1/min"),
+        "false_alarms": Field("integer", nullable=True, low=0),
+        "false_alarms_per_min": Field("number", nullable=True, low=0.0, unit="1/min"),
+        "reasons": Field("strings"),
+    }
+)
 #: ``events.json``'s ``dropped``: crossings the minimum duration dropped (not events).
 DROPPED = Record(
     {
@@ -336,6 +363,7 @@ EVENTS = Format(
             "samples": Field("numbers", shape=(None,), low=0),
             "duration_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
             "flagged_s": Field("numbers", shape=(None,), low=0.0, unit="s"),
+            "trust": Field("object", record=TRUST),
             "score": Field("object", record=SCORE),
             "dropped": Field("object", record=DROPPED),
             "beyond_identification": BEYOND_IDENTIFICATION,
@@ -469,9 +497,33 @@ def load_thresholds(path: str | Path) -> Thresholds:
             sample_rate_hz=None if rate is None else float(rate),
             velocities=cal.get("velocities"),
             detectable=_numbers_or_none(cal.get("detectable"), len(d["contact"])),
+            calibrated=_calibrated_on(cal),
         )
     except DynidError as exc:
         raise DataError(str(exc), file=path.name) from None
+
+
+def _calibrated_on(cal: dict[str, Any]) -> CalibratedOn | None:
+    """What the thresholds were calibrated on (``calibration``'s ``data``,
+    ``duration_s``, ``false_alarms`` and ``residual_level``); None: a file that records
+    no calibration logs."""
+    data = cal.get("data")
+    if not isinstance(data, list) or not data:
+        return None
+
+    def number(key: str) -> float | None:
+        v = cal.get(key)
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not np.isfinite(v):
+            return None
+        return float(v)
+
+    alarms = number("false_alarms")
+    return CalibratedOn(
+        tuple(str(x) for x in data),
+        number("duration_s"),
+        None if alarms is None else int(alarms),
+        number("residual_level"),
+    )
 
 
 def _numbers_or_none(x: Any, n: int) -> NDArray[np.float64] | None:
@@ -759,6 +811,7 @@ def save_observation(
                 "false_alarms": check.false_alarms,
                 "detectable": check.detectable.tolist(),
                 "peak": check.peak.tolist(),
+                **({} if check.level is None else {"residual_level": check.level}),
             }
             if check.collision is not None:
                 cal["collision_moving"] = check.collision.tolist()
@@ -816,6 +869,7 @@ def save_observation(
         "flagged_s": [x.flagged_seconds() for x in result.logs],
         **_fingerprint(result.fingerprint),
         **({} if result.frame is None else {"wrench": _estimate_info(result)}),
+        **({} if (trust := result.trust()) is None else {"trust": trust.as_dict()}),
         **({} if (total := result.score()) is None else {"score": _score_info(result, total)}),
         **({} if result.min_duration_s is None else {"dropped": _dropped_info(result, joints)}),
         **_loads_info(result, labels),

@@ -28,12 +28,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..identification.verdict import Verdict
 from .events import detect
-from .thresholds import Thresholds
+from .thresholds import Thresholds, threshold_series
+from .trust import QuietResidual, quiet_residual, sample_ratio
 
 __all__ = [
     "CalibrationCheck",
     "ModelCheck",
     "calibration_false_alarms",
+    "calibration_quiet",
     "collision_level",
     "detectable",
     "model_words",
@@ -135,6 +137,10 @@ class CalibrationCheck:
     collision : ndarray, shape (n,), or None
         The collision level wherever the joint moves [N m]: the largest collision
         threshold along the motion (:func:`collision_level`; None: not given).
+    level : float or None
+        The residual's level over the calibration logs in shares of the contact threshold
+        (:meth:`~dynid.observer.trust.QuietResidual.level` of :func:`calibration_quiet`),
+        which a detection's trust verdict compares its own with; None: not read.
     """
 
     duration_s: float
@@ -144,6 +150,7 @@ class CalibrationCheck:
     peak: NDArray[np.float64]
     model: ModelCheck | None = None
     collision: NDArray[np.float64] | None = None
+    level: float | None = None
 
     @property
     def false_alarms_per_min(self) -> float | None:
@@ -187,3 +194,21 @@ def calibration_false_alarms(
         still = still if thresholds.standstill else None
         count += len(detect(t, r, thresholds, std=std, standstill=still))
     return count
+
+
+def calibration_quiet(
+    thresholds: Thresholds,
+    logs: Iterable[tuple[NDArray[np.float64], NDArray[np.float64], NDArray | None, NDArray | None]],
+) -> QuietResidual:
+    """The residual of the calibration logs, each ``(t, r, std, standstill)`` as
+    :func:`calibration_false_alarms` takes them, against the thresholds in force at each
+    sample: every sample's ``max_j |r_j| / contact_j`` pooled
+    (:func:`~dynid.observer.trust.quiet_residual`; a collision-free log holds no event to
+    leave out)."""
+    parts = []
+    for t, r, std, still in logs:
+        std = std if thresholds.uses_uncertainty else None
+        still = still if thresholds.standstill else None
+        contact, _ = threshold_series(thresholds, r.shape[0], std, still)
+        parts.append(quiet_residual(t, sample_ratio(r, contact)))
+    return QuietResidual.pooled(parts)

@@ -26,6 +26,7 @@ from .model import ObserverModel
 from .motion_range import FASTER, beyond_joints, motion_hint
 from .scoring import ContactScore, combined, early_by_chance, shifted_labels_note
 from .thresholds import ModelFingerprint
+from .trust import QuietResidual, TrustVerdict, trust_verdict
 from .unmodelled import MOST_FLAGGED, UnmodelledFriction, no_friction_note
 from .unmodelled_load import UnmodelledLoad, load_note
 from .wrench import FULL, WrenchEstimate, WrenchKind, underdetermined_note
@@ -151,6 +152,10 @@ class LogObservation:
         Of a detection with the reading of loads off (``--no-loads``): the loads that fit
         the residual of a long event as the default reading fits them
         (:mod:`~dynid.observer.carried_load`), not applied: a note names them.
+    quiet : QuietResidual or None
+        Of a detection: the residual outside its events and labelled contacts against the
+        contact threshold (:mod:`~dynid.observer.trust`), which the trust verdict reads;
+        None: not read (a calibration).
     """
 
     path: Path
@@ -177,6 +182,7 @@ class LogObservation:
     recording: str | None = None
     speed_max: NDArray[np.float64] | None = None
     unread_loads: tuple[CarriedLoad, ...] = ()
+    quiet: QuietResidual | None = None
 
     @property
     def series(self) -> NDArray[np.float64]:
@@ -281,6 +287,25 @@ class ObserveResult:
         (:func:`~dynid.observer.scoring.combined`); None: no log has labels."""
         scores = [x.score for x in self.logs if x.score is not None]
         return combined(scores) if scores else None
+
+    def trust(self) -> TrustVerdict | None:
+        """Of a detection: how far to trust its events, in one verdict
+        (:func:`~dynid.observer.trust.trust_verdict`: the residual outside the events of
+        every log against the threshold, the calibration's level and false alarms, the
+        time the events cover and the false alarms counted against labels); None: a
+        calibration, or no log read outside its events."""
+        quiet = [x.quiet for x in self.logs if x.quiet is not None]
+        if self.min_duration_s is None or not quiet:
+            return None
+        pooled = QuietResidual.pooled(quiet)
+        flagged, logged = self.flagged(loads=False)  # a load's event is no model error
+        sc = self.score()
+        return trust_verdict(
+            pooled,
+            self.thresholds.calibrated,
+            flagged_share=flagged / logged if logged > 0 else 0.0,
+            labelled=None if sc is None else (sc.false_alarms, sc.contact_free_s),
+        )
 
     def flagged(self, *, loads: bool = True) -> tuple[float, float]:
         """``(flagged, logged)`` [s]: the time every log's events cover (``loads`` False:

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import _checks
 from ..exceptions import DataError, ShapeError
 from .residual import ObserverOptions
+from .trust import CalibratedOn
 
 __all__ = [
     "RATE_TOLERANCE",
@@ -164,6 +165,10 @@ class Thresholds:
         (``thresholds.json``'s ``calibration.detectable``,
         :func:`~dynid.observer.calibration_check.detectable`), read back with the file;
         None: not recorded (the fixed ``contact`` stands for it).
+    calibrated : CalibratedOn or None
+        What they were calibrated on, read back with the file: the logs, their duration,
+        the false alarms raised on them and the residual's level there
+        (:mod:`~dynid.observer.trust`); None: not recorded (thresholds made otherwise).
     """
 
     contact: NDArray[np.float64]
@@ -181,6 +186,7 @@ class Thresholds:
     velocities: str | None = None
     rest: RestMargin | None = None
     detectable: NDArray[np.float64] | None = field(default=None)
+    calibrated: CalibratedOn | None = None
 
     def __post_init__(self) -> None:
         if self.velocities not in (None, "measured", "derived", "mixed"):

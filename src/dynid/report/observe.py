@@ -8,6 +8,10 @@ The files' layouts belong to the command that writes them; this page reads them
 generically: the events are the records of ``events.json`` (a list, or the list under
 ``events``), the thresholds the file's tables.
 
+A detection's answer opens with how far to trust its events (``events.json``'s
+``trust``: :mod:`~dynid.observer.trust`), its level the box's and its badge ``trust good``,
+``trust fair`` or ``trust poor``; what was found follows as the first fact.
+
 The run's notes (:attr:`~dynid.observer.results.ObserveResult.notes`, in the run summary)
 are facts of the answer: a model without friction whose residual shows the arm's friction
 (its size per joint, and the ``dynid friction`` command that identifies it) lowers a
@@ -240,6 +244,30 @@ def _scored(doc: Any) -> str | None:
 
             said += f" ({LOOK_AHEAD_WORDS})"
     return esc(said + "." + _missed_said(sc))
+
+
+def _trust(doc: Any) -> tuple[str, str] | None:
+    """How far to trust the events (``events.json``'s ``trust``,
+    :mod:`~dynid.observer.trust`): its line after the level (escaped; the badge says the
+    level) and its level, or None where the file has none."""
+    got = doc.get("trust") if isinstance(doc, dict) else None
+    if not isinstance(got, dict) or got.get("level") not in ("good", "fair", "poor"):
+        return None
+    said = str(got.get("summary", ""))
+    if not said.startswith("trust: "):
+        return None
+    level = str(got["level"])
+    rest = said.removeprefix(f"trust: {level}").lstrip(" -")
+    return esc(capitalised(rest)), level
+
+
+def _worse(level: str, trust: str) -> str:
+    """The box's level: the trust's where the answer is a finding (events found), else
+    the worse of the two."""
+    order = ("good", "fair", "poor", "unusable")
+    if level not in order:
+        return trust
+    return max(level, trust, key=order.index)
 
 
 #: Missed contacts a report names at most (events.json holds them all).
@@ -507,6 +535,11 @@ def answer(run: RunFiles) -> Answer | None:
         level, label = "info", "no event"
     else:
         head, level = esc("No event: every residual stayed below its threshold."), "good"
+    found_head = None
+    if (trust := _trust(run.docs.get(found["events.json"] or ""))) is not None:
+        found_head = head  # what was found: the first fact, below how far to trust it
+        head, level = trust[0], _worse(level, trust[1])
+        label = label or f"trust {trust[1]}"  # a label of its own ("no event") kept
     if said is not None:
         facts.append(said)
     if (scored := _scored(run.docs.get(found["events.json"] or ""))) is not None:
@@ -519,6 +552,8 @@ def answer(run: RunFiles) -> Answer | None:
     where = found["events.json"] if events is not None else found["thresholds.json"]
     fast = beyond_fact(run.docs.get(where or ""), run.summary.notes)  # the model extrapolates
     facts[0:0] = notes + ([fast] if fast is not None else [])  # before the tables
+    if found_head is not None:
+        facts.insert(0, found_head)
     if level == "good" and any(FRICTION_FOUND in n for n in notes):  # thresholds hold it
         level = "fair"
     if found["thresholds.json"] is not None:

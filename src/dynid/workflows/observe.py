@@ -97,6 +97,7 @@ from ..observer.calibration_check import (
     CalibrationCheck,
     ModelCheck,
     calibration_false_alarms,
+    calibration_quiet,
     collision_level,
     detectable,
 )
@@ -109,6 +110,7 @@ from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
 from ..observer.thresholds import ModelFingerprint, log_rate, rate_mismatch, velocity_mismatch
+from ..observer.trust import QuietResidual
 from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import wrench_kind, wrench_rank
@@ -941,8 +943,8 @@ def _calibrated(
     )
     sigma_max = np.zeros(model.n) if wants_std else None
     r_max = np.zeros(model.n)  # the largest |r| of every log
-    # a quantile below 1 without the series: its false alarms counted on a second pass
-    again: list[PreparedLog] | None = [] if opts.quantile < 1 and not opts.keep_series else None
+    # no series: the residual's level and false alarms read on a second pass
+    again: list[PreparedLog] | None = [] if not opts.keep_series else None
     kept: list[PreparedLog] = []  # with the series: their margins again once calibrated
 
     def blocks() -> Iterator[ObservedBlock]:
@@ -1020,7 +1022,8 @@ def _calibrated(
     counted = None
     if again is not None:  # the observer again, a block at a time: no series kept
         wants = (wants_std, wants_margin)
-        counted = sum(counted_events(p, model, th, options, wants) for p in again)
+        passes = [counted_events(p, model, th, options, wants) for p in again]
+        counted = (sum(k for k, _ in passes), QuietResidual.pooled(q for _, q in passes))
     return ObserveResult(
         model,
         th,
@@ -1091,22 +1094,29 @@ def _checked(
     logs: list[LogObservation],
     sigma_max: NDArray[np.float64] | None,
     peak: NDArray[np.float64],
-    counted: int | None = None,
+    counted: tuple[int, QuietResidual] | None = None,
 ) -> CalibrationCheck:
-    """The calibration's false alarms on its own logs (counted on their series when kept;
-    ``counted`` on a second pass of the observer when not; none by construction with the
-    largest ``|r|``) and its smallest detectable torques
-    (:mod:`~dynid.observer.calibration_check`); ``peak`` the largest ``|r|`` [N m]."""
+    """The calibration's false alarms on its own logs and the residual's level there in
+    shares of the threshold (read on their series when kept; ``counted`` on a second pass
+    of the observer when not; no false alarm by construction with the largest ``|r|``)
+    and its smallest detectable torques (:mod:`~dynid.observer.calibration_check`);
+    ``peak`` the largest ``|r|`` [N m]."""
     kept = all(x.r is not None for x in logs)
-    count = counted
+    count, level = None, None
     if kept:
-        count = calibration_false_alarms(th, ((x.t, x.series, x.std, x.standstill) for x in logs))
-    elif th.quantile >= 1.0:
+        series = [(x.t, x.series, x.std, x.standstill) for x in logs]
+        count = calibration_false_alarms(th, series)
+        level = calibration_quiet(th, series).level()
+    elif counted is not None:
+        count, level = counted[0], counted[1].level()
+    if not kept and th.quantile >= 1.0:
         count = 0  # every sample's |r| lies under margin (>= 1) times the largest
     duration = float(sum(x.duration() for x in logs))
     moving = detectable(th, sigma_max)
     collision = collision_level(th, sigma_max)
-    return CalibrationCheck(duration, count, sigma_max, moving, peak, collision=collision)
+    return CalibrationCheck(
+        duration, count, sigma_max, moving, peak, collision=collision, level=level
+    )
 
 
 def _std(x: ObservedBlock) -> NDArray[np.float64]:

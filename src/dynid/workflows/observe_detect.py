@@ -58,6 +58,7 @@ from ..observer.scoring import (
 )
 from ..observer.sign import TorqueSign, opposite_finding
 from ..observer.thresholds import Thresholds, threshold_series
+from ..observer.trust import QuietResidual, guard_s, quiet_residual, sample_ratio
 from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
 from ..observer.wrench import FULL, WrenchEstimate, WrenchKind, external_wrench, wrench_rank
@@ -237,15 +238,9 @@ def _detected_once(
     scored with them (no wrench fit: NaN unexplained)."""
     log, n = prep.log, model.n
     starts = tuple(a for a, _ in prep.spans)
-    steps = np.diff(log.t)
-    period = float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
-    det = EventDetector(
-        thresholds,
-        merge_s=merge_s,
-        min_duration_s=min_duration_s,
-        restarts=starts,
-        sample_period_s=period,
-    )
+    period = _period(log.t)
+    det = EventDetector(thresholds, merge_s=merge_s, min_duration_s=min_duration_s,
+                        restarts=starts, sample_period_s=period)  # fmt: skip
     keep = Series.new(prep, n, *wants) if keep_series else None
     ext = in_file(prep.path, lambda: true_torques(prep, model, columns))
     stats, sign = _Running(n), TorqueSign(n)
@@ -258,6 +253,7 @@ def _detected_once(
         unmodelled.new_log()
     labelled = _labelled_samples(labels, ext, n)
     less = LoadTorque(model.robot, carried, options.gains(n)) if carried else None
+    rho = np.full(log.t.shape[0], np.nan)  # max_j |r_j| / contact_j: outside events, trust
     with about_file(prep.path.name), table or nullcontext(None) as put:
         for blk in _less_load(
             prep, observed_rows(prep, model, options, *wants, thresholds.rest), less, motion
@@ -267,6 +263,7 @@ def _detected_once(
                 seen = blk.friction  # banded for the velocity noise (a note says so)
             levels = threshold_series(thresholds, b - a, blk.std, blk.margin)  # built once
             events += det.feed(log.t[a:b], blk.r, levels=levels)
+            rho[a:b] = sample_ratio(blk.r, levels[0])
             w = None if frame is None else observed_wrench(model, log.q[a:b], blk.r, frame, kind)
             if put is not None:
                 put(log.t[a:b], blk.r, *((None, None) if w is None else (w.wrench, w.damped)))
@@ -291,6 +288,9 @@ def _detected_once(
     if frame is not None and fits is not None:
         unexplained = _off_frame(prep, model, frame, kind, events, fits, thresholds)
     events, unexplained = _with_picks(events, unexplained, picks)
+    score = _log_score(
+        prep, model, thresholds, events, labels, ext, tolerance_s, labelled, det.dropped
+    )
     return LogObservation(
         prep.path,
         log.t,
@@ -307,16 +307,40 @@ def _detected_once(
         figure=None if strided is None else strided.series(),
         peak_ratio=det.largest_ratio,
         friction=None if seen is model.friction else seen,
-        score=_log_score(
-            prep, model, thresholds, events, labels, ext, tolerance_s, labelled, det.dropped
-        ),  # fmt: skip
+        score=score,
         dropped=det.dropped,
         dropped_count=det.dropped_count,
         damped=None if fits is None else damped_shares(log.t, events, fits.damped),
         unexplained=unexplained,
         loads=tuple(carried),
         recording=recording_note(prep),
+        quiet=_quiet(log.t, rho, events, score, guard_s(options.gains(n)), period),
     )
+
+
+def _period(t: NDArray) -> float | None:
+    """The median positive step of ``t`` (N,) [s]; None: fewer than two distinct
+    samples."""
+    steps = np.diff(t)
+    return float(np.median(steps[steps > 0])) if np.any(steps > 0) else None
+
+
+def _quiet(
+    t: NDArray,
+    rho: NDArray,
+    events: Sequence[ContactEvent],
+    score: ContactScore | None,
+    guard: float,
+    period: float | None,
+) -> QuietResidual:
+    """The residual outside the ``events`` and the labelled contacts of ``score`` (from
+    its lead before each to its tolerance after), each widened by ``guard`` [s]: the
+    histogram of ``rho`` (N,) at ``t`` (N,) [s] (:func:`~dynid.observer.trust.quiet_residual`)
+    a trust verdict reads."""
+    spans = [(e.start, e.end) for e in events]
+    if score is not None:
+        spans += [(a - score.lead_s, b + score.tolerance_s) for a, b in score.intervals]
+    return quiet_residual(t, rho, spans, guard, step=period)
 
 
 def detected_log(
@@ -528,21 +552,23 @@ def counted_events(
     thresholds: Thresholds,
     options: ObserverOptions,
     wants: tuple[bool, bool],
-) -> int:
-    """The events the default rules raise on one prepared log against ``thresholds``, the
-    observer run again a block at a time (``wants`` its std and standstill margin): the
-    count :func:`~dynid.observer.calibration_check.calibration_false_alarms` makes on a
-    kept series, without keeping one (a calibration with a quantile below 1 and no
-    figures)."""
+) -> tuple[int, QuietResidual]:
+    """The events the default rules raise on one prepared log against ``thresholds`` and
+    the residual's histogram against them, the observer run again a block at a time
+    (``wants`` its std and standstill margin): what
+    :func:`~dynid.observer.calibration_check.calibration_false_alarms` and
+    :func:`~dynid.observer.calibration_check.calibration_quiet` read on a kept series,
+    without keeping one (a calibration without figures)."""
     det = EventDetector(thresholds)
-    count = 0
+    count, quiet, step = 0, QuietResidual.empty(), _period(prep.log.t) or 0.0
     with about_file(prep.path.name):
         for blk in observed_rows(prep, model, options, *wants, thresholds.rest):
             a, b = blk.a, blk.a + blk.r.shape[0]
-            std = blk.std if thresholds.uses_uncertainty else None
-            still = blk.margin if thresholds.standstill else None
-            count += len(det.feed(prep.log.t[a:b], blk.r, std=std, standstill=still))
-        return count + len(det.finish())
+            levels = threshold_series(thresholds, b - a, blk.std, blk.margin)
+            count += len(det.feed(prep.log.t[a:b], blk.r, levels=levels))
+            t = prep.log.t[a:b]
+            quiet = quiet.plus(quiet_residual(t, sample_ratio(blk.r, levels[0]), step=step))
+        return count + len(det.finish()), quiet
 
 
 def scored(
