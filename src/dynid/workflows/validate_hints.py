@@ -58,13 +58,16 @@ URDF_INERTIA = (
 @dataclass(frozen=True, slots=True)
 class JudgedNoise:
     """The noise per joint [N m] (n,) of the pieces judged: the torque sensors', that of
-    the states the model is evaluated at (None: not known) and both (root sum of
-    squares), and each joint's error over it as the verdict weighed it (None: not known)."""
+    the states the model is evaluated at (None: not known) and all its parts (root sum of
+    squares), each joint's error over it as the verdict weighed it (None: not known), and
+    the part an identified model's coefficients put into its prediction (None: not
+    counted)."""
 
     sensor: NDArray[np.float64]
     inputs: NDArray[np.float64] | None
     total: NDArray[np.float64]
     ratios: NDArray[np.float64] | None = None
+    fitted: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True, slots=True)
