@@ -138,3 +138,20 @@ def test_a_robots_own_parameters_count_no_part(fitted):
     res = validate_files(planar_2r(), path)
     assert res.fit_noise_rms is None
     assert "model's coefficients" not in res.verdict.reason
+
+
+def test_a_model_whose_own_fit_missed_its_floor_counts_no_part(fitted):
+    """A model whose identification held out above its floor (effects outside it) records
+    a covariance the misfit inflates: its coefficients' part is not counted, and the
+    exact log is judged against its own noise as before; the model as identified (held
+    out at its floor) counts it."""
+    models, _, path = fitted
+    model = models[0]
+    held = dict(model.info.heldout or {})
+    assert held["heldout_error_percent"] <= 1.25 * held["noise_floor_percent"]
+    assert validate_files(model, path).fit_noise_rms is not None
+    held["heldout_error_percent"] = 2.0 * held["noise_floor_percent"]
+    missed = dataclasses.replace(model, info=dataclasses.replace(model.info, heldout=held))
+    res = validate_files(missed, path)
+    assert res.fit_noise_rms is None
+    assert "effects outside the model" in res.verdict.reason, res.verdict.reason

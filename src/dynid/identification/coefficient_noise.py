@@ -32,8 +32,9 @@ from .fold_spread import draw_margin_of, joint_grams, prediction_variance
 from .log import TorqueLog
 from .log_rows import less_known_rotors, term_regressor
 from .model import IdentifiedModel
+from .verdict import SYSTEMATIC_RATIO
 
-__all__ = ["CoefficientNoise", "coefficient_noise"]
+__all__ = ["CoefficientNoise", "coefficient_noise", "held_at_floor"]
 
 #: Samples of a piece whose columns are formed at once (bounds the regressor held).
 _BLOCK = 2_048
@@ -62,6 +63,23 @@ class CoefficientNoise:
         """Per piece, the step and the variance [N^2 m^2] the floor counts: ``pieces``'
         times ``margin``."""
         return [(k, V * self.margin) for k, V in self.pieces]
+
+
+def held_at_floor(model: IdentifiedModel) -> bool:
+    """Whether ``model``'s own identification predicted its held-out folds within
+    :data:`~dynid.identification.verdict.SYSTEMATIC_RATIO` times their noise floor
+    (``info.heldout``'s ``heldout_error_percent`` against ``noise_floor_percent``): only
+    then is the covariance it recorded its coefficients' estimation error alone. A fit
+    that left effects outside its model records a covariance the misfit inflates (a
+    heteroskedasticity-and-autocorrelation-consistent estimate reads the misfit as
+    noise), and counted in the floor it would hide the tilt, spring or torque-constant
+    findings ``validate`` exists to name. False where the file records no held-out
+    errors."""
+    held = model.info.heldout or {}
+    err, floor = held.get("heldout_error_percent"), held.get("noise_floor_percent")
+    if err is None or floor is None or not (np.isfinite(err) and np.isfinite(floor)):
+        return False
+    return bool(floor > 0 and err <= SYSTEMATIC_RATIO * floor)
 
 
 def coefficient_noise(
@@ -97,10 +115,11 @@ def coefficient_noise(
     CoefficientNoise or None
         The steps as :func:`~dynid.identification.floor_verdict.input_step`; None where
         the model records no covariance of every coefficient or its columns do not give
-        its torques (a piece without ``ddq``).
+        its torques (a piece without ``ddq``), or whose own identification was not held
+        out at its floor (:func:`held_at_floor`).
     """
     cov = model.coefficient_covariance()
-    if cov is None or not logs:
+    if cov is None or not logs or not held_at_floor(model):
         return None
     terms = tuple(t.term for t in model.terms.values())
     x = np.concatenate([np.asarray(model.fit.beta)] + [t.values for t in model.appended])
