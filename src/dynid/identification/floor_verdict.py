@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .input_noise import (
+    FITTED_WORDS,
     NoiseFloor,
     Predict,
     StateNoise,
@@ -116,6 +117,7 @@ def judged_prediction(
     *,
     opposite: bool = False,
     fitted: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
+    fitted_words: str = FITTED_WORDS,
 ) -> tuple[Verdict, NoiseFloor]:
     """The verdict of a prediction on pieces and the noise floor it was judged against.
 
@@ -137,7 +139,10 @@ def judged_prediction(
     fitted : sequence of (int, ndarray), optional
         The noise the coefficients of a fit that did not see the pieces put into the
         prediction, per piece as ``inputs``
-        (:mod:`~dynid.identification.fold_spread`); None: not counted.
+        (:mod:`~dynid.identification.fold_spread`), or of the model's own coefficients
+        (:mod:`~dynid.identification.coefficient_noise`); None: not counted.
+    fitted_words : str
+        How the verdict's floor names that part (default: the folds' coefficients).
 
     Returns
     -------
@@ -146,7 +151,9 @@ def judged_prediction(
         against :func:`~dynid.identification.input_noise.noise_floor`, each joint against
         its own noise.
     """
-    fl = noise_floor(tau, error, sensor_var, inputs, rms=errors.rms, fitted=fitted)
+    fl = noise_floor(
+        tau, error, sensor_var, inputs, rms=errors.rms, fitted=fitted, fitted_words=fitted_words
+    )
     verdict = judge_prediction(
         errors.relative_error_percent,
         fl.percent,

@@ -47,7 +47,7 @@ above its noise on one joint in two.
 * :func:`prediction_variance`: ``diag(Y Sigma Y^T)`` per sample;
 * :func:`fit_factors`: each joint's factor of the fit's own spread over the noise's;
 * :func:`draw_margin`: each joint's factor from the part's mean to its mean plus one
-  standard deviation.
+  standard deviation (:func:`draw_margin_of` of the rows' sums, :func:`joint_grams`).
 """
 
 from __future__ import annotations
@@ -64,7 +64,9 @@ __all__ = [
     "coefficient_covariance",
     "covariance_of_sums",
     "draw_margin",
+    "draw_margin_of",
     "fit_factors",
+    "joint_grams",
     "loose_folds",
     "piece_sums",
     "prediction_variance",
@@ -195,11 +197,28 @@ def draw_margin(
     ndarray, shape (n,)
         At least 1 (1 where the coefficients add nothing).
     """
-    n = folds[0][1].shape[1]
+    return draw_margin_of([(joint_grams(Y, k), cov) for k, Y, cov in folds])
+
+
+def joint_grams(Y: NDArray[np.float64], k: int = 1) -> NDArray[np.float64]:
+    """``k Y_j^T Y_j`` (n, p, p) per joint ``j`` of rows ``Y`` (M, n, p) that each count
+    ``k`` samples: the sums :func:`draw_margin_of` reads (added over blocks of rows)."""
+    out = np.stack([Y[:, j, :].T @ Y[:, j, :] for j in range(Y.shape[1])])
+    return np.asarray(k * out, dtype=np.float64)
+
+
+def draw_margin_of(
+    folds: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
+) -> NDArray[np.float64]:
+    """:func:`draw_margin` (n,) of folds given as their held-out rows' sums
+    (:func:`joint_grams`, (n, p, p)) and their coefficients' covariance (p, p); one
+    entry for rows that share one set of coefficients (a model predicting several
+    pieces)."""
+    n = folds[0][0].shape[0]
     mean, var = np.zeros(n), np.zeros(n)
-    for k, Y, cov in folds:
+    for A, cov in folds:
         for j in range(n):
-            AS = k * (Y[:, j, :].T @ Y[:, j, :]) @ cov
+            AS = A[j] @ cov
             mean[j] += float(np.trace(AS))
             var[j] += 2.0 * float(np.sum(AS * AS.T))
     out = 1.0 + np.divide(np.sqrt(var), mean, out=np.zeros(n), where=mean > 0)

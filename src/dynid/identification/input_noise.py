@@ -44,6 +44,7 @@ from .velocity_noise import ROUND_OFF_SHARE, at_round_off, signal_noise_std
 from .verdict import NOISE_FLOOR_SHARE, joint_ratios
 
 __all__ = [
+    "FITTED_WORDS",
     "LATTICE_SHARE",
     "NODES",
     "NoiseFloor",
@@ -338,6 +339,11 @@ def _node_terms(
     return out
 
 
+#: How the floor's words name the part of coefficients fitted without the samples judged
+#: (a held-out fold's).
+FITTED_WORDS = "that of the coefficients fitted without these samples"
+
+
 @dataclass(frozen=True, slots=True)
 class NoiseFloor:
     """The noise a perfect model leaves on some pieces, and an error weighed against it.
@@ -384,6 +390,7 @@ def noise_floor(
     inputs: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
     rms: NDArray[np.float64] | None = None,
     fitted: Sequence[tuple[int, NDArray[np.float64]]] | None = None,
+    fitted_words: str = FITTED_WORDS,
 ) -> NoiseFloor:
     """The noise floor of pieces and their prediction error weighed against it.
 
@@ -411,6 +418,9 @@ def noise_floor(
         The noise of coefficients fitted without these pieces through the model, each
         piece's as ``inputs`` (the same steps), a part of the floor weighed with the
         states' noise and said on its own.
+    fitted_words : str
+        How the floor's words name that part (default :data:`FITTED_WORDS`: coefficients
+        fitted without these samples).
     """
     n = tau[0].shape[1]
     N = sum(t.shape[0] for t in tau)
@@ -418,8 +428,8 @@ def noise_floor(
         (t.shape[0] * s for t, s in zip(tau, sensor_var, strict=True) if s is not None), np.zeros(n)
     )
     norm2 = float(sum(np.sum(t**2) for t in tau))
-    states = inputs is not None
     own = None if fitted is None else _every_sample(fitted, N, n)
+    alone = None if inputs is None else _every_sample(inputs, N, n)  # the states' own part
     if fitted is not None:
         inputs = (
             fitted
@@ -444,11 +454,10 @@ def noise_floor(
             count += V.shape[0]
         ratios = np.sqrt(w_e2 / max(count, 1) / mean)
         ratio = float(np.sqrt(np.sum(w_e2) / max(count, 1) / np.sum(mean)))
-        words = _floor_words(var, put, own, states, norm2)
-    mine = np.zeros(n) if own is None else own
+        words = _floor_words(var, alone, own, norm2, fitted_words)
     return NoiseFloor(
         sensor_rms=np.sqrt(var / max(N, 1)),
-        input_rms=np.sqrt(np.maximum(put - mine, 0.0) / max(N, 1)) if states else None,
+        input_rms=None if alone is None else np.sqrt(alone / max(N, 1)),
         total_rms=total,
         percent=percent,
         ratio=ratio,
@@ -469,24 +478,24 @@ def _every_sample(
 
 def _floor_words(
     var: NDArray[np.float64],
-    put: NDArray[np.float64],
+    states: NDArray[np.float64] | None,
     own: NDArray[np.float64] | None,
-    states: bool,
     norm2: float,
+    fitted_words: str = FITTED_WORDS,
 ) -> str:
-    """The floor's parts in words: the torques' noise ``var``, the states' (``put`` less
-    ``own``, when ``states``) and that of coefficients fitted without the samples
-    (``own``), each summed over the samples [N^2 m^2] (n,), in % of the torques' norm."""
+    """The floor's parts in words: the torques' noise ``var``, the states' (``states``,
+    when known) and that of the coefficients (``own``, named by ``fitted_words``, default
+    :data:`FITTED_WORDS`), each summed over the samples [N^2 m^2] (n,), in % of the
+    torques' norm."""
 
     def pct(x: NDArray[np.float64]) -> str:
         return f"{100 * np.sqrt(max(float(x.sum()), 0.0) / norm2):.3g} %"
 
     parts = [f"the torques' noise {pct(var)}"]
-    if states:
-        states_var = put if own is None else put - own
-        parts.append(f"that of the states through the model {pct(states_var)}")
+    if states is not None:
+        parts.append(f"that of the states through the model {pct(states)}")
     if own is not None:
-        parts.append(f"that of the coefficients fitted without these samples {pct(own)}")
+        parts.append(f"{fitted_words} {pct(own)}")
     said = ", ".join(parts[:-1]) + f" and {parts[-1]}"
     return (
         f", of which {said}; the ratio weighs each sample against its own noise, which "

@@ -163,6 +163,11 @@ class IdentifiedModel:
         [kg m^2] about the link origin), kept apart from ``robot`` by a model read from a
         file (whose robot holds the kinematics only): the prior a consistent fit from the
         model starts from (:attr:`description`). None: ``robot``'s own.
+    recorded_covariance : ndarray, shape (c, c), optional
+        With appended terms, the covariance of every coefficient (the ``r`` base
+        parameters, then the appended terms' in order) as ``identification.json`` records
+        it, for a model read from a file, which holds no ``joint_fit``
+        (:meth:`coefficient_covariance`). None: not recorded.
     """
 
     robot: Robot
@@ -174,6 +179,7 @@ class IdentifiedModel:
     drive: Drive | None = None
     holdout: HeldOut | None = None
     description_phi: NDArray[np.float64] | None = None
+    recorded_covariance: NDArray[np.float64] | None = None
     equivalent_robot: Robot = field(init=False)
     rotor_inertia: NDArray[np.float64] | None = field(init=False)
     _other: tuple[IdentifiedTerm, ...] = field(init=False, repr=False)
@@ -326,7 +332,25 @@ class IdentifiedModel:
             terms[t.term.name] = t.with_values(v[c : c + k])
             c += k
         fit = dataclasses.replace(self.fit, beta=_checks.frozen(v[:r]))
-        return dataclasses.replace(self, fit=fit, terms=terms, joint_fit=None, holdout=None)
+        return dataclasses.replace(
+            self, fit=fit, terms=terms, joint_fit=None, holdout=None, recorded_covariance=None
+        )
+
+    def coefficient_covariance(self) -> NDArray[np.float64] | None:
+        """The covariance (c, c) of every coefficient, in the units of each pair: the ``r``
+        base parameters, then the appended terms' in order (the columns of
+        :func:`~dynid.identification.log_rows.term_regressor`): ``joint_fit``'s, else the
+        one a file recorded (:attr:`recorded_covariance`), else ``fit``'s where no term is
+        appended; None where it is not known (a file written before it was recorded)."""
+        width = self.base.rank + sum(len(t.labels) for t in self.appended)
+        for fit in (self.joint_fit, self.fit):
+            cov = None if fit is None else fit.covariance
+            if cov is not None and np.shape(cov) == (width, width):
+                return np.asarray(cov, dtype=np.float64)
+        cov = self.recorded_covariance
+        if cov is not None and np.shape(cov) == (width, width):
+            return np.asarray(cov, dtype=np.float64)
+        return None
 
     def links_only(self) -> IdentifiedModel:
         """The model of the links alone: base parameters that are parameters of the terms

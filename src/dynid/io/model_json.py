@@ -8,6 +8,9 @@ Layout of the file (top-level keys)::
     coefficients: [{"name", "expression", "value", "std", "std_percent", "kept",
         ["description", "z"]}, ...],
     covariance: (r x r) covariance of the values, or null,
+    covariance_with_terms: with appended terms, the (c x c) covariance of the values and
+        the appended terms' coefficients in order (the columns of the model's regressor),
+        or null; older files have none,
     base: {"std_labels", "independent", "dependent", "K_d", "rank", "rtol", "gap"},
     terms: the model terms beside the links, in the order stacked (:mod:`dynid.regressors.
         terms`): [{"name", "kind" (a key of TERM_KINDS), "definition" (the term's own
@@ -66,7 +69,7 @@ from .. import __version__, _checks
 from ..friction.laws import LAWS
 from ..identification.info import IdentificationInfo, LogInfo, StaticInfo
 from ..identification.least_squares import LeastSquaresFit
-from ..identification.model import IdentifiedModel
+from ..identification.model import IdentifiedModel, IdentifiedTerm
 from ..identification.vs_description import description_comparison
 from ..model.drive import Drive
 from ..model.units import units_said
@@ -162,6 +165,8 @@ def model_to_dict(model: IdentifiedModel, *, seed: int | None = None) -> dict[st
     out["std_estimator"] = info.std
     out["coefficients"] = coefficients
     out["covariance"] = None if fit.covariance is None else np.asarray(fit.covariance).tolist()
+    full = model.coefficient_covariance() if model.appended else None
+    out["covariance_with_terms"] = None if full is None else full.tolist()
     out["base"] = {
         "std_labels": list(base.std_labels),
         "independent": base.independent.tolist(),
@@ -353,6 +358,21 @@ def _covariance(c: Any, r: int, source: str) -> NDArray[np.float64] | None:
     return _frozen(0.5 * (a + a.T))
 
 
+def _covariance_with_terms(
+    c: Any, r: int, terms: Mapping[str, IdentifiedTerm], source: str
+) -> NDArray[np.float64] | None:
+    """The (c, c) covariance of the base parameters and the appended ``terms``'
+    coefficients of a file, or None when it has none (older files, no appended term)."""
+    if c is None:
+        return None
+    width = r + sum(len(t.labels) for t in terms.values() if not t.term.in_base)
+    a = np.asarray(c, dtype=np.float64)
+    if a.shape != (width, width):
+        want = f"an {width} x {width} matrix (base.rank and the appended terms' coefficients)"
+        raise fault(source, "covariance_with_terms", f"expected {want}; got {a.shape}")
+    return _frozen(0.5 * (a + a.T))
+
+
 _NUMBER = Field("number", required=True, nullable=True)
 _COEFFICIENT = Record(
     {
@@ -430,6 +450,7 @@ MODEL = Format(
             "std_estimator": Field("any"),
             "coefficients": Field("objects", required=True, record=_COEFFICIENT),
             "covariance": Field("numbers", nullable=True, shape=(None, None)),
+            "covariance_with_terms": Field("numbers", nullable=True, shape=(None, None)),
             "base": Field("object", required=True, record=_BASE),
             "terms": Field("objects", record=TERM_RECORD),
             "friction": Field("numbers", nullable=True, shape=("n", None)),
@@ -521,6 +542,9 @@ def model_from_dict(d: Mapping[str, Any], *, source: str = "identified model") -
         info=info,
         drive=drive,
         description_phi=description,
+        recorded_covariance=_covariance_with_terms(
+            d.get("covariance_with_terms"), r, terms, source
+        ),
     )
 
 

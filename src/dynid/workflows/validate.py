@@ -70,6 +70,7 @@ from ..friction.model import (
 )
 from ..friction.recordings import RecordingsValidation, validate_recordings
 from ..friction.validation import RECORDED, own_friction, recorded_cutoff
+from ..identification.coefficient_noise import coefficient_noise
 from ..identification.drive_gains import DriveGains
 from ..identification.error_spans import ErrorSpans, error_spans
 from ..identification.floor_verdict import (
@@ -222,8 +223,9 @@ class ValidateResult:
         names the file).
     noise_rms : ndarray, shape (n,)
         The noise a perfect model leaves per joint, over every piece [N m]: the torque
-        sensors' (``sensor_noise_rms``) and that of the states it is evaluated at
-        (``input_noise_rms``), root sum of squares.
+        sensors' (``sensor_noise_rms``), that of the states it is evaluated at
+        (``input_noise_rms``) and, of an identified model, that of its coefficients
+        (``fit_noise_rms``), root sum of squares.
     noise_floor_percent : float
         The noise relative to the measured torques' norm [%]: the smallest relative error
         a model can reach on them.
@@ -234,6 +236,11 @@ class ValidateResult:
         (empty: not known).
     sensor_noise_rms, input_noise_rms : ndarray, shape (n,), optional
         The parts of ``noise_rms`` [N m].
+    fit_noise_rms : ndarray, shape (n,), optional
+        The part of ``noise_rms`` an identified model's coefficients put into its
+        prediction through their recorded covariance [N m]
+        (:mod:`~dynid.identification.coefficient_noise`); None: not counted (a robot's
+        parameters, a model whose file records no covariance of every coefficient).
     joint_ratios : ndarray, shape (n,), optional
         Each joint's error over its noise as the verdict weighed it (each sample against
         its own noise), the numbers its reason gives; None: not known.
@@ -304,6 +311,7 @@ class ValidateResult:
     spikes: tuple[int, ...] = ()
     sensor_noise_rms: NDArray[np.float64] | None = None
     input_noise_rms: NDArray[np.float64] | None = None
+    fit_noise_rms: NDArray[np.float64] | None = None
     joint_ratios: NDArray[np.float64] | None = None
     sign_map: str | None = None
     opposite_sign: tuple[tuple[str, str], ...] = ()
@@ -320,9 +328,10 @@ class ValidateResult:
     def metadata(self) -> dict[str, Any]:
         """The keys ``validation.json`` records beside the errors: ``model``,
         ``friction_source``, ``data`` (the files, comma-separated), ``files``,
-        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``sensor_noise_rms`` and
-        ``input_noise_rms`` (its parts, when known), ``joint_ratios`` (each joint's error
-        over its noise as the verdict weighed it, when known), ``torque_spikes_replaced`` (per file,
+        ``cutoff_hz``, ``noise_rms``, ``noise_floor_percent``, ``sensor_noise_rms``,
+        ``input_noise_rms`` and ``fit_noise_rms`` (its parts, when known),
+        ``joint_ratios`` (each joint's error over its noise as the verdict weighed it,
+        when known), ``torque_spikes_replaced`` (per file,
         when known), ``sign_map`` (the recorded sign map's finding, when there is one),
         ``opposite_sign`` (by file, the finding that its torques read with the opposite
         sign on some joints or on all, with the ``--units`` that reads them; when there is
@@ -353,6 +362,7 @@ class ValidateResult:
             for k, a in (
                 ("sensor_noise_rms", self.sensor_noise_rms),
                 ("input_noise_rms", self.input_noise_rms),
+                ("fit_noise_rms", self.fit_noise_rms),
                 ("joint_ratios", self.joint_ratios),
             )
             if a is not None
@@ -485,9 +495,10 @@ def validate_files(
     val = in_file(rec.paths[0], lambda: _banded(run, friction)) if len(rec.paths) == 1 else None
     val = _banded(run, friction) if val is None else val  # friction as observe evaluates it
     errors, names = _finite(val, rec.names, label, opt), robot.joint_names
-    inputs = _input_noise(model, val.friction, val)
-    verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, inputs)
-    verdict = _worst_recording(val, verdict, rec.names, names, inputs)
+    parts = _input_noise(model, val.friction, val), _coefficient_noise(
+        model, val, fr_source == "model" and feasible is None, rec.names)  # fmt: skip
+    verdict, noise, floor = _judged(val, np.ones(len(val.parts), bool), errors, names, *parts)
+    verdict = _worst_recording(val, verdict, rec.names, names, *parts)
     burst = _error_spans(verdict, val, rec.logs, noise)  # a contact: not the model's
     speeds, dq = _identified_speeds(model if own is None else own), [v.log.dq for v in val.parts]
     # a motion beyond the identification's is the likelier cause of what the residual follows
@@ -519,8 +530,7 @@ def validate_files(
         noise_floor_percent=floor,
         joint_names=tuple(robot.joint_names),
         spikes=spikes,
-        sensor_noise_rms=noise.sensor,
-        input_noise_rms=noise.inputs,
+        sensor_noise_rms=noise.sensor, input_noise_rms=noise.inputs, fit_noise_rms=noise.fitted,
         joint_ratios=noise.ratios,
         sign_map=sign_map,
         opposite_sign=tuple((f.name, f.text) for f in opposite if f.kind == "opposite"),
@@ -706,20 +716,47 @@ def _input_noise(
     return prediction_input_noise(rigid, fr, logs, val.pieces.state_noise, separable)
 
 
+#: How the verdict's floor names the part the model's coefficients put into its prediction.
+_FITTED_WORDS = "that of the model's coefficients (their recorded covariance) through the model"
+
+
+def _coefficient_noise(
+    model: IdentifiedModel | Robot,
+    val: RecordingsValidation,
+    own_friction: bool,
+    files: Sequence[str],
+) -> list[tuple[int, NDArray[np.float64]]] | None:
+    """Per piece, the variance an identified ``model``'s coefficients put into its
+    prediction as the floor counts it, at its mean plus one standard deviation of their
+    one draw (:func:`~dynid.identification.coefficient_noise.coefficient_noise`; its
+    friction's columns with its ``own_friction``), none on the pieces of recordings
+    (``files``) it was identified from; None for a robot or a model that records no
+    covariance of every coefficient."""
+    if not isinstance(model, IdentifiedModel):
+        return None
+    trained = set(model.info.fitted_on(files))
+    seen = [files[r] in trained for r in val.pieces.recording]
+    logs, tau = [v.log for v in val.parts], [v.tau_model for v in val.parts]
+    found = coefficient_noise(model, logs, tau, friction=own_friction, seen=seen)
+    return None if found is None else found.counted
+
+
 def _judged(
     val: RecordingsValidation,
     sel: NDArray[np.bool_],
     errors: TorqueErrors,
     names: Sequence[str],
     inputs: list[tuple[int, NDArray[np.float64]]] | None = None,
+    fitted: list[tuple[int, NDArray[np.float64]]] | None = None,
 ) -> tuple[Verdict, JudgedNoise, float]:
     """The verdict, the noise per joint and the noise floor [%] of the pieces ``sel`` (bool
     per piece), whose pooled errors are ``errors``
     (:func:`~dynid.identification.floor_verdict.judged_prediction`): the sensors' noise
     read from each piece's measured torques
     (:func:`~dynid.identification.floor_verdict.sensor_variance`) and the states' through
-    the model (``inputs``: :func:`_input_noise`; None: not known); the model's torques
-    checked for the opposite sign."""
+    the model (``inputs``: :func:`_input_noise`; None: not known) and the model's
+    coefficients' (``fitted``: :func:`_coefficient_noise`; None: not counted); the
+    model's torques checked for the opposite sign."""
     chosen = [k for k, s in enumerate(sel) if s]
     parts = [val.parts[k] for k in chosen]
     verdict, fl = judged_prediction(
@@ -730,10 +767,12 @@ def _judged(
         names,
         None if inputs is None else [inputs[k] for k in chosen],
         opposite=opposite_sign([v.log.tau for v in parts], [v.tau_hat for v in parts]),
+        fitted=None if fitted is None else [fitted[k] for k in chosen],
+        fitted_words=_FITTED_WORDS,
     )
     return (
         verdict,
-        JudgedNoise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios),
+        JudgedNoise(fl.sensor_rms, fl.input_rms, fl.total_rms, fl.joint_ratios, fl.fit_rms),
         fl.percent,
     )
 
@@ -792,15 +831,17 @@ def _worst_recording(
     files: Sequence[str],
     names: Sequence[str],
     inputs: list[tuple[int, NDArray[np.float64]]] | None,
+    fitted: list[tuple[int, NDArray[np.float64]]] | None = None,
 ) -> Verdict:
     """The pooled ``verdict``, or with several recordings (``files``) judged apart the
     worst one's, named, where they differ and it is at least as bad as the pooled one
-    (``names``: the joints')."""
+    (``names``: the joints'; ``inputs`` and ``fitted`` the floor's parts per piece as
+    :func:`_judged` takes them)."""
     if len(files) < 2:
         return verdict
     labels = np.asarray(val.pieces.recording)
     each = [
-        _judged(val, labels == r, val.recordings[r].errors, names, inputs)[0]
+        _judged(val, labels == r, val.recordings[r].errors, names, inputs, fitted)[0]
         for r in range(len(files))
     ]
     rank = [LEVELS.index(v.level) for v in each]
