@@ -40,6 +40,7 @@ from ..exceptions import DynidError, DynidWarning
 from ..identification.derived_cutoff import with_derived_cutoff_hint
 from ..identification.drive_gains import DriveGains, drive_gains
 from ..identification.floor_verdict import input_step, judged_prediction, prediction_input_noise
+from ..identification.fold_offsets import fold_solution, kept_labels
 from ..identification.fold_spread import (
     PieceSums,
     covariance_of_sums,
@@ -428,12 +429,24 @@ class HeldOutTorques:
 
 def _fold_model(model: IdentifiedModel, fold: int) -> IdentifiedModel | None:
     """The model fitted on every block but ``fold`` (None: the columns are not the base
-    parameters followed by ``fv, fc, fo`` per joint)."""
+    parameters followed by ``fv, fc, fo`` per joint), an offset its training rows do not
+    tell from the joint's Coulomb friction left out at zero, as the structure search
+    judged it (:func:`~dynid.identification.fold_offsets.fold_solution`)."""
     assert model.holdout is not None
-    x = model.holdout.train[fold].solve()
+    x = _fold_solution(model, fold)[0]
     if x.size != model.base.rank + sum(len(t.labels) for t in model.appended):
         return None
     return model.with_coefficients(x)
+
+
+def _fold_solution(
+    model: IdentifiedModel, fold: int
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """The coefficients fitted on every block but ``fold`` and the columns fitted
+    (:func:`~dynid.identification.fold_offsets.fold_solution`)."""
+    assert model.holdout is not None
+    train = model.holdout.train[fold]
+    return fold_solution(train, labels=kept_labels(model, np.arange(train.p)))
 
 
 def heldout_torques(
@@ -639,9 +652,9 @@ def _fold_spread(
     for fold in range(len(parts)):
         mine = at[labels[at] == fold]
         normals = model.holdout.train[fold]
-        fitted = np.diag(normals.G) > 0
+        x, fitted = _fold_solution(model, fold)
+        fitted &= np.diag(normals.G) > 0
         Y = rows(v.log, mine)
-        x = normals.solve()
         scale = max(float(np.sqrt(np.mean(v.log.tau[mine] ** 2))), 1e-300)
         if not np.allclose(Y @ x, v.tau_hat[mine], rtol=0.0, atol=1e-6 * scale):
             return None  # not the folds' columns: no part said

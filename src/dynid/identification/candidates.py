@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .dissipation import Violation
+from .fold_offsets import fold_fits, fold_solution, model_labels
 from .holdout import HeldOut
 from .model import IdentifiedModel
 from .structural import mixed_sign
@@ -363,7 +364,9 @@ def candidate_judged(
     deviations, 0 where not used) says where its friction is not dissipative. With
     ``check``, each column's label (``""`` for a column never left out alone,
     :func:`~.structure.column_labels`) gives the coefficients' relative standard
-    deviations (:attr:`Candidate.relative_std`). A coefficient that holds a difference
+    deviations (:attr:`Candidate.relative_std`). A fold whose training rows do not tell a
+    joint's offset from its Coulomb friction fits without that offset
+    (:func:`~.fold_offsets.fold_solution`). A coefficient that holds a difference
     of coefficients (``fv6`` holding ``fv6 - fv5``, ``model.info.combined``:
     :func:`~.structural.mixed_sign`) has no sign of its own: 0 in the dissipation
     ``check`` and not among :attr:`Candidate.loose_pushing`."""
@@ -371,7 +374,7 @@ def candidate_judged(
     use = use & np.asarray(fit.kept, dtype=bool)
     idx = np.flatnonzero(use)
     sub = held.restricted(idx)
-    xs = [t.solve(rtol) for t in sub.train]
+    xs = fold_fits(sub, rtol, _labels_of(model, labels, use.size), idx)
     per_fold = [t.relative_error_percent(x) for t, x in zip(sub.test, xs, strict=True)]
     se = float(np.std(per_fold, ddof=1) / math.sqrt(len(per_fold))) if len(per_fold) > 1 else 0.0
     white = [t.relative_error_percent(x) for t, x in zip(sub.whitened, xs, strict=True)]
@@ -410,6 +413,13 @@ def candidate_judged(
         loose_pushing=loose,
         admissible=signed,
     )
+
+
+def _labels_of(model: IdentifiedModel, labels: Sequence[str], p: int) -> tuple[str, ...]:
+    """Each of the ``p`` columns' label: ``labels`` when given, else the model's own
+    (:func:`~.fold_offsets.model_labels`); none when they do not match the columns."""
+    out = tuple(labels) if labels else model_labels(model)
+    return out if len(out) == p else ()
 
 
 #: A Stribeck coefficient of one joint (motor): ``fsp3``, ``jfsp7``.
@@ -530,16 +540,18 @@ def recording_oddness(use: NDArray[np.bool_], model: IdentifiedModel, rtol: floa
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     idx = np.flatnonzero(use & np.asarray(fit.kept, dtype=bool))
     held = heldout_of(model).restricted(idx)
+    labels = _labels_of(model, (), use.size)
+    mine = tuple(labels[i] for i in idx) if labels else ()
     tests = held.test
     out = []
     for r, (train, test) in enumerate(zip(held.train, tests, strict=True)):
         rest = HeldOut.k_fold([t for j, t in enumerate(tests) if j != r])
         others = [
-            t.relative_error_percent(f.solve(rtol))
-            for f, t in zip(rest.train, rest.test, strict=True)
+            t.relative_error_percent(x)
+            for x, t in zip(fold_fits(rest, rtol, mine), rest.test, strict=True)
         ]
         med = float(np.median(others))
-        e = test.relative_error_percent(train.solve(rtol))
+        e = test.relative_error_percent(fold_solution(train, rtol, mine)[0])
         if e < ODD_FLOOR_PERCENT:
             out.append(0.0)
             continue

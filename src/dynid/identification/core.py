@@ -45,6 +45,7 @@ from ..regressors.terms import ModelTerm, drive_terms
 from .dataset import Dataset, ModelColumns, RegressorBlock, RegressorKind
 from .engine import HeldRows, Rows, fit_rows
 from .estimators import Estimator, EstimatorName, estimator_named
+from .fold_offsets import FOLD_RTOL, fold_fits
 from .holdout import HeldOut, cross_validate
 from .info import IdentificationInfo, Route
 from .least_squares import (
@@ -361,7 +362,9 @@ def identify(
     info = _record(data, columns, fit, stack, est.name, std, max_std_percent, rtol)
     if held is not None:
         kept = np.flatnonzero(fit.kept)
-        errors = cross_validate(held.restricted(kept), fit=np.asarray(fit.beta)[kept])
+        sub = held.restricted(kept)  # an offset a fold cannot tell apart left out there
+        xs = fold_fits(sub, FOLD_RTOL, labels, kept)
+        errors = cross_validate(sub, fit=np.asarray(fit.beta)[kept], xs=xs)
         info = dataclasses.replace(info, heldout=errors.as_dict())
     return _model(robot, columns, fit, info, held)
 

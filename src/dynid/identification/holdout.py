@@ -196,6 +196,28 @@ class Normals:
             held.popitem(last=False)
         return got
 
+    def rank(self, rtol: float = 1e-10, floor: float | None = None) -> int:
+        """The number of directions :meth:`solve` keeps at ``rtol`` (``p``: every one, the
+        unique solution), read from the same factorisation; with ``floor`` (between
+        ``rtol`` and 1e-3), those whose scaled eigenvalue is above ``floor^2`` times the
+        largest (a Cholesky factorisation, condition below 1e6, keeps every one)."""
+        s = self._scaled_eigen(rtol)[2]
+        if s is None:
+            return self.p
+        if floor is None or not s.size:
+            return int(s.size)
+        return int(np.count_nonzero(s > floor**2 * float(s.max())))
+
+    def scaled_root(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``R`` (p, p) with ``R^T R`` the column-scaled ``G`` (``G / (d d^T)``), and the
+        column scales ``d`` (p,) (``sqrt(diag G)``, 1 for a zero column): a triangular
+        factor's stand-in for naming what the rows do not excite
+        (:func:`~dynid.identification.solvers.unexcited_combinations`)."""
+        d = np.sqrt(np.maximum(np.diag(self.G), 0.0))
+        d = np.where(d > 0, d, 1.0)
+        s, U = np.linalg.eigh(0.5 * (self.G + self.G.T) / np.outer(d, d))
+        return np.asarray(np.sqrt(np.maximum(s, 0.0))[:, None] * U.T, dtype=np.float64), d
+
     def solve(self, rtol: float = 1e-10) -> NDArray[np.float64]:
         """Least-squares ``x`` (p,): minimum norm in the column-scaled coordinates,
         directions with a scaled eigenvalue below ``rtol^2`` times the largest left out."""
@@ -547,7 +569,10 @@ class HeldOutErrors:
 
 
 def cross_validate(
-    held: HeldOut, rtol: float = 1e-10, fit: NDArray[np.float64] | None = None
+    held: HeldOut,
+    rtol: float = 1e-10,
+    fit: NDArray[np.float64] | None = None,
+    xs: Sequence[NDArray[np.float64]] | None = None,
 ) -> HeldOutErrors:
     """Training and held-out errors of unconstrained least squares over the folds.
 
@@ -560,8 +585,12 @@ def cross_validate(
     fit : ndarray, shape (p,), optional
         The coefficients fitted on all data, whose training error is given (the
         identification's, solved on the rows); default: least squares on ``held.whole``.
+    xs : sequence of ndarray, optional
+        Each fold's coefficients (p,); default: least squares on its training rows at
+        ``rtol`` (:func:`~dynid.identification.fold_offsets.fold_fits` leaves out the
+        offsets those rows do not tell apart).
     """
-    xs = [t.solve(rtol) for t in held.train]
+    xs = [t.solve(rtol) for t in held.train] if xs is None else list(xs)
     x = held.whole.solve(rtol) if fit is None else np.asarray(fit, dtype=np.float64)
     return HeldOutErrors(
         held.scheme,
@@ -571,10 +600,11 @@ def cross_validate(
     )
 
 
-def fold_errors_percent(held: HeldOut, rtol: float = 1e-10) -> tuple[float, ...]:
+def fold_errors_percent(
+    held: HeldOut, rtol: float = 1e-10, xs: Sequence[NDArray[np.float64]] | None = None
+) -> tuple[float, ...]:
     """Each fold's relative held-out error [%], ``100 ||W x_j - y_j|| / ||y_j||`` with
-    ``x_j`` least squares on its training rows (:meth:`Normals.solve` at ``rtol``): the
-    folds :func:`cross_validate` pools."""
-    return tuple(
-        t.relative_error_percent(f.solve(rtol)) for f, t in zip(held.train, held.test, strict=True)
-    )
+    ``x_j`` of ``xs``, default least squares on its training rows (:meth:`Normals.solve`
+    at ``rtol``): the folds :func:`cross_validate` pools."""
+    fits = [f.solve(rtol) for f in held.train] if xs is None else list(xs)
+    return tuple(t.relative_error_percent(x) for x, t in zip(fits, held.test, strict=True))

@@ -31,6 +31,7 @@ from ..progress import stage
 from ..regressors.terms import ModelTerm
 from .candidates import OUTLIER_RATIO, Selection, cut_record, heldout_of, recording_oddness
 from .core import model_columns
+from .fold_offsets import FOLD_RTOL, fold_fits, fold_solution, kept_labels
 from .holdout import fold_errors_percent
 from .input_noise import exact_to_round_off
 from .log import TorqueLog, default_max_gap
@@ -191,7 +192,7 @@ def _residual_spans(
     held = heldout_of(model).restricted(idx)
     if held.folds != len(data.names):
         return ()
-    x = held.train[k].solve(rtol)
+    x = fold_solution(held.train[k], rtol, kept_labels(model, idx))[0]
     columns = model_columns(robot, data, drive=model.drive, terms=tuple(terms), base=model.base)
     labels, _ = data.fold_labels()
     e, o = [], 0
@@ -232,7 +233,9 @@ def _per_recording_fitted(
     if held is None or held.scheme != "recordings" or held.folds != len(fitted):
         return per
     fit = model.joint_fit if model.joint_fit is not None else model.fit
-    errors = fold_errors_percent(held.restricted(np.flatnonzero(fit.kept)))
+    kept = np.flatnonzero(fit.kept)
+    sub = held.restricted(kept)
+    errors = fold_errors_percent(sub, xs=fold_fits(sub, FOLD_RTOL, kept_labels(model, kept)))
     folds = dict(zip(fitted, errors, strict=True))
     return tuple((name, folds.get(k, e)) for k, (name, e) in enumerate(per))
 
@@ -403,7 +406,9 @@ def _odd_under(
         return (), {}, ()
     fit = model.joint_fit if model.joint_fit is not None else model.fit
     kept = np.asarray(fit.kept, dtype=bool)
-    errors = fold_errors_percent(held.restricted(np.flatnonzero(kept)), rtol)
+    idx = np.flatnonzero(kept)
+    sub = held.restricted(idx)
+    errors = fold_errors_percent(sub, xs=fold_fits(sub, rtol, kept_labels(model, idx)))
     per = tuple(zip(names, errors, strict=True))
     if len(names) < 3:
         return (), {}, per
