@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import warnings
 
@@ -22,6 +23,7 @@ import pytest
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.io.observer_files import save_thresholds
 from dynid.io.robot.toml import save_toml
 from dynid.observer.unmodelled_load import LOAD_FRAME
 from dynid.workflows.observe import ObserveOptions, observe_files
@@ -160,3 +162,56 @@ def test_a_short_event_is_drawn_wider_than_a_hairline_and_named_in_the_legend():
     labels = [x.get_text() for x in fig.legends[0].get_texts()]
     assert "collision event" in labels and "contact event" not in labels
     plt.close(fig)
+
+
+def _positions_only(src, dst) -> None:
+    """``src``'s log with its velocity columns left out (as a positions-only log)."""
+    lines = [x for x in src.read_text().splitlines() if not x.startswith("#")]
+    keep = [i for i, h in enumerate(lines[0].split(",")) if not h.startswith("dq")]
+    dst.write_text("\n".join(",".join(x.split(",")[i] for i in keep) for x in lines) + "\n")
+
+
+def test_calibrating_on_both_kinds_of_velocities_warns_and_detection_says_mixed(logs):
+    """Regression (an iiwa trial): calibrating on logs with measured velocities and one of
+    positions only recorded "velocities: mixed" in silence, and a positions-only log
+    detected with those thresholds (2-3.5x wider than its own kind's) said nothing. The
+    same motion with its velocities measured (the simulation's noise on them) and derived
+    (low-passed): the calibration names each log's kind and the measured ones as the
+    noisier, and a detection on either kind warns that the thresholds are mixed."""
+    d = logs
+    _positions_only(d / "free.csv", d / "free_q.csv")
+    _positions_only(d / "hit.csv", d / "hit_q.csv")
+    opts = ObserveOptions(
+        data=(d / "free.csv", d / "free_q.csv"), params="panda", calibrate=True, keep_series=False
+    )
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        result = observe_files(opts)
+    assert result.thresholds.velocities == "mixed"
+    mixed = [str(w.message) for w in said if "one set of thresholds for both" in str(w.message)]
+    assert len(mixed) == 1 and "\n" not in mixed[0]
+    assert mixed[0].startswith(
+        "velocities measured in free.csv and derived from the positions in free_q.csv"
+    )
+    assert "here the measured ones" in mixed[0] and "calibrate per kind" in mixed[0]
+    # the cost said: the mixed thresholds over those of the derived log alone, no warning
+    alone = dataclasses.replace(opts, data=(d / "free_q.csv",))
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        own = observe_files(alone).thresholds
+    assert own.velocities == "derived"
+    assert not [w for w in said if "one set of thresholds for both" in str(w.message)]
+    ratio = result.thresholds.contact / own.contact
+    j = int(np.argmax(ratio))
+    assert ratio[j] > 1.2 and f"up to {ratio[j]:.3g} x" in mixed[0]
+    assert f"{dynid.panda().joint_names[j]} " in mixed[0]
+    path = d / "mixed.json"
+    save_thresholds(path, result.thresholds, joints=dynid.panda().joint_names)
+    for name, kind, other in (
+        ("hit_q.csv", "derived", "measured"),
+        ("hit.csv", "measured", "derived"),
+    ):
+        _, said = _detect(d, name, path)
+        kinds = [s for s in said if "calibrated on logs of both kinds" in s]
+        assert len(kinds) == 1 and kinds[0].startswith(f"{name}: velocities {kind}"), name
+        assert f"set partly on {other} velocities" in kinds[0]

@@ -244,3 +244,36 @@ def test_a_calibration_on_the_models_own_recordings_is_said_in_sample(free, tmp_
     assert said["own"][0] == [1, 1] and said["other"][0] == [0, 1]
     assert words in said["own"][1] and words in said["own"][2]
     assert "in-sample" not in said["other"][1] and "in-sample" not in said["other"][2]
+
+
+def test_a_feasible_json_s_own_recordings_are_said_in_sample(free, tmp_path, capsys):
+    """Regression (an iiwa trial): observe --params feasible.json --calibrate on the
+    recordings identify --consistent fitted said "at the noise floor" with no word that
+    they were its training data (validate --params says it). The identification.json
+    beside the feasible.json records them by name: counted and said in-sample; a
+    feasible.json with no identification beside it counts none."""
+    from dynid.identification.info import IdentificationInfo
+    from dynid.io.feasible import save_feasible_json
+    from dynid.io.model_json import save_model_json
+
+    from conftest import exact_model
+
+    path, _ = free
+    panda = dynid.panda()
+    said = {}
+    for name, beside in (("own", True), ("alone", False)):
+        folder = tmp_path / name
+        folder.mkdir()
+        params = save_feasible_json(folder / "feasible.json", panda)
+        if beside:
+            info = IdentificationInfo(recordings=({"file": path.name},))
+            model = dataclasses.replace(exact_model(panda, panda), info=info)
+            save_model_json(folder / "identification.json", model)
+        args = ["observe", "--params", str(params), "--data", str(path), "--calibrate"]
+        capsys.readouterr()
+        assert main([*args, "--no-figures", "--out", str(folder / "cal")]) == 0
+        doc = json.loads((folder / "cal" / "thresholds.json").read_text())
+        said[name] = (doc["calibration"]["model_check"]["fitted"], capsys.readouterr().out)
+    words = "all are the identification's own recordings, so in-sample"
+    assert said["own"][0] == [1, 1] and words in said["own"][1]
+    assert said["alone"][0] == [0, 1] and "in-sample" not in said["alone"][1]

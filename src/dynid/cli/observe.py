@@ -40,9 +40,12 @@ Two steps:
   more than 20 % away from it warns (the velocities' noise in the residual, and the
   thresholds, change with the rate; calibrate at the log's rate), and so does a log whose
   velocities are derived from its positions where the calibration's were measured, or the
-  reverse. A log without velocity columns has them derived from its positions (a
-  zero-phase low-pass at 20 Hz, then differences), at a quarter of its rate when it is
-  sampled at 40 Hz or less (a note says so; calibrate and detect at the same rate).
+  reverse, or any log where the calibration held both kinds (one set of thresholds for
+  both is set by the noisier kind: calibrating on both warns, naming each log's kind and
+  the cost; calibrate per kind, on logs of the kind the detection will see). A log
+  without velocity columns has them derived from its positions (a zero-phase low-pass at
+  20 Hz, then differences), at a quarter of its rate when it is sampled at 40 Hz or less
+  (a note says so; calibrate and detect at the same rate).
   Whether the observer is
   good enough is printed below the table, kept in thresholds.json's calibration and put
   first in the report: the false alarms the thresholds raise on the calibration logs (the
@@ -50,7 +53,9 @@ Two steps:
   detected per joint while it moves (the largest contact threshold along the motion; at
   rest: its column), and how well the model predicts the calibration logs' torques, judged
   as `dynid validate` judges it (relative error against the noise floor, validate's
-  verdict): a model above the floor makes the thresholds wider, and the line says so.
+  verdict): a model above the floor makes the thresholds wider, and the line says so;
+  calibration logs the model was fitted on (an identification.json's recordings, or those
+  of the one beside a --params feasible.json) are counted there as in-sample.
   --thresholds thresholds.json on any logs writes OUT/events.json (dynid-events/1: start
   and end [s], joints (1-based) and joint_names, peak [N m] per joint and level, contact
   or collision, and the log of every event), OUT/residuals.csv (t, r1..rn and, with

@@ -13,11 +13,14 @@ UR5 the wrist's contact threshold was 0.071 N m calibrated at 1 kHz and 0.123 N 
 :func:`rate_mismatch` says a log sampled more than :data:`RATE_TOLERANCE` away from it.
 For the same reason :attr:`Thresholds.velocities` records whether the calibration logs'
 velocities were measured or derived from the positions (a low-pass and differences: far
-less noise), and :func:`velocity_mismatch` says a log whose velocities are the other kind.
+less noise), and :func:`velocity_mismatch` says a log whose velocities are the other kind,
+or any log where the calibration held both kinds (``mixed``): one set of thresholds for
+both is set by the noisier kind, which :func:`mixed_velocities` says at the calibration.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,6 +37,7 @@ __all__ = [
     "RestMargin",
     "Thresholds",
     "log_rate",
+    "mixed_velocities",
     "rate_mismatch",
     "threshold_series",
     "velocity_mismatch",
@@ -247,9 +251,19 @@ def rate_mismatch(rate_hz: float | None, thresholds: Thresholds, name: str) -> s
 def velocity_mismatch(derived: bool, thresholds: Thresholds, name: str) -> str | None:
     """One line when a log's velocities (``derived`` from its positions, else measured)
     are of the other kind than the calibration logs' (module docstring), ``name`` the
-    thresholds file; None otherwise, or when the calibration's are not recorded or mixed."""
+    thresholds file, or of either kind where the calibration's were ``mixed`` (set partly on
+    the other kind); None otherwise, or when the calibration's are not recorded."""
     cal = thresholds.velocities
     kind = "derived" if derived else "measured"
+    if cal == "mixed":
+        other = "measured" if derived else "derived"
+        return (
+            f"velocities {kind}, {name} calibrated on logs of both kinds: its thresholds were "
+            f"set partly on {other} velocities, whose residual's noise is not this log's (the "
+            "noisier kind sets them), so they may be too high (contacts missed) or too low "
+            f"(false alarms); hint: calibrate on collision-free logs with {kind} velocities "
+            "alone"
+        )
     if cal not in ("measured", "derived") or cal == kind:
         return None
     return (
@@ -257,6 +271,58 @@ def velocity_mismatch(derived: bool, thresholds: Thresholds, name: str) -> str |
         "velocities' through M(q) dq times the gain) is not the same, so the thresholds may "
         "be too low (false alarms) or too high (contacts missed); hint: calibrate on "
         f"collision-free logs with {kind} velocities"
+    )
+
+
+def mixed_velocities(
+    measured: Sequence[str],
+    derived: Sequence[str],
+    read_measured: ArrayLike,
+    read_derived: ArrayLike,
+    joints: Sequence[str],
+    unit: str = "N m",
+) -> str:
+    """One line for a calibration on logs of both kinds of velocities: which logs hold
+    which, and what one set of thresholds for both costs (module docstring).
+
+    Parameters
+    ----------
+    measured, derived : sequence of str
+        The logs (names) whose velocities are columns of theirs, or derived from the
+        positions.
+    read_measured, read_derived : array_like, shape (n,)
+        The largest ``|r|`` read past the standstill margin [N m] on the logs of each kind,
+        per joint: the thresholds are ``margin`` times the larger (the noisier kind's).
+    joints : sequence of str
+        The joints' names (n).
+    unit : str
+        The unit the torques are said in.
+
+    Returns
+    -------
+    str
+        The warning: the noisier kind, its largest ratio to the other and that joint's
+        two levels, and the hint to calibrate per kind.
+    """
+    m = np.asarray(read_measured, dtype=np.float64)
+    d = np.asarray(read_derived, dtype=np.float64)
+    tiny = np.finfo(np.float64).tiny
+    up = np.nan_to_num(m / np.maximum(d, tiny), nan=1.0)
+    down = np.nan_to_num(d / np.maximum(m, tiny), nan=1.0)
+    noisy, quiet, ratio = (
+        ("measured", "derived", up) if up.max() >= down.max() else ("derived", "measured", down)
+    )
+    hi, lo = (m, d) if noisy == "measured" else (d, m)
+    j = int(np.argmax(ratio))
+    return (
+        f"velocities measured in {', '.join(measured)} and derived from the positions in "
+        f"{', '.join(derived)}: one set of thresholds for both is set by the noisier kind, "
+        f"here the {noisy} ones (the largest |r| read on the logs of {noisy} velocities is up "
+        f"to {ratio[j]:.3g} x that on the {quiet} ones: {joints[j]} {hi[j]:.3g} against "
+        f"{lo[j]:.3g} {unit}), so a detection on a log of {quiet} velocities is up to that much "
+        "less sensitive than thresholds of its own kind would make it; hint: calibrate per "
+        "kind, on collision-free logs of the kind the detection will see (these thresholds "
+        "record velocities: mixed, which a detection warns of)"
     )
 
 

@@ -80,6 +80,7 @@ from ..exceptions import DataError, DynidError, DynidWarning, OptionError, Shape
 from ..exceptions import in_file as about_file
 from ..friction.fit import same_drive
 from ..friction.model import FrictionModel, FrictionSum, own_at_motors_note, placed_friction
+from ..identification.info import IdentificationInfo
 from ..identification.log import TorqueLog, joint_side_log
 from ..identification.model import IdentifiedModel
 from ..identification.spikes import SPIKES_BEFORE_OBSERVER
@@ -109,7 +110,13 @@ from ..observer.residual import DEFAULT_GAIN, ObserverOptions
 from ..observer.results import LogObservation, ObserveResult
 from ..observer.scoring import DEFAULT_TOLERANCE_S
 from ..observer.sign import TorqueSign, opposite_finding, unexplained_finding
-from ..observer.thresholds import ModelFingerprint, log_rate, rate_mismatch, velocity_mismatch
+from ..observer.thresholds import (
+    ModelFingerprint,
+    log_rate,
+    mixed_velocities,
+    rate_mismatch,
+    velocity_mismatch,
+)
 from ..observer.trust import QuietResidual
 from ..observer.unmodelled import FrictionTally
 from ..observer.unmodelled_load import LoadTally
@@ -943,6 +950,7 @@ def _calibrated(
     )
     sigma_max = np.zeros(model.n) if wants_std else None
     r_max = np.zeros(model.n)  # the largest |r| of every log
+    kinds: dict[bool, NDArray[np.float64]] = {}  # read past the margin, per velocity kind
     # no series: the residual's level and false alarms read on a second pass
     again: list[PreparedLog] | None = [] if not opts.keep_series else None
     kept: list[PreparedLog] = []  # with the series: their margins again once calibrated
@@ -974,6 +982,7 @@ def _calibrated(
                 mine.add(q[rows], dq[rows], blk.r)
                 if np.isfinite(blk.r).any():
                     np.fmax(r_max, np.nanmax(np.abs(blk.r), axis=0), out=r_max)
+                    _read_past(kinds.setdefault(bool(log.dq_derived), np.zeros(model.n)), blk)
                 if sigma_max is not None and blk.std is not None and np.isfinite(blk.std).any():
                     np.fmax(sigma_max, np.nanmax(blk.std, axis=0), out=sigma_max)
                 if unmodelled is not None:  # the friction the model misses, at speed
@@ -1002,18 +1011,11 @@ def _calibrated(
     std = beside(_std) if wants_std else None
     margins = beside(lambda x: _margin(x, model.n)) if wants_margin else None
     settled = beside(lambda x: _settled(x, model.n)) if wants_margin else None
-    r = residuals()
     th = calibrate(
-        r,
-        options,
-        std=std,
-        standstill=margins,
-        rest=settled,
-        margin=opts.margin,
-        quantile=opts.quantile,
-        collision_factor=opts.collision_factor,
-        k_sigma=opts.k_sigma,
-    )
+        residuals(), options, std=std, standstill=margins, rest=settled, margin=opts.margin,
+        quantile=opts.quantile, collision_factor=opts.collision_factor, k_sigma=opts.k_sigma,
+    )  # fmt: skip
+    _warn_mixed(read, kinds, model)
     if kept and th.rest is not None and np.any(th.rest.calibrated):  # the margins applied
         logs[:] = [
             dataclasses.replace(x, standstill=margin_series(p, model, options, th.rest))
@@ -1034,6 +1036,31 @@ def _calibrated(
             _checked(th, logs, sigma_max, r_max, counted), model=_model_check(opts, model, read)
         ),
     )
+
+
+def _read_past(peak: NDArray[np.float64], blk: ObservedBlock) -> None:
+    """``peak`` (n,) [N m] raised to the largest ``|r|`` of ``blk`` past its standstill
+    margin, as the calibration reads it (:func:`~dynid.observer.detection.calibrate`)."""
+    a = np.abs(blk.r) if blk.margin is None else np.clip(np.abs(blk.r) - blk.margin, 0.0, None)
+    np.fmax(peak, np.nanmax(a, axis=0), out=peak)
+
+
+def _warn_mixed(
+    read: Recorded, kinds: Mapping[bool, NDArray[np.float64]], model: ObserverModel
+) -> None:
+    """A warning when the calibration logs ``read`` hold both kinds of velocities
+    (measured and derived from the positions), with the largest ``|r|`` read past the
+    margin on each kind's logs, ``kinds`` [N m] (:func:`~dynid.observer.thresholds.
+    mixed_velocities`)."""
+    if len(kinds) < 2:
+        return
+    names = {k: [Path(p).name for p, x in zip(read.paths, read.logs, strict=True)
+                 if bool(x.dq_derived) is k] for k in (False, True)}  # fmt: skip
+    said = mixed_velocities(
+        names[False], names[True], kinds[False], kinds[True], model.robot.joint_names,
+        unit_said(model.robot, "N m"),
+    )  # fmt: skip
+    warnings.warn(said, DynidWarning, stacklevel=caller_level())
 
 
 @contextlib.contextmanager
@@ -1084,9 +1111,22 @@ def _model_check(opts: ObserveOptions, model: ObserverModel, read: Recorded) -> 
         return None
     error = float(got.validation.errors.relative_error_percent)
     names = [Path(p).name for p in opts.data]
-    fitted = judged.info.fitted_on(names) if isinstance(judged, IdentifiedModel) else ()
+    fitted = () if (record := _fitted_record(judged, feasible)) is None else record.fitted_on(names)
     count = (len(fitted), len(opts.data))
     return ModelCheck(got.verdict, error, float(got.noise_floor_percent), count)
+
+
+def _fitted_record(
+    judged: IdentifiedModel | Robot, feasible: str | None
+) -> IdentificationInfo | None:
+    """The record of the recordings ``judged`` was fitted on: an identified model's own,
+    or that of the ``identification.json`` beside a ``feasible.json`` (``identify
+    --consistent`` writes both: :func:`~dynid.workflows.as_identified.identification_beside`,
+    as ``validate --params`` finds it); None for a robot file."""
+    if isinstance(judged, IdentifiedModel):
+        return judged.info
+    own = None if feasible is None else identification_beside(feasible, judged)
+    return None if own is None else own.info
 
 
 def _checked(
