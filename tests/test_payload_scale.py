@@ -17,6 +17,7 @@ from test_payload import COM, MASS, _inertia, _static
 
 import dynid
 from dynid.cli.__main__ import main
+from dynid.cli.payload import scale_line
 from dynid.exceptions import DataError
 from dynid.feasibility.payload import identify_payload
 from dynid.feasibility.payload_scale import TorqueScale, scale_doubts
@@ -178,3 +179,19 @@ def test_the_hint_names_the_drive_files_torque_constant_for_currents():
     assert not scale_doubts(TorqueScale(0.951, 0.001, 0.83, 0.01, "loaded"), 0.83 * 0.951)
     assert scale_doubts(TorqueScale(0.951, 0.001, 0.83, 0.01, "loaded"), 0.5)
     assert not scale_doubts(TorqueScale(0.9, 0.04, 0.83, 0.01, "loaded"), 0.5)
+
+
+def test_the_scale_line_says_how_far_a_factor_within_the_tolerance_is_from_1():
+    """Regression (a factor 36 std from 1 read "no doubt (a within 3 std of 1, ...)"): a
+    factor 4.7 % from 1 at a std of 0.0013 is said 4.7 % off 1, clear of it by 36 std,
+    within the 5 % the check accepts, and carried by the load's mass (m / a 2.463 kg of a
+    2.579 kg reading); one within 3 std is said so; one beyond the tolerance is the
+    doubt's."""
+    near = TorqueScale(1.0471, 0.0013, 2.579 / 1.0471, 0.017, "unloaded")
+    line = scale_line(near, 2.579)
+    assert "4.7 % off 1 (clear of it by 36.2 std), within the 5 % the check accepts" in line
+    assert "the load's mass carries it" in line and "m / a = 2.463 kg" in line
+    assert "no doubt" not in line
+    same = scale_line(TorqueScale(1.0002, 0.0003, 0.83, 0.001, "loaded"), 0.83)
+    assert "within 3 std of 1, no sign of a scale" in same
+    assert "a doubt (the warning)" in scale_line(dataclasses.replace(near, value=0.834), 2.0)

@@ -61,11 +61,13 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from ..exceptions import DataError
 from ..feasibility.payload import PayloadEstimate
 from ..feasibility.payload_scale import (
     SCALE_OFF,
     SCALE_SIGMAS,
     TorqueScale,
+    known_mass_scale,
     scale_mass,
     unjudged_ratio,
 )
@@ -162,6 +164,15 @@ def register(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "friction identify chooses on held-out data from the same recordings if it leaves "
         "less",
     )
+    p.add_argument(
+        "--known-mass",
+        type=float,
+        default=None,
+        metavar="KG",
+        help="the load's true mass [kg], when known: the identified mass over it is the "
+        "torques' scale (a drive's torque constants off by that factor in common), printed "
+        "and written to payload.json (known_mass)",
+    )
     add_drive_option(p)
     add_q_start_option(p)
     add_log_options(p)
@@ -193,8 +204,13 @@ def run(args: argparse.Namespace, console: Console) -> int:
             ExportRobotOptions(format="toml", drive=drive, **(chain if is_urdf(spec) else {})),
         )
         loaded = save_export(args.out / ROBOT_WITH_LOAD, plan)
-    path = save_payload_json(args.out / "payload.json", result.estimate, kin, with_tool=loaded.name)
-    print_payload(console, result, label, kin)
+    known = args.known_mass
+    if known is not None and not known > 0:
+        raise DataError(f"--known-mass must be above 0 kg, got {known:g}")
+    path = save_payload_json(
+        args.out / "payload.json", result.estimate, kin, with_tool=loaded.name, known_mass=known
+    )
+    print_payload(console, result, label, kin, known_mass=known)
     if isinstance(arm, IdentifiedModel):
         console.print(
             f"note: {args.model.name} holds base parameters (combinations of the links' "
@@ -224,11 +240,17 @@ def _options(args: argparse.Namespace, n: int, drive: Any) -> dict[str, Any]:
 
 
 def print_payload(
-    console: Console, result: PayloadFileResult, label: str, robot: Robot | None = None
+    console: Console,
+    result: PayloadFileResult,
+    label: str,
+    robot: Robot | None = None,
+    *,
+    known_mass: float | None = None,
 ) -> None:
     """The estimate (mass, CoM, inertia with their std), the recordings, the preprocessing,
     the notes and whether setLoad values were written (the torques' units per joint kind
-    of ``robot``)."""
+    of ``robot``); ``known_mass`` [kg]: the load's true mass, the torques' scale it reads
+    (:func:`known_mass_line`)."""
     est = result.estimate
     console.print(f"payload on frame {est.frame!r} ({est.route}; arm: {label})")
     doubt = "  in doubt" if est.doubts else ""
@@ -248,6 +270,12 @@ def print_payload(
         console.print(f"  {judged}")
     if est.torque_scale is not None:
         console.print(f"  {scale_line(est.torque_scale, est.mass, est.floor_rms)}")
+    elif est.scale_unchecked:
+        console.print(
+            f"  torques  not checked against the arm description's: {est.scale_unchecked}"
+        )
+    if known_mass is not None:
+        console.print(f"  {known_mass_line(est, known_mass)}")
     if result.recordings:
         console.print(result.describe())
     prep = est.preprocessing
@@ -276,31 +304,51 @@ def print_payload(
 
 
 def scale_line(t: TorqueScale, mass: float, noise_rms: float | None = None) -> str:
-    """``torques 1.0002 x the arm description's (std 0.00021, on the loaded data); at the
-    description's scale the load is 0.8292 kg (fitted beside the factor, over it; std
-    0.0013); no doubt (a within 3 std of 1, or within 5 % and the load's mass too)``
-    (:attr:`PayloadEstimate.torque_scale`, :func:`~dynid.feasibility.payload_scale.
-    scale_mass`; ``mass``: the load's estimate [kg], :meth:`TorqueScale.off`); with a fit
-    that leaves more than 3 x the torque noise ``noise_rms`` [N m], the factor not judged
-    (:func:`~dynid.feasibility.payload_scale.unjudged_ratio`)."""
+    """``torques  1.0471 x the arm description's (std 0.0013, on the data without the
+    load): 4.7 % off 1 (clear of it by 36 std), within the 5 % the check accepts; the
+    load's mass carries it: at the description's scale the load is m / a = 2.462 kg (std
+    0.017)``, or ``within 3 std of 1: no sign of a scale`` (:attr:`PayloadEstimate.
+    torque_scale`, :func:`~dynid.feasibility.payload_scale.scale_mass`; ``mass``: the
+    load's estimate [kg], :meth:`TorqueScale.off`: beyond what the check accepts, a doubt
+    of its own); with a fit that leaves more than 3 x the torque noise ``noise_rms`` [N m],
+    the factor not judged (:func:`~dynid.feasibility.payload_scale.unjudged_ratio`)."""
     where = "the data without the load" if t.data == "unloaded" else "the loaded data"
+    head = f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where})"
     if (ratio := unjudged_ratio(t, noise_rms)) is not None:
         return (
-            f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}): "
-            f"not judged, the fit with the factor leaves {ratio:.3g} x the torque noise: the "
-            "arm's description lacks torques of these data (a spring, friction, inertials "
-            "off), which the factor takes in, so it says nothing of the sensors' scale; "
-            "hint: judge it with an arm identified from these recordings (--model)"
+            f"{head}: not judged, the fit with the factor leaves {ratio:.3g} x the torque "
+            "noise: the arm's description lacks torques of these data (a spring, friction, "
+            "inertials off), which the factor takes in, so it says nothing of the sensors' "
+            "scale; hint: judge it with an arm identified from these recordings (--model)"
         )
+    at = f"at the description's scale the load is {scale_mass(t)}"
+    d = abs(t.value - 1.0)
+    if not d > SCALE_SIGMAS * t.std:
+        return f"{head}: within {SCALE_SIGMAS:g} std of 1, no sign of a scale; {at}"
+    off = f"{100 * d:.2g} % off 1 (clear of it by {d / t.std:.3g} std)" if t.std > 0 else ""
+    if t.off(mass):
+        return f"{head}: {off or f'{100 * d:.2g} % off 1'}, a doubt (the warning); {at}"
     return (
-        f"torques  {t.value:.4f} x the arm description's (std {t.std:.2g}, on {where}); "
-        f"at the description's scale the load is {scale_mass(t)}"
-        + (
-            ""
-            if t.off(mass)
-            else f"; no doubt (a within {SCALE_SIGMAS:g} std of 1, or within "
-            f"{100 * SCALE_OFF:g} % and the load's mass too)"
-        )
+        f"{head}: {off}, within the {100 * SCALE_OFF:g} % the check accepts; the load's mass "
+        f"carries it (scaled by about as much): {at}"
+    )
+
+
+def known_mass_line(est: PayloadEstimate, known: float) -> str:
+    """``known    2.5 kg: the torques read 1.0318 x it (std 0.0076): 3.2 % off 1, the
+    drive's torque constants off by about that in common`` (:func:`~dynid.feasibility.
+    payload_scale.known_mass_scale`; ``known`` [kg])."""
+    a, std = known_mass_scale(est.mass, est.std_mass, known)
+    d = abs(a - 1.0)
+    clear = (
+        f"clear of 1 by {d / std:.3g} std"
+        if std > 0 and d > SCALE_SIGMAS * std
+        else f"within {SCALE_SIGMAS:g} std of 1"
+    )
+    return (
+        f"known    {known:.6g} kg: the torques read {a:.4f} x it (std {std:.2g}; {100 * d:.2g} % "
+        f"off 1, {clear}): a torque constant or gear ratio off by about that in common over "
+        "the joints the load loads"
     )
 
 

@@ -101,6 +101,7 @@ from ..exceptions import (
     ShapeError,
 )
 from ..friction.fit import model_drive
+from ..identification.constants_checked import recorded_constants
 from ..identification.data import StaticDataset
 from ..identification.gravity_scale import recorded_scale
 from ..identification.log import TorqueLog
@@ -288,6 +289,16 @@ class PayloadEstimate:
         mass at the description's scale (:mod:`dynid.feasibility.payload_scale`); None for
         an identified model (its scale was fitted to the same sensors) or a description
         without inertial parameters.
+    scale_unchecked : str
+        Why the torques' scale was not compared with a robot's description (its drive's
+        rotor inertias to be identified, no inertial parameters); empty when it was, or
+        the arm is an identified model.
+    constants_checked : mapping or None
+        A load weighed from motor currents: the torque constants' error its mass and first
+        moments carry, ``finding`` (the note's sentence) and, of an identified arm's record
+        (:func:`~dynid.identification.constants_checked.constants_record`), ``checked``,
+        ``corrected``, ``unchecked`` (the motors, from 1), ``within_percent`` [%] and
+        ``per``; None for a log of torques.
     preprocessing : mapping
         Torque logs: ``cutoff_hz`` [Hz], ``cutoff_source`` (``"given"``, ``"model"``: the
         identification's, ``"motion"``: read from the recordings), ``decimate``,
@@ -332,6 +343,8 @@ class PayloadEstimate:
     judged: JudgedResidual | None = None
     friction_terms: str = ""
     friction_labels: tuple[str, ...] = ()
+    scale_unchecked: str = ""
+    constants_checked: Mapping[str, Any] | None = None
 
     @property
     def plausible(self) -> bool:
@@ -461,7 +474,7 @@ def identify_payload(
     kept: NDArray[np.bool_] | None = None
     record: dict[str, Any] = {}
     judging: _Judging = (None, None, None)  # torque logs: what judges the load's fit
-    described = _description(arm, d, friction)
+    described, unchecked = _description(arm, d, friction)
     if isinstance(data, StaticDataset):
         empty = None if base is None else cast(StaticDataset, base[0])
         W, yv, route, differenced, scale = _static_route(
@@ -478,7 +491,7 @@ def identify_payload(
     fit = (W, yv, kept, 4 if (static and gravity_only) else 10, static, rtol, margin)
     route += ", difference" if differenced else ""
     scaled = None if described is None else scale
-    recorded = recorded_scale(inner)  # an identified arm's scale finding: the load carries it
+    recorded = (recorded_scale(inner), recorded_constants(inner), unchecked)  # the load's too
     return _estimate(
         *fit, kin, frame, route, notes, record, differenced, scaled, d, *judging, recorded
     )
@@ -542,18 +555,27 @@ def _static_route(
 
 def _description(
     arm: Robot | IdentifiedModel | ArmModel, drive: Drive | None, friction: ArmFriction
-) -> ArmModel | None:
+) -> tuple[ArmModel | None, str]:
     """The arm's description as a whole model (:func:`~dynid.feasibility.payload_arm.arm_model`)
     when its links do not come from the data's sensors: a robot with inertial parameters
     and known rotor inertias; None for an identified model (its scale was fitted to the
-    same sensors)."""
+    same sensors). Beside it, why a robot's description cannot be compared with the
+    torques (:attr:`PayloadEstimate.scale_unchecked`; empty: it can, or it is no robot)."""
     inner = arm.model if isinstance(arm, ArmModel) else arm
-    if not isinstance(inner, Robot) or not np.any(inner.phi):
-        return None
+    if not isinstance(inner, Robot):
+        return None, ""
+    if not np.any(inner.phi):
+        return None, "the arm's description has no inertial parameters"
     try:
-        return arm_model(arm, drive=drive, friction=friction)
+        return arm_model(arm, drive=drive, friction=friction), ""
     except ModelError:  # rotor inertias to identify: the description's torques unknown
-        return None
+        return None, (
+            'the drive\'s rotor inertias are to be identified (rotor_inertia = "identify"), '
+            "so the description's torques at the motors are not known: the measured "
+            "torques have no model to be compared with; hint: give the rotor inertias in "
+            "the drive file (rotor_inertia = [...]), or weigh a load of known mass "
+            "(--known-mass)"
+        )
 
 
 def _estimate(
@@ -575,7 +597,7 @@ def _estimate(
     against: _Unloaded | None = None,
     floor: _Floor | None = None,
     spread: NDArray[np.float64] | None = None,
-    recorded: tuple[float, str] | None = None,
+    arm_records: tuple[tuple[float, str] | None, Mapping[str, Any] | None, str] = (None, None, ""),
 ) -> PayloadEstimate:
     """The load's estimate from its rows: least squares, consistency, doubts (warned);
     ``difference``: the arm was identified from unloaded data (its hint differs);
@@ -585,9 +607,14 @@ def _estimate(
     judged on the difference at matched states (:func:`_judged`); ``floor``: the noises
     the residual is judged against (None: the torque noise alone); ``spread``: the
     covariance the identified arm's parameters put into the load's, added (None: none);
-    ``recorded``: the identified arm's recorded gravity scale
-    (:func:`~dynid.feasibility.payload_doubts.model_scale_doubts`)."""
+    ``arm_records``: the identified arm's recorded gravity scale
+    (:func:`~dynid.feasibility.payload_doubts.model_scale_doubts`), why a robot's
+    description was not compared with the torques (:attr:`PayloadEstimate.scale_unchecked`)
+    and what its identification's data checked of the drive's torque constants
+    (:func:`~dynid.identification.constants_checked.recorded_constants`), which the load's
+    mass and first moments carry (:func:`~dynid.feasibility.payload_scale.constants_note`)."""
     n, k = kin.n, kin.frame(frame).link
+    recorded, checked, unchecked = arm_records
     fit = fit_load(W, yv, kept, rtol, p, static)
     est = np.asarray(fit.beta)
     cols = np.ones(W.shape[1], bool) if kept is None else kept
@@ -628,7 +655,7 @@ def _estimate(
             raise
         raise DataError(f"{exc}; {said[0]}") from None
     m, c, I, sm, sc, si = summary(phi, cov, p == 10)
-    if (constants := constants_note(drive, m, sm)) is not None:
+    if (constants := constants_note(drive, m, sm, checked)) is not None:
         notes.append(constants)
     doubts = misfit + doubts_about(kin, frame, m, sm_noise, c, misfit=bool(misfit))
     doubts += scale_doubts(scale, m, drive, floor_rms) + model_scale_doubts(recorded, m)
@@ -665,7 +692,9 @@ def _estimate(
         undetermined=undetermined,
         inertia_doubts=about_inertia,
         torque_scale=scale,
+        scale_unchecked=unchecked,
         judged=judged,
+        constants_checked=None if constants is None else {**(checked or {}), "finding": constants},
         **record,
     )
 

@@ -27,7 +27,9 @@ than :data:`SCALE_SIGMAS` of its standard deviations and either by more than
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -47,6 +49,7 @@ __all__ = [
     "SCALE_SIGMAS",
     "TorqueScale",
     "constants_note",
+    "known_mass_scale",
     "scale_doubts",
     "scale_mass",
     "torque_scale",
@@ -183,23 +186,76 @@ def torque_scale(
     )
 
 
-def constants_note(drive: Drive | None, mass: float, std_mass: float) -> str | None:
+def constants_note(
+    drive: Drive | None,
+    mass: float,
+    std_mass: float,
+    checked: Mapping[str, Any] | None = None,
+) -> str | None:
     """The note of a load weighed from motor currents (``drive`` logs currents): its mass
     ``mass`` [kg] and standard deviation ``std_mass`` [kg] hold the torques' noise and the
     arm's model, not the drive's torque constants, through which every torque is read: a
     relative error ``e`` of them, common to the joints, makes the load's torques and its
     mass ``1 + e`` times the true (a UR5's datasheet constants about 2 % off: 1.217 kg
-    +- 0.0036 for 1.2); None for a log of torques."""
+    +- 0.0036 for 1.2); None for a log of torques. ``checked``: what the identification's
+    data told of the constants (:func:`~dynid.identification.constants_checked.
+    constants_record`), said first: those checked only to within a tolerance, those not
+    checked (a UR10's constants 5 % high on motor 2 and 5 % low on motor 4, neither checked:
+    2.579 kg, std 0.019, for 2.5)."""
     if drive is None or drive.effort != "current":
         return None
     per = 0.01 * mass
     sigmas = f", {per / std_mass:.2g} std" if std_mass > 0 else ""
-    return (
-        f"the mass's std ({std_mass:.2g} kg) leaves out the error of the drive's "
-        "torque_constant: the load's torques are the currents times it, so a relative error "
-        f"of the constants common to the joints moves the mass by as much ({per:.2g} kg"
-        f"{sigmas}, per 1 %)"
+    rel = f"{100 * std_mass / mass:.2g} %" if mass > 0 else f"{std_mass:.2g} kg"
+    moved = (
+        f"a relative error of the constants common to the joints moves the mass by as much "
+        f"({per:.2g} kg{sigmas}, per 1 %)"
     )
+    said = _checked_words(checked)
+    if said is None:
+        return (
+            f"the mass's std ({std_mass:.2g} kg) leaves out the error of the drive's "
+            "torque_constant: the load's torques are the currents times it, so its mass and "
+            f"first moments carry that error: {moved}"
+        )
+    return (
+        f"the load's torques are the currents through torque constants {said}: its mass and "
+        f"first moments carry the constants' error, and the mass is known to that, not to "
+        f"its std's {rel} ({std_mass:.2g} kg): {moved}; hint: weigh a load of known mass "
+        "(--known-mass), or correct the drive file and identify again"
+    )
+
+
+def _checked_words(checked: Mapping[str, Any] | None) -> str | None:
+    """``the identification's data checked only to 10 % (motor(s) 3) and not at all (motor(s)
+    1, 2, 4, 5, 6)`` from a record of
+    :func:`~dynid.identification.constants_checked.constants_record`; None without one."""
+    if not checked:
+        return None
+    unit = str(checked.get("per", "motor"))
+    within, parts = float(checked["within_percent"]), []
+    if checked["checked"]:
+        parts.append(f"only to {within:g} % ({unit}(s) {_listed(checked['checked'])})")
+    if checked.get("corrected"):
+        parts.append(f"off, the fix said ({unit}(s) {_listed(checked['corrected'])})")
+    if checked["unchecked"]:
+        parts.append(f"not at all ({unit}(s) {_listed(checked['unchecked'])})")
+    if not parts:
+        return None
+    return "the identification's data checked " + " and ".join(parts)
+
+
+def _listed(ks: Any) -> str:
+    """``1, 2, 4`` of a list of numbers."""
+    return ", ".join(str(int(k)) for k in ks)
+
+
+def known_mass_scale(mass: float, std_mass: float, known: float) -> tuple[float, float]:
+    """The torques' scale a load of ``known`` mass [kg] reads: ``mass / known`` (the
+    measured over the true, as :attr:`TorqueScale.value`), with its standard deviation
+    from the load's ``std_mass`` [kg]; the drive's torque constants are off by that factor
+    in common (their relative error's mean over the joints the load loads)."""
+    return mass / known, std_mass / known
 
 
 def scale_mass(scale: TorqueScale) -> str:

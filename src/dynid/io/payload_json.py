@@ -55,7 +55,15 @@ factor); null with an identified model (its scale was fitted to the same sensors
 description without inertial parameters. A factor more than 5 % and 3 standard deviations
 from 1 is a doubt; ``judged`` is false when the fit with the factor leaves more than 3 x
 its noise floor (``noise_rms`` and the states' noise; the factor then takes torques the
-arm's model lacks: neither a doubt nor a load to trust).
+arm's model lacks: neither a doubt nor a load to trust). ``torque_scale_unchecked`` says
+why a robot's description was not compared with the torques (its drive's rotor inertias
+to be identified), null otherwise. ``constants_checked`` (a drive of motor currents): the
+torque constants' error the load's mass and first moments carry, ``finding`` (the note)
+and, from an identified arm's record, ``checked`` (the motors, from 1, its data checked
+only to ``within_percent`` [%]), ``corrected`` and ``unchecked``; null for torques.
+``known_mass`` (``--known-mass``): the load's true ``mass`` [kg] and the ``factor`` [1]
+the identified mass reads over it (with its ``std``): the torques' scale; null when not
+given.
 ``preprocessing`` is how torque logs were prepared (cut-off [Hz] and where it came from:
 ``given``, ``model`` (the identification's) or ``motion``; decimation; longest gap
 bridged [s], null for the default rule; ``torque_delay_s``, the torques' lag behind the
@@ -76,7 +84,7 @@ import numpy as np
 
 from .. import __version__, spatial
 from ..feasibility.payload import PayloadEstimate
-from ..feasibility.payload_scale import unjudged_ratio
+from ..feasibility.payload_scale import known_mass_scale, unjudged_ratio
 from ..model.inertia import INERTIA_ORDER, inertia6_from_matrix
 from ..model.robot import Robot
 from ..model.units import unit_said
@@ -97,9 +105,14 @@ def _list(a: Any) -> list[float | None]:
 
 
 def payload_to_dict(
-    est: PayloadEstimate, robot: Robot, *, with_tool: str | None = None
+    est: PayloadEstimate,
+    robot: Robot,
+    *,
+    with_tool: str | None = None,
+    known_mass: float | None = None,
 ) -> dict[str, Any]:
-    """The payload.json document of an estimate on ``robot`` (module docstring)."""
+    """The payload.json document of an estimate on ``robot`` (module docstring);
+    ``known_mass`` [kg]: the load's true mass, given (``known_mass``)."""
     d: dict[str, Any] = {
         "schema": PAYLOAD_SCHEMA,
         "dynid_version": __version__,
@@ -143,6 +156,11 @@ def payload_to_dict(
             "inertia_determined": est.inertia_determined,
             "undetermined_inertia": list(est.undetermined),
             "torque_scale": _scale(est),
+            "torque_scale_unchecked": est.scale_unchecked or None,
+            "constants_checked": (
+                None if est.constants_checked is None else dict(est.constants_checked)
+            ),
+            "known_mass": _known(est, known_mass),
             "preprocessing": dict(est.preprocessing) or None,
             "friction_terms": est.friction_terms or None,
             "recordings": [dict(r) for r in est.recordings],
@@ -202,8 +220,21 @@ def _scale(est: PayloadEstimate) -> dict[str, Any] | None:
     }
 
 
+def _known(est: PayloadEstimate, known: float | None) -> dict[str, Any] | None:
+    """``known_mass`` of the document (module docstring), or None."""
+    if known is None:
+        return None
+    a, std = known_mass_scale(est.mass, est.std_mass, known)
+    return {"mass": _num(known), "factor": _num(a), "std": _num(std)}
+
+
 def save_payload_json(
-    path: str | Path, est: PayloadEstimate, robot: Robot, *, with_tool: str | None = None
+    path: str | Path,
+    est: PayloadEstimate,
+    robot: Robot,
+    *,
+    with_tool: str | None = None,
+    known_mass: float | None = None,
 ) -> Path:
     """Write :func:`payload_to_dict` to ``path``; returns the path."""
-    return save_json(path, payload_to_dict(est, robot, with_tool=with_tool))
+    return save_json(path, payload_to_dict(est, robot, with_tool=with_tool, known_mass=known_mass))

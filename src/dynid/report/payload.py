@@ -15,7 +15,9 @@ the data do not determine (``undetermined_inertia`` of ``payload.json``). The le
   both;
 * usable, with reservations (fair), each reason listed: inertia elements not determined,
   a mass known to 5 % or worse, the physical-consistency constraint active (the
-  least-squares estimate was not a body);
+  least-squares estimate was not a body), motor currents read through torque constants
+  that nothing checked or the identification checked only to a tolerance
+  (``constants_checked``: the mass and CoM carry their error, which the std leaves out);
 * good otherwise.
 
 The residual is given in N m beside that noise (``noise_rms``) for torque logs, and the
@@ -218,7 +220,59 @@ def _reservations(doc: dict[str, Any], rel: float | None, undetermined: list[str
         )
     if doc.get("constraint_active"):
         out.append("the least-squares estimate was not a physical body (the constraint moved it)")
+    constants = _constants_reservation(doc)
+    if constants:
+        out.append(constants)
     return out
+
+
+def _constants_reservation(doc: dict[str, Any]) -> str | None:
+    """The torque constants' error the mass and CoM carry (``constants_checked``: motor
+    currents read through constants the identification's data checked only to a tolerance
+    or not at all, or that nothing here checked), or None: torques, or constants checked
+    (a known mass given, or the torques' scale judged against the description)."""
+    c = doc.get("constants_checked")
+    if not isinstance(c, dict):
+        return None
+    known = doc.get("known_mass")
+    if isinstance(known, dict) and is_number(known.get("factor")) and is_number(known.get("std")):
+        f, sf = known["factor"], known["std"]
+        if abs(f - 1.0) <= 3 * sf:
+            return None
+        return (
+            f"the mass reads {number(f, 4)} x the known {cell(known.get('mass'))} kg: the "
+            "torque constants are off by about that factor, which the mass and centre of "
+            "mass carry"
+        )
+    loose, unchecked = c.get("checked") or [], c.get("unchecked") or []
+    if loose or unchecked:
+        said = []
+        if loose:
+            said.append(f"only to {cell(c.get('within_percent'))} % on motor(s) {_ids(loose)}")
+        if unchecked:
+            said.append(f"not at all on motor(s) {_ids(unchecked)}")
+        return (
+            "the mass and centre of mass carry the torque constants' error, which the "
+            f"identification's data checked {' and '.join(said)} (a known mass checks it)"
+        )
+    t = doc.get("torque_scale")
+    if isinstance(t, dict) and t.get("judged") is not False:
+        a, sa = t.get("value"), t.get("std")
+        if is_number(a) and is_number(sa) and abs(a - 1.0) > 3 * sa:
+            return (
+                f"the torques read {number(a, 4)} x the arm description's, {100 * abs(a - 1):.2g} "
+                "% off 1 and clear of it: the mass carries about that factor"
+            )
+        return None
+    return (
+        "the mass and centre of mass carry the drive's torque constants' error, which nothing "
+        "here checked (a known mass checks it)"
+    )
+
+
+def _ids(ks: list[Any]) -> str:
+    """``1, 2, 4``."""
+    return ", ".join(str(k) for k in ks)
 
 
 def _section(doc: dict[str, Any], std: dict[str, Any], frame: str) -> str:

@@ -55,6 +55,7 @@ from ..friction.delay_check import logs_delay
 from ..friction.heldout_torques import HeldOutTorques, heldout_torques
 from ..identification.confounded_offset import with_confounded_offsets
 from ..identification.consistency import fit_mismatch, limit_violations
+from ..identification.constants_checked import CONSTANTS_CHECKED, constants_record
 from ..identification.core import model_loose, shared_bases
 from ..identification.data import StaticDataset
 from ..identification.dissipation import ReversedSignError
@@ -704,8 +705,16 @@ def _with_unknown_scale(
 ) -> IdentifiedModel:
     """``model`` with a note and its metadata's ``unknown_scale`` naming the motors whose
     effort's scale the data leave unknown beside those judged off
-    (:func:`~dynid.workflows.gains_first.unknown_scale`); as it was otherwise."""
-    found = unknown_scale(None if held is None else held.gains, model.drive, joint_names)
+    (:func:`~dynid.workflows.gains_first.unknown_scale`), and, for a log of currents, its
+    metadata's ``constants_checked``: which motors' constants the data checked, and to what
+    (:func:`~dynid.identification.constants_checked.constants_record`), which a load
+    weighed through them carries; as it was otherwise."""
+    gains = None if held is None else held.gains
+    checked = constants_record(gains)  # what a payload weighed through them carries
+    if checked is not None:
+        extra = {**model.info.extra, CONSTANTS_CHECKED: checked}
+        model = dataclasses.replace(model, info=dataclasses.replace(model.info, extra=extra))
+    found = unknown_scale(gains, model.drive, joint_names)
     if found is None:
         return model
     said = found.sentence()
