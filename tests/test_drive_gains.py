@@ -341,8 +341,8 @@ def test_fold_fits_from_stacked_factors_equal_the_explicit_least_squares():
     p, m = 9, 4
     A, B = _rank_deficient(rng, 5000, p, m)
     labels = np.repeat([0, 1, 2, 3], [3000, 10, 1200, 790])  # 10 rows < 13 columns
-    parts = _fold_rows(A, B, labels)
-    D = np.concatenate([A, B], axis=1)
+    parts = _fold_rows(A, np.hstack([B, B]), labels)  # the efforts, then as instrumented
+    D = np.concatenate([A, B, B], axis=1)
     norms = np.linalg.norm(D, axis=0)
     norms[norms == 0] = 1.0
     active = np.array([True, False, True, True])  # effort 1 a free column

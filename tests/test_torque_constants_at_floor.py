@@ -92,20 +92,24 @@ def fits(panda, noisy_currents):
     }
 
 
-def test_a_constant_15_percent_off_is_named_at_the_noise_floor(fits):
+def test_a_constant_15_percent_off_is_read_at_the_noise_floor(fits):
     """Joint 2's constant 1.15 times the true one, joint 4's 0.85: the held-out verdict is
-    at the floor (it was, and named nothing: the gains were judged above it only); joint
-    2's factor is named within 3 std (in-sample and over the folds) of the truth 1 / 1.15
-    and the verdict says it."""
+    at the floor; joint 2's and joint 4's factors lie within 3 std of the truths 1 / 1.15
+    and 1 / 0.85 (regression: 0.861 and 1.080 +- 0.017, five std off, while the efforts
+    of the motors left out entered the fit as noisy regressors), and joint 2's is said
+    with the reason it is not named: clear of 1 by over 5 in-sample std, within 5
+    spreads over the folds (0.126 from 1, spread 0.03), the floor's rule."""
     held = fits["off"].heldout
     verdict, gains = held.verdict, held.gains
     assert verdict.level == "good"
-    assert gains is not None and gains.floor and 1 in gains.named
-    assert gains.heldout_std is not None
-    std = max(gains.std[1], gains.heldout_std[1])
-    assert std < 0.03 and abs(gains.factor[1] - 1 / 1.15) < 3 * std
-    assert "torque_constant of joint 2 looks" in verdict.reason
-    assert f"multiply it by {gains.factor[1]:.3g}" in verdict.reason
+    assert gains is not None and gains.floor and gains.heldout_std is not None
+    for k, truth in ((1, 1 / 1.15), (3, 1 / 0.85)):
+        std = max(gains.std[k], gains.heldout_std[k])
+        assert std < 0.12 and abs(gains.factor[k] - truth) < 3 * std, (k, gains.factor, std)
+    assert abs(gains.factor[1] - 1.0) > 5 * gains.std[1]
+    if 1 not in gains.named:
+        assert abs(gains.factor[1] - 1.0) < 5 * gains.heldout_std[1]
+        assert "within 5 times its spread over the folds" in gains.unnamed_reason(1)
 
 
 @pytest.mark.parametrize("rate", [200.0, 100.0], ids=["20s-200Hz", "15s-100Hz"])
@@ -249,18 +253,20 @@ def test_the_mass_note_names_the_constants_the_identification_did_not_check(
 
 
 def test_the_constants_line_says_a_factor_clear_of_1_in_sample_and_why_not_named(fits):
-    """Constants within 2 % of the true ones (joint 4's exact): joint 4 reads about 0.92,
-    many in-sample standard deviations from 1, yet its spread over the folds holds the
-    truth; the line says why it is not named (under 10 %, within 5 spreads at the floor)
-    with an uncertainty that holds the truth, and names the joints the data cannot check
-    (5 to 7: their own rotor and friction) as right as the drive file's constants."""
+    """Constants within 2 % of the true ones (joint 4's exact): joint 4 reads within 3
+    in-sample standard deviations of its truth 1 (regression: 0.925 +- 0.014, while the
+    efforts of the motors left out entered the fit as noisy regressors), and within 3
+    spreads over the folds; the line says why it is not named (under 10 %, within 5
+    spreads at the floor) with an uncertainty that holds the truth, and names the joints
+    the data cannot check (5 to 7: their own rotor and friction) as right as the drive
+    file's constants."""
     gains = fits["near"].heldout.gains
     assert gains is not None and gains.floor and gains.heldout_std is not None
     words = gains.constants_words()
     assert words is not None
     k = 3  # joint 4: the drive file's constant is the true one
-    assert abs(gains.factor[k] - 1.0) > 5 * gains.std[k]  # clear of 1 in-sample
-    assert abs(gains.factor[k] - 1.0) < 3 * gains.heldout_std[k]  # not over the folds
+    assert abs(gains.factor[k] - 1.0) < 3 * gains.std[k]  # in-sample: an honest std
+    assert abs(gains.factor[k] - 1.0) < 3 * gains.heldout_std[k]  # and over the folds
     assert f"joint 4 {gains.factor[k]:.3g} +- {gains.heldout_std[k]:.2g} (over the folds" in words
     said = re.search(r"no change to the drive file for joint\(s\) ([\d, ]+): ([^;]+)", words)
     assert said is not None and "4" in said[1].split(", "), words
