@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import _checks, signals
-from .._memo import scoped, value_key
+from .._memo import scoped, value_digest, value_key
 from ..exceptions import DataError
 from ..model.drive import Drive
 from ..model.robot import Robot
@@ -50,16 +50,41 @@ __all__ = [
 
 
 class _Shared:
-    """The stepping columns of terms already filtered on spans of logs while
-    :func:`shared_steps` is active: key (:func:`_span_columns`) -> (what the key's ids
-    name, kept alive while the entry lives; the columns (m, n, p), read only), and the
-    bytes held: at most :func:`~dynid.identification.streaming.max_stack_bytes`, the
-    memory a stacked regressor may take (a log streamed in blocks keeps none)."""
+    """The columns already computed while :func:`shared_steps` is active: key -> (what the
+    key's ids name, kept alive while the entry lives; the columns, read only), and the
+    bytes held per pool (the stepping columns; the link columns and states): at most
+    :func:`~dynid.identification.streaming.max_stack_bytes` each, the memory a stacked
+    regressor may take (a log streamed in blocks keeps none)."""
 
     def __init__(self) -> None:
-        self.held: dict[Hashable, tuple[Any, NDArray[np.float64]]] = {}
-        self.nbytes = 0
+        self.held: dict[Hashable, tuple[Any, Any]] = {}
+        self.nbytes = {"steps": 0, "states": 0}
         self.budget = max_stack_bytes()
+
+    def hold(self, key: Hashable, refs: Any, value: Any, pool: str = "steps") -> None:
+        """Hold ``value`` (an array or a tuple of arrays and None, made read only) under
+        ``key`` when the budget of its ``pool`` allows."""
+        arrays = [a for a in (value if isinstance(value, tuple) else (value,)) if a is not None]
+        size = sum(a.nbytes for a in arrays)
+        if self.nbytes[pool] + size <= self.budget:
+            for a in arrays:
+                a.flags.writeable = False
+            self.held[key] = (refs, value)
+            self.nbytes[pool] += size
+
+
+def _held(key: Hashable, refs: Any, compute: Callable[[], Any]) -> Any:
+    """``compute()`` (states, link columns), read back from :func:`shared_steps` when it
+    holds ``key`` and held there otherwise (``refs``: the objects whose ids ``key``
+    names, kept alive with it); computed each time outside the block."""
+    shared = _SHARED.get()
+    if shared is None:
+        return compute()
+    if key in shared.held:
+        return shared.held[key][1]
+    value = compute()
+    shared.hold(key, refs, value, "states")
+    return value
 
 
 _SHARED: ContextVar[_Shared | None] = ContextVar("_SHARED", default=None)
@@ -67,10 +92,13 @@ _SHARED: ContextVar[_Shared | None] = ContextVar("_SHARED", default=None)
 
 @contextmanager
 def shared_steps() -> Iterator[None]:
-    """Within the block, a term's stepping columns filtered on a span of a log are
-    computed once and read back by every later regressor holding that term (the
-    candidate structures' regressors share their friction terms): the same numbers, not
-    recomputed. Nested blocks share the outer one's; the columns are dropped at its end."""
+    """Within the block, a term's stepping columns filtered on a span of a log, the states
+    interpolated there, and the link columns at states of equal values
+    (:func:`term_regressor`) are computed once and read back by every later regressor
+    holding them (the candidate structures' regressors share their links and most
+    friction terms, and the held-out judgement's rows as measured the fit's states): the
+    same numbers, not recomputed. Nested blocks share the outer one's; the columns are
+    dropped at its end."""
     with scoped(_SHARED, _Shared):
         yield
 
@@ -270,18 +298,26 @@ def stepped_filtered(
             x: NDArray[np.float64] = x,
             grid: NDArray[np.float64] = grid,
             keep: slice = keep,
+            span: tuple[int, int] = (s, e),
         ) -> list[NDArray[np.float64]]:
             """The columns of ``terms[which]`` on this span, from the states there."""
-            onto = None
-            if stamps is not None and tw.shape[0] > 1:  # where the torques were measured
-                i0 = max(int(np.searchsorted(stamps, grid[0], side="right")) - 1, 0)
-                i1 = int(np.searchsorted(stamps, grid[-1], side="left")) + 1
-                at = stamps[i0:i1]
-                x = CubicSpline(tw, x, axis=0)(at)
-                onto = partial(_interpolated, at, grid)
-            elif grid is not tw and k > 1 and tw.shape[0] > 1:
-                x = CubicSpline(tw, x, axis=0)(np.minimum(grid, tw[-1]))
-            states = (x[:, :n], x[:, n : 2 * n], x[:, 2 * n :])
+
+            def interpolated() -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+                """The states where the columns are computed, and those instants [s] when
+                the torques were measured there (None: on ``grid``)."""
+                if stamps is not None and tw.shape[0] > 1:  # where the torques were measured
+                    i0 = max(int(np.searchsorted(stamps, grid[0], side="right")) - 1, 0)
+                    i1 = int(np.searchsorted(stamps, grid[-1], side="left")) + 1
+                    at = stamps[i0:i1]
+                    return CubicSpline(tw, x, axis=0)(at), at
+                if grid is not tw and k > 1 and tw.shape[0] > 1:
+                    return CubicSpline(tw, x, axis=0)(np.minimum(grid, tw[-1])), None
+                return x, None
+
+            where = _span_key(logs, span, cutoff_hz, k, stamps, fine)
+            xs, at = _held(("states", where), (logs, stamps, fine), interpolated)
+            onto = None if at is None else partial(_interpolated, at, grid)
+            states = (xs[:, :n], xs[:, n : 2 * n], xs[:, 2 * n :])
             rate_k = k * rate
             return [
                 _filtered_columns(terms[i], states, cutoff_hz, rate_k, keep, onto) for i in which
@@ -309,14 +345,7 @@ def _span_columns(
     if shared is None:
         return compute(list(range(len(terms))))
     refs = (logs, stamps, fine)
-    where = (
-        tuple(id(g) for g in logs),
-        span,
-        float(cutoff_hz),
-        k,
-        id(stamps),
-        None if fine is None else (id(fine[0]), fine[1]),
-    )
+    where = _span_key(logs, span, cutoff_hz, k, stamps, fine)
     keys: list[Hashable | None] = []
     for t in terms:
         try:
@@ -331,11 +360,29 @@ def _span_columns(
         for i, cols in zip(missing, compute(missing), strict=True):
             got[i] = cols
             key = keys[i]
-            if key is not None and shared.nbytes + cols.nbytes <= shared.budget:
-                cols.flags.writeable = False
-                shared.held[key] = (refs, cols)
-                shared.nbytes += cols.nbytes
+            if key is not None:
+                shared.hold(key, refs, cols)
     return [g for g in got if g is not None]
+
+
+def _span_key(
+    logs: tuple[TorqueLog | None, TorqueLog, TorqueLog | None],
+    span: tuple[int, int],
+    cutoff_hz: float,
+    k: int,
+    stamps: NDArray[np.float64] | None,
+    fine: tuple[TorqueLog, int] | None,
+) -> Hashable:
+    """What a span's filtered columns depend on beside their terms, by the ids of the
+    logs and arrays (held alive with the entry) for :func:`shared_steps`."""
+    return (
+        tuple(id(g) for g in logs),
+        span,
+        float(cutoff_hz),
+        k,
+        id(stamps),
+        None if fine is None else (id(fine[0]), fine[1]),
+    )
 
 
 def _filtered_columns(
@@ -468,13 +515,22 @@ def term_regressor(
 
     Columns: the independent base columns in ``base.independent`` order (link parameters
     from the compiled regressor, then those of the ``in_base`` terms), then every column of
-    each term that is not ``in_base`` (friction). Returns it with its labels.
+    each term that is not ``in_base`` (friction). Returns it with its labels. Within
+    :func:`shared_steps`, the link columns at states of equal values are computed once.
     """
     ind = np.asarray(base.independent)
     rigid = ind[ind < 10 * robot.n]
     appended = [t for t in terms if not t.in_base]
     width = ind.size + sum(len(t.labels) for t in appended)
-    Y = torque_regressor_prepared(robot, q, dq, ddq, robot.gravity, columns=rigid, width=width)
+    if _SHARED.get() is None:
+        Y = torque_regressor_prepared(robot, q, dq, ddq, robot.gravity, columns=rigid, width=width)
+    else:  # the states by value: the rows as measured share the fit's states
+        Y = np.empty(q.shape + (width,))
+        Y[..., : rigid.size] = _held(
+            ("links", id(robot), rigid.tobytes(), value_digest((q, dq, ddq))),
+            robot,
+            lambda: torque_regressor_prepared(robot, q, dq, ddq, robot.gravity, columns=rigid),
+        )
     c = rigid.size
     for t, sel in base_term_columns(terms, ind, robot.n):
         if sel.size:

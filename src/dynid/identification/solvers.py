@@ -370,13 +370,18 @@ def tall_r(
     Wk: NDArray[np.float64], scale: NDArray[np.float64], y: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """The upper triangular factor (k, k) of ``[Wk / scale, y]`` (m, k), ``y`` (m,) or (m,
-    q), m > k, by unpivoted Householder QR (LAPACK ``geqrf``) of blocks of
+    q), m > k: by Cholesky QR done twice (:func:`_cholesky_qr2`) where the columns are
+    conditioned for it, else by unpivoted Householder QR (LAPACK ``geqrf``) of blocks of
     :data:`_QR_BLOCK_ROWS` rows, then of their factors stacked (tall-skinny QR: the same
     factor up to the signs of its rows, in about half the time of one ``geqrf`` over rows
     that leave the cache)."""
     Y = y.reshape(y.shape[0], -1)
     m, c = Wk.shape
     k = c + Y.shape[1]
+    if m >= 4 * k:
+        R = _cholesky_qr2(Wk, scale, Y)
+        if R is not None:
+            return R
     parts: list[NDArray[np.float64]] = []
     for a in range(0, m, _QR_BLOCK_ROWS):
         b = min(a + _QR_BLOCK_ROWS, m)
@@ -388,6 +393,50 @@ def tall_r(
     if len(parts) == 1:
         return parts[0]
     return _geqrf_r(np.asfortranarray(np.vstack(parts)))
+
+
+#: Largest condition number (LAPACK's 1-norm estimate) of the first Cholesky QR's factor
+#: for which :func:`_cholesky_qr2` is used: ``eps cond^2`` far below 1, where its factor
+#: is as accurate as Householder QR's (Yamamoto et al. 2015).
+_CQR2_MAX_COND = 1e6
+
+
+def _cholesky_qr2(
+    Wk: NDArray[np.float64], scale: NDArray[np.float64], Y: NDArray[np.float64]
+) -> NDArray[np.float64] | None:
+    """The triangular factor of ``X = [Wk / scale, Y]`` (m, k) by Cholesky QR twice
+    (CholeskyQR2; Yamamoto, Nakatsukasa, Yanagisawa and Fukaya, "Roundoff error analysis
+    of the CholeskyQR2 algorithm", ETNA 44, 2015): ``X^T X = R1^T R1``, ``Q1 = X R1^-1``,
+    ``Q1^T Q1 = R2^T R2``, ``R = R2 R1``; the second pass restores the orthogonality the
+    first loses to ``eps cond(X)^2``, so that ``R`` is that of Householder QR up to the
+    signs of its rows (1e-16 relative on a 40,593 x 119 regressor of condition 5e3) in
+    about 0.6 of its time: three passes of level-3 BLAS over the rows against Householder
+    steps (one copy of ``X`` held, column-major). None when a Cholesky factorisation
+    fails or the first factor's condition number (of the columns scaled, ``Y``'s too)
+    exceeds :data:`_CQR2_MAX_COND` (the caller's Householder QR decides: a
+    rank-deficient or ill-conditioned ``Wk``, or
+    ``Y`` nearly in its span)."""
+    import scipy.linalg  # scipy on first use (start-up time)
+
+    lapack, blas = scipy.linalg.lapack, scipy.linalg.blas
+    m, c = Wk.shape
+    ny = column_scale(Y)  # the targets scaled too, undone in R's last columns
+    X = np.empty((m, c + Y.shape[1]), order="F")  # column-major: BLAS's own order
+    np.divide(Wk, scale, out=X[:, :c])
+    np.divide(Y, ny, out=X[:, c:])
+    R1, info = lapack.dpotrf(X.T @ X, lower=0, clean=1, overwrite_a=1)
+    if info != 0:
+        return None
+    rcond, info = lapack.dtrcon(R1, norm="1", uplo="U", diag="N")
+    if info != 0 or not rcond * _CQR2_MAX_COND > 1.0:
+        return None
+    Q = blas.dtrsm(1.0, R1, X, side=1, lower=0, overwrite_b=1)  # in place of X
+    R2, info = lapack.dpotrf(Q.T @ Q, lower=0, clean=1, overwrite_a=1)
+    if info != 0:
+        return None
+    R = np.triu(R2 @ R1)
+    R[:, c:] *= ny
+    return R
 
 
 def _geqrf(A: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
