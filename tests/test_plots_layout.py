@@ -1,6 +1,7 @@
 """The figures' layout and saving draw less and change no pixel: dynid's tight layout gives
 matplotlib's own ``Figure.tight_layout`` subplot parameters with each panel measured once,
-and ``save_figure`` draws a tight-laid-out figure once into the PNG ``savefig`` writes.
+and ``save_figure`` draws a tight-laid-out figure once into the PNG ``savefig`` writes,
+each axis computing its ticks once per measure or draw.
 
 Reference: matplotlib's ``Figure.tight_layout`` and ``Figure.savefig`` on the same figure.
 """
@@ -90,3 +91,43 @@ def test_save_figure_draws_a_tight_laid_out_figure_once_into_the_same_png(tmp_pa
     engine = constrained.get_layout_engine()
     save_figure(lambda: constrained, tmp_path / "c.png")
     assert constrained.get_layout_engine() is engine
+
+
+@pytest.mark.parametrize("aligned", [False, True])
+def test_ticks_are_computed_once_per_draw_with_the_same_pixels(aligned, monkeypatch):
+    """Within ticks_once, each axis computes its ticks once per measure or draw (matplotlib
+    computes them again to place the axis label): at most half as often, and the PNG has
+    the pixels of matplotlib's own draw, labels aligned across panels too (the boxes of
+    the other panels' axes), and the axes keep the class's methods afterwards."""
+    from matplotlib.axis import Axis
+    from PIL import Image
+
+    from dynid.plots.layout import ticks_once
+
+    def drawn(fig, count: bool) -> np.ndarray:
+        if aligned:
+            fig.align_ylabels()
+        update = Axis._update_ticks
+        calls: list[Axis] = []
+
+        def counted(axis):
+            calls.append(axis)
+            return update(axis)
+
+        png = io.BytesIO()
+        with monkeypatch.context() as m:
+            m.setattr(Axis, "_update_ticks", counted)
+            if count:
+                with ticks_once(fig):
+                    fig.savefig(png, format="png", dpi=60)
+            else:
+                fig.savefig(png, format="png", dpi=60)
+        counts.append(len(calls))
+        return np.asarray(Image.open(png))
+
+    counts: list[int] = []
+    ours = _panels(np.random.default_rng(6))
+    assert np.array_equal(drawn(ours, True), drawn(_panels(np.random.default_rng(6)), False))
+    assert 2 * counts[0] <= counts[1]  # matplotlib 3.11: 14 against 42 here
+    names = ("_update_ticks", "_get_ticklabel_bboxes", "get_tightbbox", "draw")
+    assert all(n not in vars(a) for ax in ours.axes for a in (ax.xaxis, ax.yaxis) for n in names)

@@ -206,7 +206,7 @@ def plot_retrieval(
     ax2.legend(fontsize=7)
     ax2.grid(True, axis="y", lw=0.3)
     fig.suptitle(title or "Feasible-parameter retrieval", fontsize=10)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig
 
 
@@ -288,5 +288,5 @@ def plot_consistent(
     ax2.legend(fontsize=8, loc="upper right", ncol=2)
     title = "pseudo-inertia margin per link"
     ax2.set_title(title + (" (red: not physically consistent)" if inconsistent else ""), fontsize=9)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .layout import tight_layout
 from .style import COLOURS
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -84,5 +85,5 @@ def plot_residual_histograms(h: HeldOutTorques, *, title: str | None = None) -> 
     axes[0, 0].set_ylabel("density [1/(N m)]", fontsize=8)
     axes[0, 0].legend(fontsize=7)
     fig.suptitle(title or f"Residuals on held-out data ({h.block})", fontsize=10)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig

@@ -4,6 +4,7 @@
 (temporary file, then rename; the format from the suffix) and closes the figure. A figure
 laid out once by ``tight_layout`` is drawn once: matplotlib leaves a placeholder layout
 engine behind it, for which ``savefig`` would first draw the whole figure without output.
+Each axis computes its ticks once per draw (:func:`~dynid.plots.layout.ticks_once`).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ..io.atomic import open_atomic
+from .layout import ticks_once
 
 __all__ = ["save_figure"]
 
@@ -34,7 +36,7 @@ def save_figure(make_figure: Callable[[], Any], path: Path, *, dpi: int = 110) -
     fig = make_figure()
     try:
         _drop_placeholder_layout(fig)
-        with open_atomic(path, "wb") as fh:
+        with open_atomic(path, "wb") as fh, ticks_once(fig):
             fig.savefig(fh, format=path.suffix.lstrip(".") or "png", dpi=dpi)
     finally:
         plt.close(fig)

@@ -338,5 +338,5 @@ def plot_rms_comparison(
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     if title:
         ax.set_title(title)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig
