@@ -195,3 +195,17 @@ def test_the_scale_line_says_how_far_a_factor_within_the_tolerance_is_from_1():
     same = scale_line(TorqueScale(1.0002, 0.0003, 0.83, 0.001, "loaded"), 0.83)
     assert "within 3 std of 1, no sign of a scale" in same
     assert "a doubt (the warning)" in scale_line(dataclasses.replace(near, value=0.834), 2.0)
+
+
+def test_a_known_mass_within_its_std_says_the_constants_agree():
+    """Regression: a known mass the identified one matched (0.9994 +- 0.0005 x) read "a
+    torque constant ... off by about that"; within 3 std it says they agree, beyond it
+    names the factor."""
+    from types import SimpleNamespace
+
+    from dynid.cli.payload import known_mass_line
+
+    agree = known_mass_line(SimpleNamespace(mass=1.1993, std_mass=0.0006), 1.2)
+    assert "within 3 std of 1" in agree and "agree with it" in agree and "off by" not in agree
+    off = known_mass_line(SimpleNamespace(mass=2.579, std_mass=0.019), 2.5)
+    assert "clear of 1 by" in off and "off by about that" in off

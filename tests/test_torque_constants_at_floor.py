@@ -250,6 +250,8 @@ def test_the_mass_note_names_the_constants_the_identification_did_not_check(
     assert k["mass"] == 1.5 and abs(k["factor"] - 1.02) < 3 * k["std"] < 0.02
     assert "known    1.5 kg: the torques read" in printed.out
     assert d["load_mass"] is not None
+    page = (tmp_path / "p" / "report.html").read_text()
+    assert "x the known 1.5 kg" in page and "&lt;span" not in page  # escaped once
 
 
 def test_the_constants_line_says_a_factor_clear_of_1_in_sample_and_why_not_named(fits):
@@ -334,3 +336,4 @@ def test_a_robot_with_rotors_to_identify_says_why_its_scale_is_not_checked(
     assert "its mass and first moments carry that error" in d["constants_checked"]["finding"]
     page = (tmp_path / "p" / "report.html").read_text()
     assert "which nothing here checked" in page
+    assert "the torque constants&#x27; error aside" in page and "(known to" not in page

@@ -345,6 +345,12 @@ def known_mass_line(est: PayloadEstimate, known: float) -> str:
         if std > 0 and d > SCALE_SIGMAS * std
         else f"within {SCALE_SIGMAS:g} std of 1"
     )
+    if not (std > 0 and d > SCALE_SIGMAS * std):  # the known mass confirms the scale
+        return (
+            f"known    {known:.6g} kg: the torques read {a:.4f} x it (std {std:.2g}; "
+            f"{100 * d:.2g} % off 1, {clear}): the torque constants and gear ratios agree with "
+            "it in common over the joints the load loads"
+        )
     return (
         f"known    {known:.6g} kg: the torques read {a:.4f} x it (std {std:.2g}; {100 * d:.2g} % "
         f"off 1, {clear}): a torque constant or gear ratio off by about that in common over "

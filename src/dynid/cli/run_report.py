@@ -100,7 +100,8 @@ class RunRecord:
     def lines(self, prefix: str) -> list[str]:
         """Lines of stdout and stderr that hold ``prefix`` (``"warning: "``, ``"note: "``),
         from the prefix on; logged warnings and notes count as such (once, printed or
-        not)."""
+        not), and a line said twice (a built-in robot's note, logged each time the robot
+        is read) once."""
         found = []
         for text in ("".join(self.err_parts), self.printed):
             for line in text.splitlines():
@@ -108,7 +109,7 @@ class RunRecord:
                 if prefix in s:
                     found.append(s[s.index(prefix) + len(prefix) :])
         logged = {"warning: ": self.logged, "note: ": self.logged_notes}.get(prefix, [])
-        return found + [m for m in logged if m not in found]
+        return list(dict.fromkeys(found + [m for m in logged if m not in found]))
 
 
 class _Collect(logging.Handler):

@@ -180,7 +180,8 @@ def _headline(
     inertia's elements are not determined)."""
     m = doc["mass"]
     parts = [
-        f"The payload weighs {number(m)} kg" + (f" (known to {100 * rel:.2g} %)" if rel else "")
+        f"The payload weighs {number(m)} kg"
+        + (f" ({_known_words(doc)} {100 * rel:.2g} %)" if rel else "")
     ]
     sc = std.get("com")
     if isinstance(sc, list) and sc and all(is_number(x) for x in sc):
@@ -193,6 +194,15 @@ def _headline(
     elif isinstance(si, list) and si and all(is_number(x) for x in si):
         parts.append(f"its inertia to {number(max(si), 2)} kg m^2")
     return ", ".join(parts[:-1]) + (" and " if len(parts) > 1 else "") + parts[-1] + "."
+
+
+def _known_words(doc: dict[str, Any]) -> str:
+    """``known to`` before the mass's relative std, or, where the mass carries torque
+    constants nothing checked (:func:`_constants_reservation`), ``its std alone, the torque
+    constants' error aside,``: the std is not what the mass is known to there."""
+    if _constants_reservation(doc) is None:
+        return "known to"
+    return "its std alone, the torque constants' error aside:"
 
 
 def _reservations(doc: dict[str, Any], rel: float | None, undetermined: list[str]) -> list[str]:
@@ -226,6 +236,12 @@ def _reservations(doc: dict[str, Any], rel: float | None, undetermined: list[str
     return out
 
 
+def _plain(v: Any) -> str:
+    """A value for a sentence the verdict escapes as a whole: a number as text, else its
+    string (never a table cell's HTML)."""
+    return number(v) if is_number(v) else str(v)
+
+
 def _constants_reservation(doc: dict[str, Any]) -> str | None:
     """The torque constants' error the mass and CoM carry (``constants_checked``: motor
     currents read through constants the identification's data checked only to a tolerance
@@ -240,7 +256,7 @@ def _constants_reservation(doc: dict[str, Any]) -> str | None:
         if abs(f - 1.0) <= 3 * sf:
             return None
         return (
-            f"the mass reads {number(f, 4)} x the known {cell(known.get('mass'))} kg: the "
+            f"the mass reads {number(f, 4)} x the known {_plain(known.get('mass'))} kg: the "
             "torque constants are off by about that factor, which the mass and centre of "
             "mass carry"
         )
@@ -248,7 +264,7 @@ def _constants_reservation(doc: dict[str, Any]) -> str | None:
     if loose or unchecked:
         said = []
         if loose:
-            said.append(f"only to {cell(c.get('within_percent'))} % on motor(s) {_ids(loose)}")
+            said.append(f"only to {_plain(c.get('within_percent'))} % on motor(s) {_ids(loose)}")
         if unchecked:
             said.append(f"not at all on motor(s) {_ids(unchecked)}")
         return (
