@@ -462,3 +462,16 @@ def test_a_stribeck_bump_on_noisy_velocities_is_chosen_on_the_smooth_sign(panda,
     floor = errors["default"]["noise_floor_percent"]
     default, banded = (errors[k]["relative_error_percent"] for k in ("default", "banded"))
     assert default < 2.0 * floor and default < 0.7 * banded, (default, banded, floor)
+
+
+def test_a_note_reached_twice_is_said_once():
+    """Regression: a motor-currents tutorial's cobot printed "the smooth-sign Stribeck
+    candidates without armature: the data do not tell them from Coulomb friction" twice
+    (the same group reached for two armature choices); the selection keeps a note once,
+    in its first place."""
+    from dynid.identification.candidates import Selection
+    from dynid.identification.structure import Structure
+
+    sel = Selection((), Structure.parse("viscous"), "blocks", notes=("a", "b", "a", "c", "b"))
+    assert sel.notes == ("a", "b", "c")
+    assert sel.as_dict()["notes"] == ["a", "b", "c"]

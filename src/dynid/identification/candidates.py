@@ -309,6 +309,11 @@ class Selection:
     spring: tuple[tuple[str, Any], ...] = ()
     differing: tuple[dict[str, Any], ...] = ()
 
+    def __post_init__(self) -> None:
+        # a note reached by two routes (the same regressor group tried for two armature
+        # choices) is said once
+        object.__setattr__(self, "notes", tuple(dict.fromkeys(self.notes)))
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready (``identification.json``'s ``metadata.selection``)."""
         return {
