@@ -6,7 +6,8 @@
   in one line (thresholds calibrated at 1 kHz used on a 100 Hz log were silently too
   low), an older file without them reads as before and says nothing;
 * a load at the flange that the model lacks (simulated on the arm carrying it) is said
-  with its mass, and nothing is said of the arm without it;
+  once with its mass, held through the whole log (it was read as a pick from 1.13 s),
+  and nothing is said of the arm without it;
 * the report's events table leaves out the column of the log's clock when every log
   starts at 0; the residual figure draws a short event wider than a hairline and names
   the events' shading in its legend.
@@ -97,9 +98,14 @@ def test_a_load_the_model_lacks_is_said_with_its_mass_and_none_without_it(logs):
     result, _ = _detect(d, "loaded.csv")
     assert result.load is not None and result.load.seen
     assert result.load.mass == pytest.approx(MASS, rel=0.15)
-    note = [n for n in result.notes if "follows the weight of a load" in n]
-    assert len(note) == 1 and "dynid payload" in note[0]
-    assert "robot_with_payload.toml for --params" in note[0]  # a robot: payload's file
+    (log,) = result.logs  # held from start to end: one load, never a pick (it was one)
+    assert [ld.whole for ld in log.loads] == [True] and log.loads[0].mass == pytest.approx(
+        MASS, rel=0.15
+    )
+    assert not [e for e in log.events if e.level == "load"]
+    note = [n for n in result.notes if "weight of a load" in n or "held through the whole" in n]
+    assert len(note) == 1 and "dynid payload" in note[0]  # said once
+    assert "robot_with_payload.toml" in note[0]  # a robot: payload's file
     for name in ("hit.csv", "free.csv"):
         result, _ = _detect(d, name)
         assert result.load is not None and not result.load.seen, name

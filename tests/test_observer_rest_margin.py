@@ -272,6 +272,36 @@ def test_the_calibration_report_says_the_margin_at_rest_per_joint(free_at_rest, 
         assert "standstill margin at rest" in page
         if name == "many":
             level = th.rest.level[1]
-            assert f"min(Coulomb level, {level:.3g} N m): calibrated from 14 rests" in page
+            assert f"min(Coulomb bound, {level:.3g} N m): calibrated from 14 rests" in page
         else:
-            assert page.count("Coulomb level: too few rests (3 of 10)") == 7
+            assert page.count("Coulomb bound: too few rests (3 of the 10 needed)") == 7
+
+
+def test_a_smooth_laws_margin_at_rest_is_said_by_the_printout_and_the_report(tmp_path, capsys):
+    """Regression (the Panda's sigmoid friction, zero at rest: the printout left out the
+    margin at rest on every joint while report.html said "too few rests" on each): both
+    say it per joint, the printout with the margin the calibration applied at rest (the
+    law's step within the velocity noise band, its "up to" line)."""
+    import re
+    import warnings
+
+    from dynid.cli.__main__ import main
+
+    sim = ["simulate", "--trajectory", "fourier", "-q", "--duration", "3", "--seed", "2"]
+    assert main([*sim, "--out", str(tmp_path / "free.csv")]) == 0
+    out = tmp_path / "cal"
+    cal = ["observe", "--params", "panda", "--no-figures", "--calibrate", "--no-report"]
+    capsys.readouterr()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main([*cal[:-1], "--data", str(tmp_path / "free.csv"), "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    up_to = re.search(r"standstill margin of the friction .*up to ([^)]*) N m\)", text)
+    assert up_to is not None, text
+    applied = [float(v) for v in up_to.group(1).split(", ")]
+    assert len(applied) == 7 and min(applied) > 0  # the law's step within the band
+    for j, v in enumerate(applied):
+        line = f"  joint{j + 1}: Coulomb bound {v:.3g} N m: too few rests (0 of the 10"
+        assert line in text, text
+    page = re.sub(r"<[^>]+>", " ", (out / "report.html").read_text())
+    assert page.count("Coulomb bound: too few rests (0 of the 10 needed)") == 7

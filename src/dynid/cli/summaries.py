@@ -1150,10 +1150,12 @@ def format_observation(result: ObserveResult, names: list[str], *, calibrating: 
         )
     if th.uses_uncertainty and th.noise is not None:
         rows.append(uncertainty_words(th.k_sigma, th.noise, th.margin, robot))
+    margins = [m for x in result.logs if (m := _margin_peak(x)) is not None]
     if calibrating and th.standstill and th.rest is not None:
         coulomb = standstill_margin(result.model.friction, np.zeros((1, th.n)))[0]
+        if margins:  # a smooth law's: its steps within the velocity noise band, applied
+            coulomb = np.maximum(coulomb, np.max(margins, axis=0))
         rows += rest_margin_lines(th.rest, coulomb, names, th.margin, robot)
-    margins = [m for x in result.logs if (m := _margin_peak(x)) is not None]
     if th.standstill and margins and np.any(margins):
         top = np.max(margins, axis=0)
         rows.append(

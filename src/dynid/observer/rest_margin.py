@@ -228,8 +228,10 @@ def rest_margin_lines(
 ) -> list[str]:
     """What the standstill margin is at a settled rest, one line per joint whose Coulomb
     bound ``coulomb`` (n,) [N m] (:func:`~dynid.observer.friction.standstill_margin` at
-    rest) is not zero, and why: calibrated from the rests, the Coulomb bound which the
-    rests reach, or the Coulomb bound for too few rests; ``margin`` the thresholds' safety
+    rest; of a smooth law, zero at rest, what its steps change within the velocity noise
+    band: the largest margin the calibration applied) is not zero, and why: calibrated
+    from the rests, the Coulomb bound which the rests reach, or the Coulomb bound for too
+    few rests; ``margin`` the thresholds' safety
     factor, ``names`` the joints' (a prismatic joint of ``robot`` said in N)."""
     head = (
         f"standstill margin at rest (a joint inside its standstill band for {rest.settle_s:g} s "

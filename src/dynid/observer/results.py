@@ -370,7 +370,7 @@ class ObserveResult:
             for ld in x.unread_loads
         )
         load = load_note(self.load, self.model.robot.joint_names, identified=identified)
-        if load:
+        if load and not held:  # the load held throughout is that load, named above
             out += (load,)
         if (
             self.frame is not None

@@ -158,7 +158,8 @@ def _joint_table(doc: dict, cal: dict) -> str:
 def _rest_margin_words(doc: dict, n: int) -> list[str] | None:
     """Per joint, the standstill margin at a settled rest as ``rule.rest_margin`` holds it
     (:class:`~dynid.observer.thresholds.RestMargin`): its calibrated level and the rests it
-    was read from, or the Coulomb level for too few rests; None for a file without it."""
+    was read from, or the Coulomb bound for too few rests, in the calibration printout's
+    words; None for a file without it."""
     rule = doc.get("rule")
     got = rule.get("rest_margin") if isinstance(rule, dict) else None
     if not isinstance(got, dict):
@@ -167,9 +168,9 @@ def _rest_margin_words(doc: dict, n: int) -> list[str] | None:
     if not (isinstance(level, list) and isinstance(rests, list) and len(level) == len(rests) == n):
         return None
     return [
-        f"min(Coulomb level, {v:.3g} N m): calibrated from {k} rests"
+        f"min(Coulomb bound, {v:.3g} N m): calibrated from {k} rests"
         if is_number(v)
-        else f"Coulomb level: too few rests ({k} of {need})"
+        else f"Coulomb bound: too few rests ({k} of the {need} needed)"
         for v, k in zip(level, rests, strict=True)
     ]
 
