@@ -26,12 +26,10 @@ from numpy.typing import NDArray
 
 from ..exceptions import DataError, RankDeficientError, SolverError
 from ..identification.least_squares import LeastSquaresFit, fit_least_squares
-from ..identification.one_way_friction import offset_instead, one_way_joints
+from ..identification.one_way_friction import columns_left_out, one_way_joints
 from ..identification.solvers import (
     column_scale,
     pivoted_rank,
-    unexcited_columns,
-    unexcited_combinations,
 )
 from ..model.inertia import inertia6_from_matrix, inertial_from_phi
 from ..regressors.base import RANK_FLOOR
@@ -232,9 +230,7 @@ def _not_told_apart_columns(
     if rank == len(names):
         return None
     R = R[: len(names), np.argsort(piv)]  # the columns back in their order
-    combinations = unexcited_combinations(R, scale, rank, names)
-    columns = unexcited_columns(R, scale, rank)
-    return {offset_instead(names[i], combinations) for i in columns}, combinations
+    return columns_left_out(R, scale, rank, names)
 
 
 def _told_apart_note(combinations: tuple[str, ...], left: list[str]) -> str:

@@ -35,8 +35,9 @@ the table still saying offsets predict 20 times worse) and add a search; the cau
 fold's undetermined direction, so it is resolved there. Rows that reverse the joint only
 briefly (a few samples) do tell the two apart, poorly: their fold is judged as before.
 
-* :data:`OFFSET`, :data:`COULOMB`: the labels of a joint's (motor's) torque offset and
-  Coulomb coefficient; :data:`FOLD_RTOL`: the folds' default rank tolerance;
+* :data:`FOLD_RTOL`: the folds' default rank tolerance (the labels of offsets and Coulomb
+  coefficients: :data:`~dynid.identification.one_way_friction.OFFSET`,
+  :data:`~dynid.identification.one_way_friction.COULOMB`);
 * :func:`model_labels`, :func:`kept_labels`: the labels of a model's columns (``""`` for
   the links');
 * :func:`resolved`: the rank tolerance normal equations resolve;
@@ -48,7 +49,6 @@ briefly (a few samples) do tell the two apart, poorly: their fold is judged as b
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Sequence
 
 import numpy as np
@@ -56,13 +56,10 @@ from numpy.typing import NDArray
 
 from .holdout import HeldOut, Normals
 from .model import IdentifiedModel
-from .one_way_friction import offset_instead
-from .solvers import unexcited_columns, unexcited_combinations
+from .one_way_friction import OFFSET, columns_left_out
 
 __all__ = [
-    "COULOMB",
     "FOLD_RTOL",
-    "OFFSET",
     "fold_fits",
     "fold_solution",
     "kept_labels",
@@ -71,12 +68,8 @@ __all__ = [
     "untold_offsets",
 ]
 
-#: A torque offset of one joint (motor): ``fo3``, or ``jfo7`` at a joint beside the motors.
-OFFSET = re.compile(r"j?fo[0-9]+")
 #: The folds' rank tolerance where none is given (:meth:`Normals.solve`'s default).
 FOLD_RTOL = 1e-10
-#: A Coulomb coefficient of one joint (motor), sharp or smooth: ``fc3``, ``jfc7``.
-COULOMB = re.compile(r"j?fc[0-9]+")
 
 
 def model_labels(model: IdentifiedModel) -> tuple[str, ...]:
@@ -101,9 +94,10 @@ def untold_offsets(train: Normals, rtol: float, labels: Sequence[str]) -> NDArra
     """The columns of the torque offsets (:data:`OFFSET`) that the rows of ``train``
     (``labels``: one per column, ``""`` for a column of no offset or friction) do not tell
     apart at the rank tolerance ``rtol`` of their least squares (or what their normal
-    equations resolve, :func:`resolved`): each combination they do
-    not excite names a column, an offset in place of a Coulomb coefficient it holds with it
-    (module docstring); ascending, empty at full rank or without offsets."""
+    equations resolve, :func:`resolved`): each combination they do not excite names a
+    column, an offset in place of a Coulomb coefficient it holds with it
+    (:func:`~dynid.identification.one_way_friction.columns_left_out`); ascending, empty at
+    full rank or without offsets."""
     none = np.zeros(0, dtype=np.intp)
     if len(labels) != train.p or not any(OFFSET.fullmatch(lab) for lab in labels):
         return none
@@ -112,10 +106,7 @@ def untold_offsets(train: Normals, rtol: float, labels: Sequence[str]) -> NDArra
         return none
     R, scale = train.scaled_root()
     names = tuple(lab or f"column {i}" for i, lab in enumerate(labels))
-    named = {names[i] for i in unexcited_columns(R, scale, rank)}
-    if any(COULOMB.fullmatch(lab) for lab in named):  # the offset in its place, if alike
-        combinations = unexcited_combinations(R, scale, rank, names)
-        named = {offset_instead(lab, combinations) for lab in named}
+    named = columns_left_out(R, scale, rank, names)[0]
     found = [i for i, lab in enumerate(names) if lab in named and OFFSET.fullmatch(lab)]
     return np.array(found, dtype=np.intp)
 
