@@ -226,6 +226,25 @@ def robot_data_urdf(rel: str) -> str:
     pytest.skip(f"example-robot-data file {rel} not found")
 
 
+def given_fit(
+    beta: ArrayLike, std: ArrayLike | None = None, kept: ArrayLike | None = None, **fields
+) -> LeastSquaresFit:
+    """A least-squares fit that holds the coefficients ``beta`` with standard deviations
+    ``std`` (zeros by default), those ``kept`` (all by default; the others' rank not
+    counted); ``fields``: any other of :class:`LeastSquaresFit`'s (``covariance``,
+    ``sigma``, ``n_rows``, ...), the rest those of an exact fit."""
+    beta = np.asarray(beta, dtype=float)
+    std = np.zeros(beta.size) if std is None else np.asarray(std, dtype=float)
+    keep = np.ones(beta.size, bool) if kept is None else np.asarray(kept, dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        percent = np.where(beta != 0, 100 * std / np.abs(beta), 0.0)
+    given = dict(
+        std_percent=percent, rank=int(keep.sum()), condition_number=1.0,
+        relative_error_percent=0.0, residual_rms=0.0, sigma=0.0, n_rows=0, rtol=1e-10,
+    )  # fmt: skip
+    return LeastSquaresFit(beta=beta, std=std, kept=keep, **(given | fields))
+
+
 def exact_model(
     robot: dynid.Robot, truth: dynid.Robot, kept: np.ndarray | None = None
 ) -> IdentifiedModel:
@@ -234,19 +253,7 @@ def exact_model(
     base = base_parameters(robot, kind="static")
     r = base.rank
     keep = np.ones(r, bool) if kept is None else np.asarray(kept, dtype=bool)
-    fit = LeastSquaresFit(
-        beta=np.where(keep, base.beta_from_phi(truth.phi), 0.0),
-        std=np.zeros(r),
-        std_percent=np.zeros(r),
-        kept=keep,
-        rank=int(keep.sum()),
-        condition_number=1.0,
-        relative_error_percent=0.0,
-        residual_rms=0.0,
-        sigma=0.0,
-        n_rows=0,
-        rtol=1e-10,
-    )
+    fit = given_fit(np.where(keep, base.beta_from_phi(truth.phi), 0.0), kept=keep)
     return IdentifiedModel(robot=robot, base=base, fit=fit)
 
 

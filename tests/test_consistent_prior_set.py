@@ -23,13 +23,12 @@ from dynid.feasibility.convex import SDPOptions, retrieve_sdp
 from dynid.feasibility.convex.data_term import coefficient_term
 from dynid.feasibility.determined import DATA, PRIOR_MARK, SUM
 from dynid.feasibility.prior_share import prior_sensitivity
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.io.feasible import feasible_to_dict
 from dynid.model.inertia import inertial_from_phi, phi_from_inertial
 from dynid.regressors.base import base_parameters
 
-from conftest import planar_2r
+from conftest import given_fit, planar_2r
 
 
 @pytest.fixture(scope="module")
@@ -39,21 +38,10 @@ def fits():
     beta = base.beta_from_phi(truth.phi)
     std = 0.01 * np.abs(beta) + 1e-4
     noisy = beta + std * np.random.default_rng(1).standard_normal(beta.size)
-    r = beta.size
-    fit = LeastSquaresFit(
-        beta=noisy,
-        std=std,
-        std_percent=100 * std / np.abs(noisy),
-        kept=np.ones(r, bool),
-        rank=r,
-        condition_number=1.0,
-        relative_error_percent=1.0,
-        residual_rms=1.0,
-        sigma=1.0,
-        n_rows=10 * r,
-        rtol=1e-10,
-        covariance=np.diag(std**2),
-    )
+    fit = given_fit(
+        noisy, std, relative_error_percent=1.0, residual_rms=1.0, sigma=1.0,
+        n_rows=10 * beta.size, covariance=np.diag(std**2),
+    )  # fmt: skip
     model = IdentifiedModel(robot=truth, base=base, fit=fit)
     m, c, inertia = inertial_from_phi(truth.phi)  # a prior off the truth, as a URDF is
     prior = truth.with_params(phi_from_inertial(m * [0.9, 1.1], 1.05 * c, 1.1 * inertia))

@@ -15,7 +15,6 @@ import dynid
 from dynid.exceptions import DataError
 from dynid.feasibility.bounds import default_bounds, panda_bounds
 from dynid.feasibility.penalty import RetrievalOptions, retrieve_from_coefficients
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.io.bounds_file import bounds_from_dict, load_bounds, save_bounds
 from dynid.io.export import save_robot
@@ -24,7 +23,7 @@ from dynid.io.report_json import report_to_dict, save_report_json
 from dynid.io.robot.urdf import save_urdf, urdf_from_robot
 from dynid.regressors.base import base_parameters
 
-from conftest import random_states, robot_data_urdf
+from conftest import given_fit, random_states, robot_data_urdf
 
 
 @pytest.fixture(scope="module")
@@ -33,11 +32,7 @@ def retrieved():
     panda = dynid.panda()
     base = base_parameters(panda)
     beta = base.beta_from_phi(panda.phi)
-    r = base.rank
-    fit = LeastSquaresFit(
-        beta, np.zeros(r), np.zeros(r), np.ones(r, bool), r, 1.0, 0.0, 0.0, 0.0, 0, 1e-10
-    )
-    model = IdentifiedModel(panda, base, fit)
+    model = IdentifiedModel(panda, base, given_fit(beta))
     res = retrieve_from_coefficients(
         panda, base, beta, options=RetrievalOptions(runs=3), workers=1, seed=0
     )

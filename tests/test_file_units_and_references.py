@@ -56,6 +56,11 @@ def _write(path: Path, x: dict[str, np.ndarray], time_ms: bool = False) -> Path:
     cols = {"time": x["t"] * (1e3 if time_ms else 1.0)}
     for label, key in (("q", "q"), ("dq", "dq"), ("tau_J", "tau"), ("tau_ext_hat_filtered", "ext")):
         cols |= {f"{label}_{j}": x[key][:, j] for j in range(N)}
+    return _save_columns(path, cols)
+
+
+def _save_columns(path: Path, cols: dict[str, np.ndarray]) -> Path:
+    """A CSV of the columns ``cols``, their names as its header."""
     head = ",".join(cols)
     np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",", header=head, comments="")
     return path
@@ -152,10 +157,7 @@ def test_dynids_own_tau_ext_columns_are_read_under_any_map(tmp_path):
     x = _arrays(6)
     cols = {"time": x["t"]} | {f"pos{j}": x["q"][:, j] for j in range(N)}
     cols |= {f"tau_ext{j + 1}": x["ext"][:, j] for j in range(N)}
-    p = tmp_path / "sim.csv"
-    np.savetxt(
-        p, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments=""
-    )
+    p = _save_columns(tmp_path / "sim.csv", cols)
     found = load_external_torques(p, parse_column_map("t=time,q=pos{i0}"), N)
     assert found is not None
     np.testing.assert_array_equal(found[2], x["ext"])
@@ -181,10 +183,7 @@ def test_a_dynid_named_file_under_another_map_is_told_what_the_empty_map_means(t
     x = _arrays(8)
     cols = {"t": x["t"]} | {f"q{j + 1}": x["q"][:, j] for j in range(N)}
     cols |= {f"tau{j + 1}": x["tau"][:, j] for j in range(N)}
-    p = tmp_path / "own.csv"
-    np.savetxt(
-        p, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments=""
-    )
+    p = _save_columns(tmp_path / "own.csv", cols)
     with pytest.raises(DataError, match=r"hint: the file has dynid's own column names") as e:
         load_mapped_torque_log(p, parse_column_map(MAP))
     assert "--columns '' (an empty map) reads them as they are" in str(e.value)

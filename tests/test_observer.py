@@ -11,7 +11,6 @@ import pytest
 import dynid
 from dynid.friction.laws import LAWS
 from dynid.friction.model import DriveFriction
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel
 from dynid.model.drive import Drive
 from dynid.observer import (
@@ -42,7 +41,7 @@ from dynid.simulation.trajectories import (
     uniform_times,
 )
 
-from conftest import pinocchio_panda_urdf, random_states
+from conftest import given_fit, pinocchio_panda_urdf, random_states
 
 GEARS = np.array([100.0, 100.0, 100.0, 100.0, 80.0, 80.0, 50.0])
 IA = np.array([3e-5, 3e-5, 2.5e-5, 2.5e-5, 1e-5, 1e-5, 8e-6])
@@ -64,12 +63,7 @@ def identified() -> IdentifiedModel:
     base = base_parameters(robot, kind="torque", terms=(RotorInertia(drive),))
     beta = base.beta_from_phi(np.concatenate([robot.phi.reshape(-1), IA]))
     std = 0.01 * np.abs(beta) + 1e-9
-    r = base.rank
-    fit = LeastSquaresFit(
-        beta=beta, std=std, std_percent=100 * std / np.abs(beta), kept=np.ones(r, bool),
-        rank=r, condition_number=1.0, relative_error_percent=0.0, residual_rms=0.0,
-        sigma=0.0, n_rows=0, rtol=1e-10, covariance=np.diag(std**2),
-    )  # fmt: skip
+    fit = given_fit(beta, std, covariance=np.diag(std**2))
     return IdentifiedModel(robot=robot, base=base, fit=fit, drive=drive)
 
 

@@ -11,7 +11,6 @@ import pytest
 import dynid
 from dynid.cli.summaries import format_identification
 from dynid.exceptions import OptionError
-from dynid.identification.least_squares import LeastSquaresFit
 from dynid.identification.model import IdentifiedModel, IdentifiedTerm
 from dynid.identification.static import identify_static
 from dynid.identification.vs_description import described_inertials, description_comparison
@@ -22,7 +21,7 @@ from dynid.regressors.terms import RotorInertia
 from dynid.report.identify import _coefficients_section
 from dynid.simulation.controller import SimulatedController, acquire_static
 
-from conftest import pinocchio_panda_model, planar_2r, random_states
+from conftest import given_fit, pinocchio_panda_model, planar_2r, random_states
 
 #: dynid order (m, mcx, mcy, mcz, Jxx, Jxy, Jxz, Jyy, Jyz, Jzz) from Pinocchio's
 #: (m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz)
@@ -31,21 +30,7 @@ PIN_TO_DYNID = np.array([0, 1, 2, 3, 4, 5, 7, 6, 8, 9])
 
 def _model(robot, base, beta, std, terms=None):
     """An identified model of ``robot`` holding ``beta`` with standard deviations ``std``."""
-    r = base.rank
-    beta, std = np.asarray(beta, float), np.asarray(std, float)
-    fit = LeastSquaresFit(
-        beta=beta,
-        std=std,
-        std_percent=100 * std / np.abs(beta),
-        kept=np.ones(r, bool),
-        rank=r,
-        condition_number=1.0,
-        relative_error_percent=0.0,
-        residual_rms=0.0,
-        sigma=0.0,
-        n_rows=10 * r,
-        rtol=1e-10,
-    )
+    fit = given_fit(beta, std, n_rows=10 * base.rank)
     return IdentifiedModel(robot=robot, base=base, fit=fit, terms=terms or {})
 
 
